@@ -1,0 +1,19 @@
+# Common settings for relight's own targets: warnings as errors apply to our code only,
+# never to third-party headers (those come in as SYSTEM includes through imported targets).
+function(relight_target_defaults target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic)
+  if(RELIGHT_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  target_compile_features(${target} PUBLIC cxx_std_20)
+endfunction()
+
+# relight_library(name SOURCES ... [PUBLIC_DEPS ...] [PRIVATE_DEPS ...])
+# A stage library with headers under <folder>/include/relight/<stage>/.
+function(relight_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;PUBLIC_DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(${name} STATIC ${ARG_SOURCES})
+  target_include_directories(${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_link_libraries(${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  relight_target_defaults(${name})
+endfunction()

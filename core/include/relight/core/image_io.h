@@ -1,0 +1,29 @@
+#pragma once
+// Image files through OpenCV's codecs (kept out of this header). Every reader throws
+// relight::Error with the file name and the reason; every writer is atomic (see atomic_file.h)
+// and picks the format from the extension.
+#include <filesystem>
+
+#include "relight/core/image.h"
+
+namespace relight {
+
+/// 16-bit single-channel PNG depth, metres = value / scale (TUM: 5000, OpenNI: 1000); 0 = missing.
+DepthMap read_depth_png(const std::filesystem::path& path, double scale);
+/// Writes metres * scale rounded to uint16; invalid or out-of-range depth becomes 0.
+void write_depth_png(const std::filesystem::path& path, const DepthMap& depth, double scale);
+
+/// 8-bit colour (PNG, JPEG, ...). Grey images are expanded to RGB; 16-bit images are rejected.
+ColorImage read_color(const std::filesystem::path& path);
+void write_color(const std::filesystem::path& path, const ColorImage& image);
+void write_mask(const std::filesystem::path& path, const Mask& mask);
+
+/// Linear HDR radiance: Radiance .hdr or OpenEXR .exr.
+RadianceImage read_radiance(const std::filesystem::path& path);
+void write_radiance(const std::filesystem::path& path, const RadianceImage& image);
+
+/// False-colour previews for people to look at (not for re-reading).
+ColorImage depth_preview(const DepthMap& depth, float near_m = 0.4f, float far_m = 4.5f);
+ColorImage normal_preview(const NormalMap& normals);
+
+}  // namespace relight

@@ -1,0 +1,161 @@
+#include "relight/core/image_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <vector>
+
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+
+namespace relight {
+
+namespace {
+
+const char* describe_depth(int cv_depth) {
+  switch (cv_depth) {
+    case CV_8U: return "8-bit";
+    case CV_16U: return "16-bit";
+    case CV_32F: return "32-bit float";
+    default: return "unsupported";
+  }
+}
+
+cv::Mat read_any(const std::filesystem::path& path, int flags) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw Error("cannot read " + path.string() + ": no such file");
+  // OpenCV keeps EXR behind an opt-in switch since 4.5; relight reads only files it is asked to.
+  ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+  cv::Mat image;
+  try {
+    image = cv::imread(path.string(), flags);
+  } catch (const cv::Exception& e) {
+    throw Error("cannot decode " + path.string() + ": " + e.err);
+  }
+  if (image.empty()) throw Error("cannot decode " + path.string() + ": not a readable image (corrupt or truncated?)");
+  return image;
+}
+
+void write_encoded(const std::filesystem::path& path, const cv::Mat& image, const std::vector<int>& params = {}) {
+  ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
+  std::vector<unsigned char> encoded;
+  bool ok = false;
+  try {
+    ok = cv::imencode(path.extension().string(), image, encoded, params);
+  } catch (const cv::Exception& e) {
+    throw Error("cannot encode " + path.string() + ": " + e.err);
+  }
+  if (!ok) throw Error("cannot encode " + path.string() + " (unsupported extension?)");
+  write_file_atomically(path, std::as_bytes(std::span<const unsigned char>(encoded)));
+}
+
+template <class T>
+cv::Mat wrap(const Image<T>& image, int cv_type) {
+  // OpenCV only reads through this header; the const_cast never leads to a write.
+  return cv::Mat(image.height(), image.width(), cv_type, const_cast<T*>(image.data()));
+}
+
+}  // namespace
+
+DepthMap read_depth_png(const std::filesystem::path& path, double scale) {
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
+  if (raw.channels() != 1 || raw.depth() != CV_16U) {
+    throw Error("depth image " + path.string() + " is " + describe_depth(raw.depth()) + " with " +
+                std::to_string(raw.channels()) + " channel(s); expected a 16-bit single-channel PNG");
+  }
+  DepthMap depth(raw.cols, raw.rows);
+  const float inverse_scale = static_cast<float>(1.0 / scale);
+  for (int r = 0; r < raw.rows; ++r) {
+    const auto* source = raw.ptr<std::uint16_t>(r);
+    auto destination = depth.row(r);
+    for (int c = 0; c < raw.cols; ++c) destination[c] = static_cast<float>(source[c]) * inverse_scale;
+  }
+  return depth;
+}
+
+void write_depth_png(const std::filesystem::path& path, const DepthMap& depth, double scale) {
+  cv::Mat raw(depth.height(), depth.width(), CV_16UC1);
+  for (int r = 0; r < depth.height(); ++r) {
+    auto* destination = raw.ptr<std::uint16_t>(r);
+    const auto source = depth.row(r);
+    for (int c = 0; c < depth.width(); ++c) {
+      const double value = is_valid_depth(source[c]) ? std::round(source[c] * scale) : 0.0;
+      destination[c] = value > 65535.0 ? 0 : static_cast<std::uint16_t>(value);
+    }
+  }
+  write_encoded(path, raw);
+}
+
+ColorImage read_color(const std::filesystem::path& path) {
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  if (raw.depth() != CV_8U) {
+    throw Error("colour image " + path.string() + " is " + describe_depth(raw.depth()) + "; expected 8-bit");
+  }
+  ColorImage image(raw.cols, raw.rows);
+  cv::Mat wrapped(raw.rows, raw.cols, CV_8UC3, image.data());
+  cv::cvtColor(raw, wrapped, cv::COLOR_BGR2RGB);
+  return image;
+}
+
+void write_color(const std::filesystem::path& path, const ColorImage& image) {
+  cv::Mat bgr;
+  cv::cvtColor(wrap(image, CV_8UC3), bgr, cv::COLOR_RGB2BGR);
+  write_encoded(path, bgr);
+}
+
+void write_mask(const std::filesystem::path& path, const Mask& mask) { write_encoded(path, wrap(mask, CV_8UC1)); }
+
+RadianceImage read_radiance(const std::filesystem::path& path) {
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  cv::Mat linear;
+  raw.convertTo(linear, CV_32FC3);
+  RadianceImage image(raw.cols, raw.rows);
+  cv::Mat wrapped(raw.rows, raw.cols, CV_32FC3, image.data());
+  cv::cvtColor(linear, wrapped, cv::COLOR_BGR2RGB);
+  return image;
+}
+
+void write_radiance(const std::filesystem::path& path, const RadianceImage& image) {
+  cv::Mat bgr;
+  cv::cvtColor(wrap(image, CV_32FC3), bgr, cv::COLOR_RGB2BGR);
+  write_encoded(path, bgr);
+}
+
+ColorImage depth_preview(const DepthMap& depth, float near_m, float far_m) {
+  cv::Mat grey(depth.height(), depth.width(), CV_8UC1);
+  cv::Mat valid(depth.height(), depth.width(), CV_8UC1);
+  for (int r = 0; r < depth.height(); ++r) {
+    for (int c = 0; c < depth.width(); ++c) {
+      const float d = depth(r, c);
+      const float t = std::clamp((d - near_m) / (far_m - near_m), 0.f, 1.f);
+      grey.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(std::lround(255.f * (1.f - t)));
+      valid.at<std::uint8_t>(r, c) = is_valid_depth(d) ? 255 : 0;
+    }
+  }
+  cv::Mat coloured;
+  cv::applyColorMap(grey, coloured, cv::COLORMAP_TURBO);
+  coloured.setTo(cv::Scalar(0, 0, 0), valid == 0);
+  ColorImage preview(depth.width(), depth.height());
+  cv::Mat wrapped(depth.height(), depth.width(), CV_8UC3, preview.data());
+  cv::cvtColor(coloured, wrapped, cv::COLOR_BGR2RGB);
+  return preview;
+}
+
+ColorImage normal_preview(const NormalMap& normals) {
+  ColorImage preview(normals.width(), normals.height());
+  auto encode = [](float v) { return static_cast<std::uint8_t>(std::lround(127.5f * (std::clamp(v, -1.f, 1.f) + 1.f))); };
+  for (int r = 0; r < normals.height(); ++r) {
+    for (int c = 0; c < normals.width(); ++c) {
+      const Float3& n = normals(r, c);
+      // Camera frame has y down and z forward; flip both so that up-facing and camera-facing
+      // surfaces get the familiar light green / blue of normal maps.
+      preview(r, c) = is_valid_normal(n) ? Rgb8{encode(n.x), encode(-n.y), encode(-n.z)} : Rgb8{};
+    }
+  }
+  return preview;
+}
+
+}  // namespace relight

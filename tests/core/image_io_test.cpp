@@ -1,0 +1,106 @@
+#include "relight/core/image_io.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <limits>
+
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+#include "temp_dir.h"
+
+namespace relight {
+namespace {
+
+TEST(ImageIo, DepthPngRoundTripAtScale5000) {
+  TempDir dir;
+  DepthMap depth(16, 8);
+  for (int r = 0; r < 8; ++r)
+    for (int c = 0; c < 16; ++c) depth(r, c) = 0.5f + 0.1f * static_cast<float>(r * 16 + c) / 7.f;
+  depth(0, 0) = 0.f;
+  depth(1, 1) = std::numeric_limits<float>::quiet_NaN();
+  depth(2, 2) = 20.f;  // beyond 65535 / 5000 = 13.1 m: not representable, stored as missing
+  write_depth_png(dir.path() / "d.png", depth, 5000.0);
+  const DepthMap back = read_depth_png(dir.path() / "d.png", 5000.0);
+  ASSERT_TRUE(back.same_shape(depth));
+  EXPECT_EQ(back(0, 0), 0.f);
+  EXPECT_EQ(back(1, 1), 0.f);
+  EXPECT_EQ(back(2, 2), 0.f);
+  for (int r = 3; r < 8; ++r)
+    for (int c = 0; c < 16; ++c) EXPECT_NEAR(back(r, c), depth(r, c), 0.5 / 5000.0 + 1e-6);
+}
+
+TEST(ImageIo, ColorRoundTripKeepsChannelOrder) {
+  TempDir dir;
+  ColorImage image(3, 2);
+  image(0, 0) = {255, 0, 0};
+  image(1, 2) = {10, 200, 30};
+  write_color(dir.path() / "c.png", image);
+  const ColorImage back = read_color(dir.path() / "c.png");
+  EXPECT_TRUE(back == image);
+}
+
+TEST(ImageIo, RadianceHdrRoundTripWithinRgbePrecision) {
+  TempDir dir;
+  RadianceImage image(4, 4, Float3{0.25f, 1.5f, 40.f});
+  image(3, 3) = {1000.f, 0.01f, 0.5f};
+  write_radiance(dir.path() / "r.hdr", image);
+  const RadianceImage back = read_radiance(dir.path() / "r.hdr");
+  ASSERT_TRUE(back.same_shape(image));
+  // RGBE shares one exponent per pixel: 8-bit mantissa relative to the largest channel.
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) {
+      const Float3 a = image(r, c), b = back(r, c);
+      const float peak = std::max({a.x, a.y, a.z});
+      EXPECT_NEAR(b.x, a.x, peak / 128.f);
+      EXPECT_NEAR(b.y, a.y, peak / 128.f);
+      EXPECT_NEAR(b.z, a.z, peak / 128.f);
+    }
+  }
+}
+
+TEST(ImageIo, ExrRoundTripIsExactForHalfRepresentableValues) {
+  TempDir dir;
+  RadianceImage image(5, 3, Float3{0.5f, 2.f, 1024.f});
+  write_radiance(dir.path() / "r.exr", image);
+  const RadianceImage back = read_radiance(dir.path() / "r.exr");
+  EXPECT_TRUE(back == image);
+}
+
+TEST(ImageIo, EightBitDepthIsRejectedWithTheFileName) {
+  TempDir dir;
+  const auto path = dir.path() / "eight.png";
+  write_color(path, ColorImage(4, 4));
+  try {
+    (void)read_depth_png(path, 5000.0);
+    FAIL();
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("eight.png"), std::string::npos) << message;
+    EXPECT_NE(message.find("8-bit"), std::string::npos) << message;
+  }
+}
+
+TEST(ImageIo, MissingAndCorruptFilesAreErrors) {
+  TempDir dir;
+  EXPECT_THROW((void)read_color(dir.path() / "nope.png"), Error);
+  write_file_atomically(dir.path() / "corrupt.png", std::string_view("\x89PNG\r\n\x1a\n garbage"));
+  EXPECT_THROW((void)read_color(dir.path() / "corrupt.png"), Error);
+  EXPECT_THROW((void)read_depth_png(dir.path() / "corrupt.png", 5000.0), Error);
+}
+
+TEST(ImageIo, PreviewsMarkInvalidPixelsBlack) {
+  DepthMap depth(2, 1);
+  depth(0, 0) = 1.f;
+  const ColorImage preview = depth_preview(depth);
+  EXPECT_EQ(preview(0, 1), (Rgb8{0, 0, 0}));
+  EXPECT_NE(preview(0, 0), (Rgb8{0, 0, 0}));
+  NormalMap normals(2, 1);
+  normals(0, 0) = {0, 0, -1};
+  const ColorImage np = normal_preview(normals);
+  EXPECT_EQ(np(0, 0), (Rgb8{128, 128, 255}));
+  EXPECT_EQ(np(0, 1), (Rgb8{0, 0, 0}));
+}
+
+}  // namespace
+}  // namespace relight
