@@ -1,0 +1,41 @@
+// relight-bench [--list] [--repetitions N] [FILTER]: runs the cases whose name contains FILTER.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "bench.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"relight-bench: speed and quality of relight's stages against their baselines.\n"
+               "Prints one JSON object per line per case."};
+  bool list = false;
+  std::string filter;
+  relight::bench::Options options;
+  app.add_flag("--list", list, "List the case names and exit");
+  app.add_option("--repetitions", options.repetitions, "Timed repetitions per side")->check(CLI::Range(1, 1000));
+  app.add_option("filter", filter, "Run only cases whose name contains this text");
+  CLI11_PARSE(app, argc, argv);
+
+  int matched = 0;
+  for (const auto& bench_case : relight::bench::cases()) {
+    if (!filter.empty() && bench_case.name.find(filter) == std::string::npos) continue;
+    ++matched;
+    if (list) {
+      std::cout << bench_case.name << '\n';
+      continue;
+    }
+    relight::bench::Json line;
+    line["case"] = bench_case.name;
+    try {
+      line.update(bench_case.run(options));
+    } catch (const std::exception& e) {
+      line["error"] = e.what();
+    }
+    std::cout << line.dump() << std::endl;
+  }
+  if (matched == 0) {
+    std::cerr << "relight-bench: no case matches '" << filter << "' (see --list)\n";
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,19 @@
+#include "relight/capture/source_stage.h"
+
+namespace relight {
+
+void SourceStage::declare(StageBuilder& builder) {
+  color_ = builder.write<ColorImage>("color");
+  depth_ = builder.write<DepthMap>("depth");
+  frame_ = builder.write<FrameInfo>("frame");
+}
+
+void SourceStage::run(StageContext& context) {
+  auto frame = source_->next();
+  if (!frame) return context.end_of_stream();
+  context.get(color_) = std::move(frame->color);
+  context.get(depth_) = std::move(frame->depth);
+  context.get(frame_) = std::move(frame->info);
+}
+
+}  // namespace relight
