@@ -89,6 +89,39 @@ void write_depth_png(const std::filesystem::path& path, const DepthMap& depth, d
   write_encoded(path, raw);
 }
 
+DepthMap read_depth_exr(const std::filesystem::path& path) {
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
+  if (raw.channels() != 1 || raw.depth() != CV_32F) {
+    throw Error("depth image " + path.string() + " is " + describe_depth(raw.depth()) + " with " +
+                std::to_string(raw.channels()) + " channel(s); expected a single-channel float EXR");
+  }
+  DepthMap depth(raw.cols, raw.rows);
+  for (int r = 0; r < raw.rows; ++r) std::copy_n(raw.ptr<float>(r), raw.cols, depth.row(r).data());
+  return depth;
+}
+
+void write_depth_exr(const std::filesystem::path& path, const DepthMap& depth) {
+  // FP32 explicitly: half floats would lose millimetres beyond 2 m.
+  write_encoded(path, wrap(depth, CV_32FC1), {cv::IMWRITE_EXR_TYPE, cv::IMWRITE_EXR_TYPE_FLOAT});
+}
+
+LabelImage read_label_png(const std::filesystem::path& path) {
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
+  if (raw.channels() != 1 || (raw.depth() != CV_16U && raw.depth() != CV_8U)) {
+    throw Error("label image " + path.string() + " is " + describe_depth(raw.depth()) + " with " +
+                std::to_string(raw.channels()) + " channel(s); expected a single-channel PNG");
+  }
+  cv::Mat wide;
+  raw.convertTo(wide, CV_16U);
+  LabelImage labels(raw.cols, raw.rows);
+  for (int r = 0; r < raw.rows; ++r) std::copy_n(wide.ptr<std::uint16_t>(r), raw.cols, labels.row(r).data());
+  return labels;
+}
+
+void write_label_png(const std::filesystem::path& path, const LabelImage& labels) {
+  write_encoded(path, wrap(labels, CV_16UC1));
+}
+
 ColorImage read_color(const std::filesystem::path& path) {
   const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
   if (raw.depth() != CV_8U) {

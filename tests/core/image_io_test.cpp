@@ -102,5 +102,29 @@ TEST(ImageIo, PreviewsMarkInvalidPixelsBlack) {
   EXPECT_EQ(np(0, 1), (Rgb8{0, 0, 0}));
 }
 
+TEST(ImageIo, DepthExrRoundTripIsExactFloat) {
+  TempDir dir;
+  DepthMap depth(7, 5);
+  for (int r = 0; r < 5; ++r)
+    for (int c = 0; c < 7; ++c) depth(r, c) = 0.4f + 0.0001234f * static_cast<float>(r * 7 + c) + 3.f * static_cast<float>(c);
+  depth(2, 3) = 0.f;
+  write_depth_exr(dir.path() / "d.exr", depth);
+  const DepthMap back = read_depth_exr(dir.path() / "d.exr");
+  EXPECT_TRUE(back == depth);
+  EXPECT_THROW((void)read_depth_exr(dir.path() / "missing.exr"), Error);
+  write_color(dir.path() / "c.png", ColorImage(2, 2));
+  EXPECT_THROW((void)read_depth_exr(dir.path() / "c.png"), Error);
+}
+
+TEST(ImageIo, LabelPngKeepsSixteenBitValues) {
+  TempDir dir;
+  LabelImage labels(4, 3);
+  labels(0, 0) = 1;
+  labels(1, 2) = 300;
+  labels(2, 3) = 65535;
+  write_label_png(dir.path() / "l.png", labels);
+  EXPECT_TRUE(read_label_png(dir.path() / "l.png") == labels);
+}
+
 }  // namespace
 }  // namespace relight

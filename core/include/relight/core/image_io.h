@@ -13,6 +13,14 @@ DepthMap read_depth_png(const std::filesystem::path& path, double scale);
 /// Writes metres * scale rounded to uint16; invalid or out-of-range depth becomes 0.
 void write_depth_png(const std::filesystem::path& path, const DepthMap& depth, double scale);
 
+/// Single-channel 32-bit float OpenEXR depth in metres (exact ground truth; 0 = missing).
+DepthMap read_depth_exr(const std::filesystem::path& path);
+void write_depth_exr(const std::filesystem::path& path, const DepthMap& depth);
+
+/// 16-bit single-channel PNG labels (material ids, cluster ids), stored as they are.
+LabelImage read_label_png(const std::filesystem::path& path);
+void write_label_png(const std::filesystem::path& path, const LabelImage& labels);
+
 /// 8-bit colour (PNG, JPEG, ...). Grey images are expanded to RGB; 16-bit images are rejected.
 ColorImage read_color(const std::filesystem::path& path);
 void write_color(const std::filesystem::path& path, const ColorImage& image);
