@@ -1,0 +1,33 @@
+#pragma once
+// Which backend a stage runs on. Measured on this project's machines (shared/design/platform.md):
+// lavapipe, the CPU-type Vulkan device, runs a per-pixel compute dispatch slower than relight's
+// plain CPU loop, so per-pixel stages default to the CPU path there and to Vulkan on a real GPU.
+// Rasterisation-heavy work (the renderer) stays on Vulkan whenever a device exists.
+// Deliberately free of Vulkan headers: the app's option parsing includes it.
+#include <optional>
+#include <string_view>
+
+#include "relight/core/frame_graph.h"  // relight::Backend
+
+namespace relight::vk {
+
+class VulkanContext;
+
+/// Auto: the rule above. ForceCpu: the app's --cpu. ForceVulkan: use Vulkan even on lavapipe
+/// (tests, benchmarks); choose_backend throws relight::Error if there is no device.
+enum class BackendPolicy { Auto, ForceCpu, ForceVulkan };
+
+enum class StageKind {
+  PerPixel,       ///< independent work per pixel (filters, normals): CPU wins on lavapipe
+  Rasterisation,  ///< triangle rendering: Vulkan whenever a device exists
+};
+
+/// `context` may be null (no Vulkan device): then Cpu, except ForceVulkan throws.
+[[nodiscard]] Backend choose_backend(StageKind kind, const VulkanContext* context,
+                                     BackendPolicy policy = BackendPolicy::Auto);
+
+/// "auto", "cpu", "vulkan" (case-sensitive; for command-line flags and RELIGHT_BACKEND).
+[[nodiscard]] std::optional<BackendPolicy> parse_backend_policy(std::string_view text);
+[[nodiscard]] const char* to_string(BackendPolicy policy);
+
+}  // namespace relight::vk
