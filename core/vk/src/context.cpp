@@ -152,7 +152,13 @@ void VulkanContext::create_instance(bool want_validation) {
   if (validation) info.pNext = &messenger_info;
 
   VkInstance instance = VK_NULL_HANDLE;
-  RELIGHT_VK_CHECK(vkCreateInstance(&info, nullptr, &instance));
+  const VkResult result = vkCreateInstance(&info, nullptr, &instance);
+  if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
+    // What the loader says when it finds no driver at all: say that in words.
+    throw VulkanError(result, "no Vulkan driver found (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER); "
+                              "mesa-vulkan-drivers provides the lavapipe CPU device");
+  }
+  RELIGHT_VK_CHECK(result);
   instance_ = UniqueInstance(instance);
   if (validation) messenger_ = DebugMessenger(instance, validation_log_);
 }

@@ -23,7 +23,7 @@ class VulkanBuffer;
 class VulkanContext;
 
 struct ComputePipelineInfo {
-  std::span<const std::uint32_t> spirv;     ///< embedded SPIR-V words (see cmake/EmbedShaders.cmake)
+  std::span<const std::uint32_t> spirv{};   ///< embedded SPIR-V words (see cmake/EmbedShaders.cmake)
   std::uint32_t storage_buffers = 1;        ///< set 0, bindings 0..storage_buffers-1
   std::uint32_t push_constant_bytes = 0;    ///< multiple of 4, <= 128 (the guaranteed minimum)
   std::uint32_t max_descriptor_sets = 16;   ///< how many bind() results may exist at once

@@ -36,7 +36,7 @@ enum class Validation { Auto, On, Off };
 struct VulkanOptions {
   /// Device selector (index, type or name substring; see device_selection.h). Empty: the
   /// environment variable RELIGHT_VK_DEVICE, else the best device.
-  std::string device;
+  std::string device{};
   Validation validation = Validation::Auto;
   /// Treat device memory as if the host could not map it, so that uploads and downloads go
   /// through staging buffers and copy commands: the path a discrete GPU takes. On lavapipe (one
