@@ -270,6 +270,10 @@ namespace {
 std::string dot_quote(const std::string& text) {
   std::string quoted = "\"";
   for (char c : text) {
+    if (c == '\n') {
+      quoted += "\\n";  // DOT's line break inside a label
+      continue;
+    }
     if (c == '"' || c == '\\') quoted += '\\';
     quoted += c;
   }
@@ -284,14 +288,14 @@ std::string FrameGraph::to_dot() const {
     const bool vk = entry.stage->backend() == Backend::Vulkan;
     dot << "  " << dot_quote("stage:" + entry.name) << " [shape=box, style=\"rounded,filled\", fillcolor="
         << (entry.culled ? "\"#dddddd\"" : vk ? "\"#f4c7a1\"" : "\"#a9cce3\"")
-        << ", label=" << dot_quote(entry.name + "\\n" + to_string(entry.stage->backend()) +
+        << ", label=" << dot_quote(entry.name + "\n" + to_string(entry.stage->backend()) +
                                    (entry.culled ? " (culled)" : ""))
         << "];\n";
   }
   for (const auto& buffer : buffers_) {
     const std::string type = buffer.type ? buffer.type->name : std::string("?");
     dot << "  " << dot_quote("buffer:" + buffer.name) << " [shape=ellipse, label="
-        << dot_quote(buffer.name + "\\n" + type) << "];\n";
+        << dot_quote(buffer.name + "\n" + type) << "];\n";
   }
   for (const auto& entry : stages_) {
     for (const auto& decl : entry.declarations) {

@@ -1,8 +1,13 @@
 #include "relight/core/image_io.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -14,6 +19,34 @@
 namespace relight {
 
 namespace {
+
+// libpng prints its own "libpng error: ..." line on stderr before OpenCV reports failure; the
+// user should see one line that names the file, so the decoder's stderr is muted while it runs.
+class MutedStderr {
+ public:
+  MutedStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(STDERR_FILENO);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, STDERR_FILENO);
+    if (null >= 0) ::close(null);
+  }
+  ~MutedStderr() {
+    if (saved_ < 0) return;
+    ::dup2(saved_, STDERR_FILENO);
+    ::close(saved_);
+  }
+  MutedStderr(const MutedStderr&) = delete;
+  MutedStderr& operator=(const MutedStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
+std::mutex& decoder_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
 
 const char* describe_depth(int cv_depth) {
   switch (cv_depth) {
@@ -31,6 +64,8 @@ cv::Mat read_any(const std::filesystem::path& path, int flags) {
   ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
   cv::Mat image;
   try {
+    const std::lock_guard lock(decoder_mutex());
+    const MutedStderr muted;
     image = cv::imread(path.string(), flags);
   } catch (const cv::Exception& e) {
     throw Error("cannot decode " + path.string() + ": " + e.err);

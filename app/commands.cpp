@@ -1,0 +1,86 @@
+#include "commands.h"
+
+#include <functional>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include "json_config.h"
+#include "replay.h"
+
+namespace relight::app {
+
+namespace {
+
+void add_compute_options(CLI::App& command, ReplayOptions& options) {
+  command.add_option("--backend", options.backend,
+                     "auto (per-pixel stages on the CPU when the only Vulkan device is a CPU device), cpu, vulkan")
+      ->capture_default_str();
+  command.add_flag_callback("--cpu", [&options] { options.backend = "cpu"; }, "Same as --backend cpu");
+  command.add_option("--device", options.device,
+                     "Vulkan device: index, type (discrete, integrated, cpu) or part of its name "
+                     "(default: $RELIGHT_VK_DEVICE, else the best device)");
+}
+
+struct Registry {
+  std::map<const CLI::App*, std::function<int()>> runners;
+};
+
+Registry& registry() {
+  static Registry instance;
+  return instance;
+}
+
+void register_replay(CLI::App& app) {
+  auto options = std::make_shared<ReplayOptions>();
+  CLI::App* replay = app.add_subcommand("replay", "Run the pipeline on a recorded RGB-D sequence (TUM folder)");
+  replay->add_option("sequence", options->sequence, "TUM RGB-D folder (default: the embedded sample)");
+  replay->add_option("--out", options->out, "Output folder")->capture_default_str();
+  replay->add_option("--frames", options->frames, "Frame range A:B (B exclusive), A:, :B or N");
+  replay->add_option("--intrinsics", options->intrinsics, "Override intrinsics: kinect, fr1, fr2, fr3");
+  replay->add_flag("--quiet", options->quiet, "No progress or summary on stderr");
+  replay->add_flag("!--no-frames", options->write_frames, "Do not write per-frame images");
+  add_compute_options(*replay, *options);
+  registry().runners[replay] = [options] { return run_replay(*options); };
+}
+
+void register_graph(CLI::App& app) {
+  auto dot = std::make_shared<bool>(false);
+  CLI::App* graph = app.add_subcommand("graph", "Show the replay frame graph (stages, buffers, order)");
+  graph->add_flag("--dot", *dot, "Print Graphviz DOT instead of the execution order");
+  auto options = std::make_shared<ReplayOptions>();
+  add_compute_options(*graph, *options);
+  registry().runners[graph] = [dot, options] {
+    ReplayPipeline pipeline = build_replay_pipeline(open_replay_source(*options), *options);
+    FrameGraph& frame_graph = *pipeline.graph;
+    frame_graph.compile();
+    if (*dot) {
+      std::cout << frame_graph.to_dot();
+    } else {
+      for (const auto& stage : frame_graph.execution_order()) std::cout << stage << "\n";
+    }
+    return 0;
+  };
+}
+
+}  // namespace
+
+void register_commands(CLI::App& app) {
+  add_json_config(app);
+  // Settings made before add_subcommand are inherited by the subcommands.
+  app.allow_config_extras(CLI::config_extras_mode::error);  // a misspelt key is an error, not ignored
+  app.fallthrough();  // so that `relight replay --config cfg.json` reaches the main app's --config
+  register_replay(app);
+  register_graph(app);
+}
+
+int run_selected(CLI::App& app) {
+  for (CLI::App* command : app.get_subcommands()) {
+    const auto runner = registry().runners.find(command);
+    if (runner != registry().runners.end()) return runner->second();
+  }
+  std::cerr << app.help();
+  return 2;
+}
+
+}  // namespace relight::app

@@ -1,0 +1,35 @@
+#pragma once
+// Sink stage of `relight replay`: writes, per frame, the buffers a person wants to look at into
+// DIR/frames/ as PNG (colour as it is; depth as a false-colour preview), each file atomically.
+// Reads: the buffers registered with add_color()/add_depth() before the stage joins the graph.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "relight/core/frame_graph.h"
+#include "relight/core/image.h"
+
+namespace relight::app {
+
+class FrameWriterStage final : public Stage {
+ public:
+  explicit FrameWriterStage(std::filesystem::path folder) : folder_(std::move(folder)) {}
+  void add_color(std::string buffer) { color_names_.push_back(std::move(buffer)); }
+  void add_depth(std::string buffer) { depth_names_.push_back(std::move(buffer)); }
+
+  [[nodiscard]] std::string name() const override { return "frame_writer"; }
+  [[nodiscard]] bool has_side_effects() const override { return true; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  [[nodiscard]] std::filesystem::path file_for(std::int64_t frame, const std::string& buffer) const;
+
+  std::filesystem::path folder_;
+  std::vector<std::string> color_names_;
+  std::vector<std::string> depth_names_;
+  std::vector<Read<ColorImage>> colors_;
+  std::vector<Read<DepthMap>> depths_;
+};
+
+}  // namespace relight::app

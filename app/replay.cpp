@@ -1,0 +1,111 @@
+#include "replay.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <iostream>
+
+#include "frame_range.h"
+#include "frame_writer_stage.h"
+#include "relight/capture/source_stage.h"
+#include "relight/capture/tum_sequence.h"
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+#include "relight/core/progress.h"
+#include "relight/reconstruct/depth_box_filter.h"
+#include "relight/vk/backend.h"
+#include "relight/vk/context.h"
+#include "relight/vk/transfer.h"
+#include "report.h"
+
+namespace relight::app {
+
+std::filesystem::path data_folder() {
+  if (const char* env = std::getenv("RELIGHT_DATA"); env && *env) return env;
+  return RELIGHT_DATA_DIR;
+}
+
+std::filesystem::path default_sequence() { return data_folder() / "tum_fr1_rpy"; }
+
+std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options) {
+  TumOptions tum;
+  if (!options.intrinsics.empty()) {
+    tum.intrinsics = PinholeIntrinsics::preset(options.intrinsics);
+    if (!tum.intrinsics) throw Error("--intrinsics '" + options.intrinsics + "' is not one of kinect, fr1, fr2, fr3");
+  }
+  const FrameRange range = options.frames.empty() ? FrameRange{} : parse_frame_range(options.frames);
+  const auto folder = options.sequence.empty() ? default_sequence() : options.sequence;
+  return std::make_unique<TumSource>(TumSequence::open(folder, tum), range.first, range.last);
+}
+
+ReplayPipeline::ReplayPipeline() = default;
+ReplayPipeline::~ReplayPipeline() = default;
+ReplayPipeline::ReplayPipeline(ReplayPipeline&&) noexcept = default;
+
+namespace {
+
+// No Vulkan context is made when everything runs on the CPU anyway (--backend cpu).
+std::unique_ptr<vk::VulkanContext> make_vulkan(const ReplayOptions& options, vk::BackendPolicy policy) {
+  if (policy == vk::BackendPolicy::ForceCpu) return nullptr;
+  vk::VulkanOptions vulkan_options;
+  vulkan_options.device = options.device;
+  return vk::try_create_vulkan(vulkan_options);
+}
+
+}  // namespace
+
+ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options) {
+  const auto policy = vk::parse_backend_policy(options.backend);
+  if (!policy) throw Error("--backend '" + options.backend + "' is not one of auto, cpu, vulkan");
+  ReplayPipeline pipeline;
+  pipeline.vulkan = make_vulkan(options, *policy);
+  pipeline.graph = std::make_unique<FrameGraph>(pipeline.vulkan ? &pipeline.vulkan->transfer() : nullptr);
+  const Backend per_pixel = vk::choose_backend(vk::StageKind::PerPixel, pipeline.vulkan.get(), *policy);
+  pipeline.compute = std::string("per-pixel stages on ") + to_string(per_pixel) +
+                     (pipeline.vulkan ? " (Vulkan device: " + pipeline.vulkan->device_info().name + ")"
+                                      : " (no Vulkan device in use)");
+
+  FrameGraph& graph = *pipeline.graph;
+  graph.emplace<SourceStage>(std::move(source));
+  graph.add(make_depth_box_filter_stage(per_pixel, pipeline.vulkan.get()));
+  if (options.write_frames) {
+    auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
+    writer->add_color("color");
+    writer->add_depth("depth");
+    writer->add_depth("depth_smoothed");
+    graph.add(std::move(writer));
+  }
+  return pipeline;
+}
+
+int run_replay(const ReplayOptions& options) {
+  auto source = open_replay_source(options);
+  const std::string description = source->describe();
+  const std::int64_t total = source->size_hint();
+  std::error_code ec;
+  std::filesystem::create_directories(options.out, ec);
+  if (ec) throw Error("cannot create output folder " + options.out.string() + ": " + ec.message());
+
+  ReplayPipeline pipeline = build_replay_pipeline(std::move(source), options);
+  FrameGraph& graph = *pipeline.graph;
+  graph.compile();
+  write_file_atomically(options.out / "graph.dot", graph.to_dot());
+  if (!options.quiet) std::cerr << "relight replay: " << description << "; " << pipeline.compute << "\n";
+
+  ProgressBar progress("replay", total, options.quiet);
+  const auto start = std::chrono::steady_clock::now();
+  while (graph.run_frame()) progress.update(graph.frames_run());
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  auto report = timing_report(graph, seconds);
+  report["sequence"] = description;
+  report["compute"] = pipeline.compute;
+  write_file_atomically(options.out / "report.json", report.dump(2) + "\n");
+  if (!options.quiet) {
+    std::cerr << "relight replay: " << graph.frames_run() << " frames in " << seconds << " s; results in "
+              << options.out.string() << " (report.json, graph.dot, frames/)\n";
+  }
+  return 0;
+}
+
+}  // namespace relight::app

@@ -1,0 +1,49 @@
+#pragma once
+// `relight replay`: runs the frame graph over a recorded sequence and writes the results.
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "relight/capture/frame_source.h"
+#include "relight/core/frame_graph.h"
+
+namespace relight::vk {
+class VulkanContext;
+}
+
+namespace relight::app {
+
+struct ReplayOptions {
+  std::filesystem::path sequence;  ///< empty: the embedded sample (data/tum_fr1_rpy)
+  std::filesystem::path out = "relight-out";
+  std::string frames;              ///< "A:B" range, empty = all
+  std::string intrinsics;          ///< TUM preset name overriding the sequence's own
+  bool quiet = false;
+  bool write_frames = true;        ///< per-frame PNGs under out/frames
+  std::string backend = "auto";    ///< auto | cpu | vulkan (see vk/backend.h)
+  std::string device;              ///< Vulkan device selector (index, type or name part)
+};
+
+
+/// A built replay graph with the Vulkan context its stages use (the context outlives the graph).
+struct ReplayPipeline {
+  std::unique_ptr<relight::vk::VulkanContext> vulkan;
+  std::unique_ptr<FrameGraph> graph;
+  std::string compute;  ///< one line: which backend runs the per-pixel stages, on which device
+  ReplayPipeline();
+  ~ReplayPipeline();
+  ReplayPipeline(ReplayPipeline&&) noexcept;
+};
+
+/// The folder holding the embedded sample data: $RELIGHT_DATA, else the source tree's data/.
+[[nodiscard]] std::filesystem::path data_folder();
+[[nodiscard]] std::filesystem::path default_sequence();
+
+/// Creates the Vulkan context the options ask for and the replay graph: source, depth filter, writer.
+[[nodiscard]] ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options);
+[[nodiscard]] std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options);
+
+/// Runs the whole replay; returns the process exit code. Throws relight::Error on bad input.
+int run_replay(const ReplayOptions& options);
+
+}  // namespace relight::app

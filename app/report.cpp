@@ -1,0 +1,47 @@
+#include "report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace relight::app {
+
+MsSummary summarize(std::vector<double> ms) {
+  MsSummary summary;
+  if (ms.empty()) return summary;
+  std::sort(ms.begin(), ms.end());
+  const std::size_t n = ms.size();
+  summary.median = n % 2 ? ms[n / 2] : 0.5 * (ms[n / 2 - 1] + ms[n / 2]);
+  summary.mean = std::accumulate(ms.begin(), ms.end(), 0.0) / static_cast<double>(n);
+  summary.p95 = ms[std::min(n - 1, static_cast<std::size_t>(std::ceil(0.95 * static_cast<double>(n))) - 1)];
+  summary.max = ms.back();
+  return summary;
+}
+
+nlohmann::ordered_json timing_report(const FrameGraph& graph, double total_seconds) {
+  nlohmann::ordered_json report;
+  report["frames"] = graph.frames_run();
+  report["seconds"] = total_seconds;
+  report["fps"] = total_seconds > 0 ? static_cast<double>(graph.frames_run()) / total_seconds : 0.0;
+  report["execution_order"] = graph.execution_order();
+  report["culled_stages"] = graph.culled_stages();
+  auto& stages = report["stages"] = nlohmann::ordered_json::array();
+  for (const auto& timing : graph.timings()) {
+    const MsSummary wall = summarize(timing.wall_ms);
+    nlohmann::ordered_json stage;
+    stage["stage"] = timing.stage;
+    stage["backend"] = to_string(timing.backend);
+    stage["frames"] = timing.wall_ms.size();
+    stage["median_ms"] = wall.median;
+    stage["mean_ms"] = wall.mean;
+    stage["p95_ms"] = wall.p95;
+    stage["max_ms"] = wall.max;
+    if (!timing.device_ms.empty()) stage["device_median_ms"] = summarize(timing.device_ms).median;
+    stage["wall_ms"] = timing.wall_ms;
+    if (!timing.device_ms.empty()) stage["device_ms"] = timing.device_ms;
+    stages.push_back(std::move(stage));
+  }
+  return report;
+}
+
+}  // namespace relight::app

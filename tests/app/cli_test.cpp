@@ -1,0 +1,165 @@
+// The relight executable as users run it: exit codes, one-line errors, outputs.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
+
+#include "relight/core/atomic_file.h"
+#include "relight/core/image_io.h"
+#include "run_command.h"
+#include "temp_dir.h"
+
+namespace relight {
+namespace {
+
+const std::string kRelight = RELIGHT_BIN;
+const std::filesystem::path kSample = std::filesystem::path(RELIGHT_TEST_DATA) / "tum_fr1_rpy";
+
+CommandResult relight(const std::string& arguments) { return run_command(kRelight + " " + arguments); }
+
+void expect_one_line_error(const CommandResult& result, int exit_code) {
+  EXPECT_EQ(result.exit_code, exit_code) << result.err;
+  EXPECT_EQ(result.err.rfind("relight: error: ", 0), 0u) << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+}
+
+std::size_t temporary_files_under(const std::filesystem::path& folder) {
+  std::size_t count = 0;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder)) {
+    if (entry.path().filename().string().find(".tmp-") != std::string::npos) ++count;
+  }
+  return count;
+}
+
+TEST(Cli, HelpListsTheSubcommands) {
+  const auto result = relight("--help");
+  EXPECT_EQ(result.exit_code, 0);
+  for (const char* command : {"replay", "graph", "synth"}) EXPECT_NE(result.out.find(command), std::string::npos) << command;
+  EXPECT_EQ(relight("replay --help").exit_code, 0);
+}
+
+TEST(Cli, NoSubcommandOrUnknownFlagIsAUsageError) {
+  EXPECT_EQ(relight("").exit_code, 2);
+  EXPECT_EQ(relight("replay --no-such-flag").exit_code, 2);
+}
+
+TEST(Cli, ReplayOfTheEmbeddedSampleWritesFramesReportAndGraph) {
+  TempDir dir;
+  const auto result = relight("replay --quiet --out " + dir.path().string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(result.err.empty()) << result.err;
+  const auto report = nlohmann::json::parse(read_text_file(dir.path() / "report.json"));
+  EXPECT_EQ(report["frames"], 4);
+  std::set<std::string> stages;
+  for (const auto& stage : report["stages"]) {
+    stages.insert(stage["stage"]);
+    EXPECT_EQ(stage["wall_ms"].size(), 4u) << stage["stage"];
+    EXPECT_GE(stage["median_ms"].get<double>(), 0.0);
+  }
+  EXPECT_TRUE(stages.count("source"));
+  EXPECT_TRUE(stages.count("frame_writer"));
+  const ColorImage color = read_color(dir.path() / "frames" / "000003_color.png");
+  EXPECT_EQ(color.width(), 640);
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "frames" / "000003_depth.png"));
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "graph.dot"));
+  EXPECT_EQ(temporary_files_under(dir.path()), 0u);
+}
+
+TEST(Cli, FrameRangeLimitsTheRun) {
+  TempDir dir;
+  ASSERT_EQ(relight("replay --quiet --frames 1:3 --out " + dir.path().string()).exit_code, 0);
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(dir.path() / "report.json"))["frames"], 2);
+}
+
+TEST(Cli, BadInputGivesOneLineAndExitCodeOne) {
+  TempDir dir;
+  expect_one_line_error(relight("replay /no/such/folder --out " + dir.path().string()), 1);
+  expect_one_line_error(relight("replay --frames 3:1 --out " + dir.path().string()), 1);
+  expect_one_line_error(relight("replay --frames x --out " + dir.path().string()), 1);
+  expect_one_line_error(relight("replay --intrinsics fr9 --out " + dir.path().string()), 1);
+}
+
+TEST(Cli, CorruptFrameMidSequenceFailsCleanlyWithoutPartialFiles) {
+  TempDir dir;
+  const auto sequence = dir.path() / "seq";
+  std::filesystem::copy(kSample, sequence, std::filesystem::copy_options::recursive);
+  write_file_atomically(sequence / "depth" / "1305031229.596617.png", std::string_view("\x89PNG\r\n\x1a\nbroken"));
+  const auto out = dir.path() / "out";
+  const auto result = relight("replay " + sequence.string() + " --quiet --out " + out.string());
+  expect_one_line_error(result, 1);
+  EXPECT_NE(result.err.find("1305031229.596617.png"), std::string::npos) << result.err;
+  EXPECT_EQ(temporary_files_under(out), 0u);
+  EXPECT_FALSE(std::filesystem::exists(out / "report.json"));
+}
+
+TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
+  TempDir dir;
+  const auto cpu = dir.path() / "cpu", vulkan = dir.path() / "vulkan";
+  ASSERT_EQ(relight("replay --quiet --frames 0:2 --backend cpu --out " + cpu.string()).exit_code, 0);
+  const auto result = relight("replay --quiet --frames 0:2 --backend vulkan --out " + vulkan.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  for (const char* file : {"000000_depth_smoothed.png", "000001_depth_smoothed.png"}) {
+    EXPECT_EQ(read_text_file(cpu / "frames" / file), read_text_file(vulkan / "frames" / file)) << file;
+  }
+  const auto report = nlohmann::json::parse(read_text_file(vulkan / "report.json"));
+  bool found = false;
+  for (const auto& stage : report["stages"]) {
+    if (stage["stage"] != "depth_box_filter") continue;
+    found = true;
+    EXPECT_EQ(stage["backend"], "Vulkan");
+    EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0);
+  }
+  EXPECT_TRUE(found);
+  expect_one_line_error(relight("replay --backend quantum --out " + dir.path().string()), 1);
+}
+
+TEST(Cli, JsonConfigSuppliesOptionsAndTheCommandLineWins) {
+  TempDir dir;
+  const auto config = dir.path() / "cfg.json";
+  const auto out = dir.path() / "out";
+  write_file_atomically(config, "{\"frames\": \"0:3\", \"quiet\": true, \"out\": \"" + out.string() + "\"}");
+  ASSERT_EQ(relight("replay --config " + config.string()).exit_code, 0);
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(out / "report.json"))["frames"], 3);
+  ASSERT_EQ(relight("replay --config " + config.string() + " --frames 0:1").exit_code, 0);
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(out / "report.json"))["frames"], 1);
+}
+
+TEST(Cli, BadConfigIsAUsageError) {
+  TempDir dir;
+  const auto config = dir.path() / "cfg.json";
+  write_file_atomically(config, std::string_view("{\"frams\": 2}"));
+  const auto misspelt = relight("replay --config " + config.string());
+  EXPECT_EQ(misspelt.exit_code, 2);
+  EXPECT_NE(misspelt.err.find("frams"), std::string::npos) << misspelt.err;
+  write_file_atomically(config, std::string_view("{broken"));
+  EXPECT_EQ(relight("replay --config " + config.string()).exit_code, 2);
+  EXPECT_EQ(relight("replay --config " + (dir.path() / "missing.json").string()).exit_code, 2);
+}
+
+// A structural check of the DOT text: one digraph, every edge joins declared nodes.
+TEST(Cli, GraphDotIsAValidGraph) {
+  const auto result = relight("graph --dot");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.out.rfind("digraph relight {", 0), 0u);
+  std::set<std::string> nodes;
+  const std::regex node(R"re(^\s*("[^"]+")\s*\[)re"), edge(R"re(^\s*("[^"]+")\s*->\s*("[^"]+"))re");
+  std::istringstream lines(result.out);
+  int edges = 0;
+  for (std::string line; std::getline(lines, line);) {
+    std::smatch m;
+    if (std::regex_search(line, m, edge)) {
+      ++edges;
+      EXPECT_TRUE(nodes.count(m[1]) && nodes.count(m[2])) << line;
+    } else if (std::regex_search(line, m, node)) {
+      nodes.insert(m[1]);
+    }
+  }
+  EXPECT_GE(edges, 3);
+  EXPECT_EQ(std::count(result.out.begin(), result.out.end(), '"') % 2, 0);
+  const auto order = relight("graph");
+  EXPECT_EQ(order.out.rfind("source\n", 0), 0u) << order.out;
+}
+
+}  // namespace
+}  // namespace relight
