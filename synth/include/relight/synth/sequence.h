@@ -1,0 +1,58 @@
+#pragma once
+// Writes a complete synthetic RGB-D sequence with ground truth:
+//   rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt  standard TUM RGB-D (relight::TumWriter),
+//                                                      depth 16-bit PNG, metres * 5000
+//   gt/depth/<t>.exr     exact depth, float32 metres along the optical axis (0 = nothing hit)
+//   gt/normals/<t>.exr   camera-frame unit normals facing the camera (RGB = xyz)
+//   gt/albedo/<t>.png    k_d, sRGB-encoded 8 bit
+//   gt/material/<t>.png  16-bit material index + 1 (0 = nothing hit; see scene.json)
+//   probe.hdr            the fisheye light probe (probe.h), linear radiance
+//   scene.json           intrinsics, depth_scale, world_up, materials, objects, lights,
+//                        environment, tag (corners and pose), noise, seed, trajectory, probe
+// where <t> is TumWriter::file_name(timestamp) without its extension. Everything is a pure
+// function of the options: the same options give byte-identical files.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "relight/core/camera.h"
+#include "relight/synth/kinect_noise.h"
+#include "relight/synth/probe.h"
+#include "relight/synth/raycast.h"
+#include "relight/synth/scene.h"
+#include "relight/synth/trajectory.h"
+
+namespace relight::synth {
+
+struct SynthOptions {
+  int frames = 30;
+  Trajectory trajectory = Trajectory::Orbit;
+  std::uint64_t seed = 0;
+  NoiseModel noise = NoiseModel::Kinect1;
+  KinectNoiseOptions kinect;  ///< used when noise == Kinect1
+  ColorResponse color;        ///< white-balance gains and exposure of the colour camera
+  int width = 640;            ///< other sizes scale the Kinect v1 intrinsics
+  int height = 480;
+  int threads = 0;  ///< 0 = all hardware threads
+  bool ground_truth = true;
+  bool probe = true;
+};
+
+/// Kinect v1 intrinsics (PinholeIntrinsics::kinect_v1) scaled to options.width x height.
+[[nodiscard]] PinholeIntrinsics synth_intrinsics(const SynthOptions& options);
+
+/// The text of scene.json for this scene and these options.
+[[nodiscard]] std::string scene_json(const Scene& scene, const SynthOptions& options);
+
+/// Called after each frame with (frames done, frames total).
+using SynthProgress = std::function<void(int, int)>;
+
+/// Renders and writes the sequence of default_indoor_scene() into `out` (created if needed).
+/// Throws relight::Error on bad options or when a file cannot be written.
+void write_sequence(const SynthOptions& options, const std::filesystem::path& out, const SynthProgress& progress = {});
+void write_sequence(const Scene& scene, const SynthOptions& options, const std::filesystem::path& out,
+                    const SynthProgress& progress = {});
+
+}  // namespace relight::synth

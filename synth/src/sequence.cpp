@@ -1,0 +1,228 @@
+#include "relight/synth/sequence.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "relight/capture/tum_writer.h"
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+#include "relight/core/image_io.h"
+
+namespace relight::synth {
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+namespace fs = std::filesystem;
+
+constexpr double kDepthScale = 5000.0;
+
+Json vec(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json pose_json(const Pose& pose) {
+  const auto tum = pose_to_tum(pose);
+  Json rows = Json::array();
+  for (int r = 0; r < 4; ++r) {
+    rows.push_back(Json::array({pose.matrix()(r, 0), pose.matrix()(r, 1), pose.matrix()(r, 2), pose.matrix()(r, 3)}));
+  }
+  return {{"position", {tum[0], tum[1], tum[2]}}, {"quaternion_xyzw", {tum[3], tum[4], tum[5], tum[6]}}, {"matrix", rows}};
+}
+
+Json shape_json(const Shape& shape) {
+  return std::visit(
+      [](const auto& s) -> Json {
+        using S = std::decay_t<decltype(s)>;
+        if constexpr (std::is_same_v<S, Sphere>) return {{"type", "sphere"}, {"centre", vec(s.centre)}, {"radius", s.radius}};
+        if constexpr (std::is_same_v<S, Box>) return {{"type", "box"}, {"min", vec(s.min)}, {"max", vec(s.max)}};
+        if constexpr (std::is_same_v<S, Rect>) {
+          return {{"type", "rectangle"}, {"centre", vec(s.centre)}, {"normal", vec(s.normal)}, {"u", vec(s.u)},
+                  {"v", vec(s.v)},       {"half_u", s.half_u},       {"half_v", s.half_v}};
+        }
+        if constexpr (std::is_same_v<S, Cylinder>) {
+          return {{"type", "cylinder_z"}, {"base", vec(s.base)}, {"radius", s.radius}, {"height", s.height}};
+        }
+      },
+      shape);
+}
+
+Json materials_json(const Scene& scene) {
+  Json materials = Json::array();
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const Material& m = scene.materials[i];
+    materials.push_back({{"id", i + 1}, {"name", m.name}, {"kd", vec(m.kd)}, {"ks", m.ks}, {"n", m.n}});
+  }
+  return materials;
+}
+
+Json objects_json(const Scene& scene) {
+  Json objects = Json::array();
+  for (const Object& o : scene.objects) {
+    Json object = {{"name", o.name}, {"material", scene.materials[static_cast<std::size_t>(o.material)].name},
+                   {"material_id", o.material + 1}};
+    object.update(shape_json(o.shape));
+    objects.push_back(object);
+  }
+  return objects;
+}
+
+Json lights_json(const Scene& scene) {
+  Json lights = Json::array();
+  for (const PointLight& l : scene.lights) {
+    lights.push_back({{"type", "point"}, {"position", vec(l.position)}, {"direction", nullptr}, {"colour", vec(l.colour)},
+                      {"intensity", l.intensity}, {"units", "W/sr per unit colour"}, {"probe_radius", l.radius},
+                      {"real", true}});
+  }
+  return lights;
+}
+
+Json tag_json(const TagDecal& tag) {
+  Json corners = Json::array();
+  for (const auto& c : tag.corners_world()) corners.push_back(vec(c));
+  Pose pose = Pose::Identity();
+  pose.linear().col(0) = tag.x_axis;
+  pose.linear().col(1) = tag.y_axis;
+  pose.linear().col(2) = tag.z_axis();
+  pose.translation() = tag.centre;
+  char code[32];
+  std::snprintf(code, sizeof code, "0x%llx", static_cast<unsigned long long>(tag.code));
+  return {{"family", "tag36h11"}, {"id", tag.id}, {"code", code}, {"size", tag.size},
+          {"corners_world", corners},
+          {"corner_order", "AprilTag order: tag frame (-s/2,+s/2), (+s/2,+s/2), (+s/2,-s/2), (-s/2,-s/2)"},
+          {"pose", pose_json(pose)},
+          {"pose_convention", "tag-to-world; tag frame x right, y down in the tag image, z into the tag"}};
+}
+
+Json noise_json(const SynthOptions& options) {
+  const KinectNoiseOptions& k = options.kinect;
+  Json noise = {{"model", to_string(options.noise)}};
+  if (options.noise == NoiseModel::None) return noise;
+  noise.update({{"axial_sigma", "0.0012 + 0.0019 * (z - 0.4)^2 (Nguyen, Izadi, Lovell 2012)"},
+                {"axial", k.axial},
+                {"lateral_sigma_px", k.lateral_sigma_px},
+                {"quantise", k.quantise},
+                {"baseline_m", k.baseline_m},
+                {"focal_px", k.focal_px},
+                {"subpixel", k.subpixel},
+                {"min_depth", k.min_depth},
+                {"max_depth", k.max_depth},
+                {"grazing_angle_deg", k.grazing_angle_deg},
+                {"edge_dropouts", k.edge_dropouts},
+                {"edge_radius_px", k.edge_radius_px},
+                {"edge_threshold_m", k.edge_threshold_m},
+                {"edge_threshold_rel", k.edge_threshold_rel},
+                {"edge_dropout_probability", k.edge_dropout_probability}});
+  return noise;
+}
+
+Json probe_json(const LightProbe& probe) {
+  const FisheyeCamera& c = probe.camera;
+  Pose pose = Pose::Identity();
+  pose.linear() = probe.probe_to_world;
+  pose.translation() = probe.position;
+  return {{"file", "probe.hdr"}, {"model", "equidistant"}, {"cx", c.cx}, {"cy", c.cy}, {"radius", c.radius},
+          {"max_theta", c.max_theta}, {"width", c.width}, {"height", c.height},
+          {"samples_per_axis", probe.samples_per_axis}, {"pose", pose_json(pose)},
+          {"pose_convention", "probe-to-world; probe frame x right, y down in the image, z = optical axis"}};
+}
+
+Json intrinsics_json(const PinholeIntrinsics& k) {
+  return {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}, {"width", k.width}, {"height", k.height}};
+}
+
+void validate(const SynthOptions& options) {
+  if (options.frames < 0) throw Error("synth: number of frames must not be negative");
+  if (options.width < 2 || options.height < 2) throw Error("synth: image size must be at least 2x2");
+  for (double g : options.color.gains) {
+    if (!(g > 0.0)) throw Error("synth: white-balance gains must be positive");
+  }
+  if (!(options.color.exposure > 0.0)) throw Error("synth: exposure must be positive");
+}
+
+RadianceImage as_radiance_image(const NormalMap& normals) {
+  RadianceImage image(normals.width(), normals.height());
+  std::copy(normals.pixels().begin(), normals.pixels().end(), image.pixels().begin());
+  return image;
+}
+
+void write_ground_truth(const fs::path& out, Timestamp timestamp, const RenderedFrame& frame) {
+  const std::string stem = fs::path(TumWriter::file_name(timestamp)).stem().string();
+  write_depth_exr(out / "gt" / "depth" / (stem + ".exr"), frame.depth);
+  write_radiance(out / "gt" / "normals" / (stem + ".exr"), as_radiance_image(frame.normals));
+  write_color(out / "gt" / "albedo" / (stem + ".png"), encode_albedo(frame.albedo));
+  write_label_png(out / "gt" / "material" / (stem + ".png"), frame.material);
+}
+
+void create_folders(const fs::path& out, bool ground_truth) {
+  std::error_code ec;
+  fs::create_directories(out, ec);
+  for (const char* sub : {"depth", "normals", "albedo", "material"}) {
+    if (ground_truth && !ec) fs::create_directories(out / "gt" / sub, ec);
+  }
+  if (ec) throw Error("cannot create " + out.string() + ": " + ec.message());
+}
+
+}  // namespace
+
+PinholeIntrinsics synth_intrinsics(const SynthOptions& options) {
+  PinholeIntrinsics k = PinholeIntrinsics::kinect_v1();
+  const double sx = static_cast<double>(options.width) / k.width, sy = static_cast<double>(options.height) / k.height;
+  // Scale about pixel corners: centre (cx + 0.5) scales, the -0.5 restores centre-of-pixel indexing.
+  return {k.fx * sx, k.fy * sy, (k.cx + 0.5) * sx - 0.5, (k.cy + 0.5) * sy - 0.5, options.width, options.height};
+}
+
+std::string scene_json(const Scene& scene, const SynthOptions& options) {
+  Json json = {{"generator", "relight synth"},
+               {"units", "metres, seconds, linear RGB radiance"},
+               {"world_up", {0, 0, 1}},
+               {"intrinsics", intrinsics_json(synth_intrinsics(options))},
+               {"depth_scale", kDepthScale},
+               {"frames", options.frames},
+               {"first_timestamp", frame_timestamp(0)},
+               {"fps", 30},
+               {"trajectory", to_string(options.trajectory)},
+               {"seed", options.seed},
+               {"noise", noise_json(options)},
+               {"color", {{"gains", options.color.gains}, {"exposure", options.color.exposure}, {"encoding", "sRGB 8-bit"}}},
+               {"shading", "L = kd*Lenv + sum_visible E*(kd/pi + ks*(n+2)/(2pi)*max(0,r.v)^n), "
+                           "E = colour*intensity*max(0,n.l)/d^2"},
+               {"materials", materials_json(scene)},
+               {"objects", objects_json(scene)},
+               {"lights", lights_json(scene)},
+               {"environment", {{"type", "constant"}, {"radiance", vec(scene.environment)}}}};
+  if (!scene.tags.empty()) json["tag"] = tag_json(scene.tags.front());
+  json["probe"] = probe_json(default_probe(scene));
+  json["ground_truth"] = {{"depth", "gt/depth/<timestamp>.exr"}, {"normals", "gt/normals/<timestamp>.exr"},
+                          {"albedo", "gt/albedo/<timestamp>.png"}, {"material", "gt/material/<timestamp>.png"},
+                          {"material_background", 0}};
+  return json.dump(2) + "\n";
+}
+
+void write_sequence(const SynthOptions& options, const fs::path& out, const SynthProgress& progress) {
+  write_sequence(default_indoor_scene(), options, out, progress);
+}
+
+void write_sequence(const Scene& scene, const SynthOptions& options, const fs::path& out,
+                    const SynthProgress& progress) {
+  validate(options);
+  create_folders(out, options.ground_truth);
+  const PinholeIntrinsics intrinsics = synth_intrinsics(options);
+  const std::vector<Pose> poses = make_trajectory(options.trajectory, options.frames, options.seed, scene);
+  TumWriter writer(out, kDepthScale);
+  for (int i = 0; i < options.frames; ++i) {
+    const RenderedFrame frame = render_frame(scene, intrinsics, poses[static_cast<std::size_t>(i)], options.threads);
+    const DepthMap depth = options.noise == NoiseModel::None
+                               ? frame.depth
+                               : apply_kinect_noise(frame.depth, frame.normals, intrinsics, options.kinect,
+                                                    options.seed, static_cast<std::uint64_t>(i), options.threads);
+    const Timestamp timestamp = frame_timestamp(i);
+    writer.add(timestamp, encode_color(frame.radiance, options.color), depth, poses[static_cast<std::size_t>(i)]);
+    if (options.ground_truth) write_ground_truth(out, timestamp, frame);
+    if (progress) progress(i + 1, options.frames);
+  }
+  writer.finish();
+  if (options.probe) write_radiance(out / "probe.hdr", render_probe(scene, default_probe(scene), options.threads));
+  write_file_atomically(out / "scene.json", scene_json(scene, options));
+}
+
+}  // namespace relight::synth
