@@ -23,7 +23,7 @@ void add_compute_options(CLI::App& command, ReplayOptions& options) {
 }
 
 struct Registry {
-  std::map<const CLI::App*, std::function<int()>> runners;
+  Runners runners;
 };
 
 Registry& registry() {
@@ -72,6 +72,7 @@ void register_commands(CLI::App& app) {
   app.fallthrough();  // so that `relight replay --config cfg.json` reaches the main app's --config
   register_replay(app);
   register_graph(app);
+  register_synth(app, registry().runners);
 }
 
 int run_selected(CLI::App& app) {

@@ -2,10 +2,16 @@
 // The subcommands of the relight CLI: each registers its options on a CLI11 subcommand and a
 // runner invoked after parsing.
 #include <CLI/CLI.hpp>
+#include <functional>
+#include <map>
 
 namespace relight::app {
 
 void register_commands(CLI::App& app);
+/// Each subcommand registers its runner in `runners`, keyed by its CLI11 subcommand.
+using Runners = std::map<const CLI::App*, std::function<int()>>;
+void register_synth(CLI::App& app, Runners& runners);
+
 /// Runs the subcommand that was selected on the command line; returns the exit code.
 int run_selected(CLI::App& app);
 

@@ -114,6 +114,20 @@ TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
   expect_one_line_error(relight("replay --backend quantum --out " + dir.path().string()), 1);
 }
 
+TEST(Cli, WithoutAnyVulkanDeviceReplayFallsBackToTheCpuAndSaysSoOnce) {
+  TempDir dir;
+  const std::string no_driver = "VK_ICD_FILENAMES=" + (dir.path() / "none.json").string() + " ";
+  const auto result = run_command(no_driver + kRelight + " replay --quiet --frames 0:1 --out " + dir.path().string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::size_t notes = 0;
+  for (std::size_t at = 0; (at = result.err.find("no usable Vulkan device", at)) != std::string::npos; ++at) ++notes;
+  EXPECT_EQ(notes, 1u) << result.err;
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "frames" / "000000_depth_smoothed.png"));
+  const auto forced = run_command(no_driver + kRelight + " replay --backend vulkan --out " + dir.path().string());
+  EXPECT_EQ(forced.exit_code, 1);
+  EXPECT_NE(forced.err.find("relight: error: the Vulkan backend was forced"), std::string::npos) << forced.err;
+}
+
 TEST(Cli, JsonConfigSuppliesOptionsAndTheCommandLineWins) {
   TempDir dir;
   const auto config = dir.path() / "cfg.json";
@@ -159,6 +173,21 @@ TEST(Cli, GraphDotIsAValidGraph) {
   EXPECT_EQ(std::count(result.out.begin(), result.out.end(), '"') % 2, 0);
   const auto order = relight("graph");
   EXPECT_EQ(order.out.rfind("source\n", 0), 0u) << order.out;
+}
+
+TEST(Cli, SynthWritesASequenceThatReplayReads) {
+  TempDir dir;
+  const auto sequence = dir.path() / "synth";
+  const auto made = relight("synth --quiet --frames 2 --trajectory static --out " + sequence.string());
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const auto scene = nlohmann::json::parse(read_text_file(sequence / "scene.json"));
+  EXPECT_DOUBLE_EQ(scene["intrinsics"]["fx"].get<double>(), 525.0);
+  const auto out = dir.path() / "out";
+  const auto replayed = relight("replay " + sequence.string() + " --quiet --out " + out.string());
+  ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(out / "report.json"))["frames"], 2);
+  EXPECT_EQ(relight("synth --out " + sequence.string() + " --trajectory loop").exit_code, 2);
+  EXPECT_EQ(relight("synth --frames 3").exit_code, 2);  // --out is required
 }
 
 }  // namespace
