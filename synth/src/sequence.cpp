@@ -177,6 +177,7 @@ std::string scene_json(const Scene& scene, const SynthOptions& options) {
                {"world_up", {0, 0, 1}},
                {"intrinsics", intrinsics_json(synth_intrinsics(options))},
                {"depth_scale", kDepthScale},
+               {"registered", "colour and depth share one camera (these intrinsics, same pose)"},
                {"frames", options.frames},
                {"first_timestamp", frame_timestamp(0)},
                {"fps", 30},

@@ -9,8 +9,9 @@
 //   probe.hdr            the fisheye light probe (probe.h), linear radiance
 //   scene.json           intrinsics, depth_scale, world_up, materials, objects, lights,
 //                        environment, tag (corners and pose), noise, seed, trajectory, probe
-// where <t> is TumWriter::file_name(timestamp) without its extension. Everything is a pure
-// function of the options: the same options give byte-identical files.
+// where <t> is TumWriter::file_name(timestamp) without its extension. Colour and depth come from
+// one camera (registered, same intrinsics and pose); light emitters are invisible to it.
+// Everything is a pure function of the options: the same options give byte-identical files.
 #include <array>
 #include <cstdint>
 #include <filesystem>
