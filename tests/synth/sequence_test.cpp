@@ -67,7 +67,9 @@ TEST(Sequence, WritesATumFolderWithGroundTruthThatTheReaderUnderstands) {
   const RadianceImage normals = read_radiance(dir.path() / "gt" / "normals" / (stem + ".exr"));
   EXPECT_EQ(normals(60, 80), truth.normals(60, 80));
   EXPECT_TRUE(read_color(dir.path() / "gt" / "albedo" / (stem + ".png")) == encode_albedo(truth.albedo));
-  EXPECT_TRUE(fs::is_regular_file(dir.path() / "probe.hdr"));
+  const RadianceImage probe = read_radiance(dir.path() / "probe.hdr");
+  ASSERT_EQ(probe.width(), 512);
+  EXPECT_NEAR(probe(256, 256).y, scene.environment.y(), scene.environment.y() / 64.0);  // RGBE precision
 
   // Noisy depth stays close to the truth where it exists.
   const DepthMap noisy = read_depth_png(dir.path() / "depth" / TumWriter::file_name(frame_timestamp(1)), 5000.0);
