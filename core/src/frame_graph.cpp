@@ -369,6 +369,8 @@ detail::AnyBuffer& StageContext::host_for_write(BufferId id) {
   return *buffer.current.host;
 }
 
+detail::AnyBuffer& StageContext::host_without_sync(BufferId id) { return *graph_.buffers_[id].current.host; }
+
 detail::AnyBuffer& StageContext::host_for_shape(BufferId id) {
   check_declared(id, detail::Access::Write);
   return *graph_.buffers_[id].current.host;

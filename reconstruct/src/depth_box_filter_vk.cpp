@@ -71,9 +71,8 @@ void DepthBoxFilterVkStage::declare(StageBuilder& builder) {
 
 void DepthBoxFilterVkStage::run(StageContext& context) {
   auto& input = context.device_read<vk::VulkanBuffer>(input_);
-  // The shape comes from the host copy. It is current whenever the input was written on the
-  // host (the usual case: a source stage); after another Vulkan stage this downloads it.
-  const DepthMap& host_input = context.get(input_);
+  // Only the shape is needed on the host; shape_of never downloads device-side pixels.
+  const DepthMap& host_input = context.shape_of(input_);
   const int width = host_input.width();
   const int height = host_input.height();
   auto& output = context.device_write<vk::VulkanBuffer>(output_, [&](DepthMap& out) { out.resize(width, height); });

@@ -238,15 +238,17 @@ class FakeDevice final : public DeviceTransfer {
 // "Vulkan" stage that adds 10 to every depth value on the fake device.
 class DeviceAddTen final : public Stage {
  public:
-  std::string name() const override { return "device_add_ten"; }
+  DeviceAddTen(std::string input = "depth", std::string output = "plus_ten", std::string name = "device_add_ten")
+      : input_(std::move(input)), output_(std::move(output)), name_(std::move(name)) {}
+  std::string name() const override { return name_; }
   Backend backend() const override { return Backend::Vulkan; }
   void declare(StageBuilder& b) override {
-    in_ = b.read<DepthMap>("depth");
-    out_ = b.write<DepthMap>("plus_ten");
+    in_ = b.read<DepthMap>(input_);
+    out_ = b.write<DepthMap>(output_);
   }
   void run(StageContext& ctx) override {
     auto& src = ctx.device_read<FakeDeviceBuffer>(in_);
-    const auto& host_in = ctx.get(in_);
+    const auto& host_in = ctx.shape_of(in_);
     auto& dst = ctx.device_write<FakeDeviceBuffer>(out_, [&](DepthMap& d) { d.resize(host_in.width(), host_in.height()); });
     std::vector<float> values(src.bytes.size() / sizeof(float));
     std::memcpy(values.data(), src.bytes.data(), src.bytes.size());
@@ -256,6 +258,7 @@ class DeviceAddTen final : public Stage {
   }
 
  private:
+  std::string input_, output_, name_;
   Read<DepthMap> in_;
   Write<DepthMap> out_;
 };
@@ -287,6 +290,19 @@ TEST(FrameGraph, GraphTransfersBetweenHostAndDeviceOnlyWhenNeeded) {
   const auto device_stage = std::find_if(timings.begin(), timings.end(), [](auto& t) { return t.stage == "device_add_ten"; });
   ASSERT_NE(device_stage, timings.end());
   EXPECT_EQ(device_stage->device_ms, (std::vector<double>{0.5, 0.5}));
+}
+
+TEST(FrameGraph, ChainedDeviceStagesKeepDataOnTheDevice) {
+  FakeDevice device;
+  FrameGraph graph(&device);
+  graph.emplace<CountingSource>(1);
+  graph.emplace<DeviceAddTen>("depth", "plus_ten_first", "first");
+  graph.emplace<DeviceAddTen>("plus_ten_first", "plus_ten", "second");
+  auto& reader = graph.emplace<HostReader>();
+  ASSERT_TRUE(graph.run_frame());
+  EXPECT_EQ(reader.seen, std::vector<float>{21.f});
+  EXPECT_EQ(device.uploads, 1);
+  EXPECT_EQ(device.downloads, 1);
 }
 
 TEST(FrameGraph, VulkanStageWithoutDeviceIsAGraphError) {

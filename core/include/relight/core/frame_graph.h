@@ -148,6 +148,14 @@ class StageContext {
     return typed<T>(host_for_write(handle.id));
   }
 
+  /// The host object of an input for its shape (width, height) only: its pixels may be stale
+  /// when a Vulkan stage wrote the buffer, and reading it this way never downloads them.
+  template <class T>
+  [[nodiscard]] const T& shape_of(Read<T> handle) {
+    check_declared(handle.id, detail::Access::Read);
+    return typed<T>(host_without_sync(handle.id));
+  }
+
   /// Device copy of an input, uploaded by the graph if the host copy is newer.
   template <class D, DeviceMirrorable T>
   [[nodiscard]] D& device_read(Read<T> handle) {
@@ -184,6 +192,7 @@ class StageContext {
   detail::AnyBuffer* host_previous(BufferId id);
   detail::AnyBuffer& host_for_write(BufferId id);
   detail::AnyBuffer& host_for_shape(BufferId id);
+  detail::AnyBuffer& host_without_sync(BufferId id);
   DeviceBuffer& device_for_read(BufferId id);
   DeviceBuffer& device_for_write(BufferId id);
   void check_declared(BufferId id, detail::Access access) const;
