@@ -1,0 +1,56 @@
+#pragma once
+// Colour spaces of the statistics-based mapping (Knecht §4.5.3): the transform
+// f = linear sRGB -> XYZ -> CIELab with illuminant E, and the sRGB transfer curve.
+//
+// Illuminant E (equal energy, x = y = 1/3) instead of D65 so that RGB white (1,1,1) maps to
+// XYZ (1,1,1) = the Lab reference white, i.e. L* = 100, a* = b* = 0: the Reinhard transfer then
+// moves colours relative to a neutral white, which is what a white-balance correction does.
+// The matrix is the standard primaries-to-XYZ construction (SMPTE RP 177) for the sRGB
+// primaries R (0.64, 0.33), G (0.30, 0.60), B (0.15, 0.06) with white point E:
+//   M = [P_r P_g P_b] * diag(S), P_c = (x/y, 1, (1-x-y)/y) of primary c, S = [P_r P_g P_b]^-1 (1,1,1)
+// Every row of M sums to 1 (white -> E). Values below are M and M^-1 to 10 digits.
+//
+// Lab (CIE 1976) with white (Xn, Yn, Zn) = (1, 1, 1):
+//   L* = 116 g(Y) - 16, a* = 500 (g(X) - g(Y)), b* = 200 (g(Y) - g(Z)),
+//   g(t) = t^(1/3) for t > (6/29)^3, else t / (3 (6/29)^2) + 4/29
+// The linear branch extends to negative t, so out-of-gamut and difference colours round-trip.
+#include <cstdint>
+
+#include "relight/core/pixel.h"
+
+namespace relight::colormap {
+
+/// Linear sRGB -> XYZ, white point E (rows: X, Y, Z).
+inline constexpr float kLinearSrgbToXyzE[3][3] = {
+    {0.4969210174f, 0.3390896921f, 0.1639892905f},
+    {0.2562248996f, 0.6781793842f, 0.0655957162f},
+    {0.0232931727f, 0.1130298974f, 0.8636769299f},
+};
+/// XYZ (white point E) -> linear sRGB: the inverse of kLinearSrgbToXyzE.
+inline constexpr float kXyzEToLinearSrgb[3][3] = {
+    {2.6896551724f, -1.2758620690f, -0.4137931034f},
+    {-1.0221081721f, 1.9782866167f, 0.0438215555f},
+    {0.0612244898f, -0.2244897959f, 1.1632653061f},
+};
+
+/// CIELab colour (L* in [0, 100] for colours in gamut), stored in Float3 as (L, a, b).
+using LabPixel = Float3;
+
+[[nodiscard]] Float3 linear_srgb_to_xyz(const Float3& rgb);
+[[nodiscard]] Float3 xyz_to_linear_srgb(const Float3& xyz);
+[[nodiscard]] LabPixel xyz_to_lab(const Float3& xyz);
+[[nodiscard]] Float3 lab_to_xyz(const LabPixel& lab);
+/// f of eq. 4.30: linear sRGB -> CIELab (illuminant E), and its inverse.
+[[nodiscard]] LabPixel linear_srgb_to_lab(const Float3& rgb);
+[[nodiscard]] Float3 lab_to_linear_srgb(const LabPixel& lab);
+
+/// sRGB transfer curve (IEC 61966-2-1) on [0, 1]: encoded -> linear and back.
+[[nodiscard]] float srgb_to_linear(float encoded);
+[[nodiscard]] float linear_to_srgb(float linear);
+/// 8-bit sRGB -> linear through a 256-entry table (exact to float rounding).
+[[nodiscard]] float srgb8_to_linear(std::uint8_t encoded);
+[[nodiscard]] Float3 decode_srgb8(const Rgb8& pixel);
+/// Linear -> 8-bit sRGB, clamped to [0, 1] and rounded to nearest.
+[[nodiscard]] Rgb8 encode_srgb8(const Float3& linear);
+
+}  // namespace relight::colormap

@@ -1,0 +1,74 @@
+#include "relight/colormap/color_space.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace relight::colormap {
+
+namespace {
+
+constexpr float kDelta = 6.f / 29.f;
+constexpr float kDeltaCubed = kDelta * kDelta * kDelta;
+constexpr float kLinearSlope = 1.f / (3.f * kDelta * kDelta);
+
+Float3 multiply(const float (&m)[3][3], const Float3& v) {
+  return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,
+          m[2][0] * v.x + m[2][1] * v.y + m[2][2] * v.z};
+}
+
+float lab_g(float t) { return t > kDeltaCubed ? std::cbrt(t) : t * kLinearSlope + 4.f / 29.f; }
+float lab_g_inverse(float u) { return u > kDelta ? u * u * u : (u - 4.f / 29.f) / kLinearSlope; }
+
+std::array<float, 256> make_srgb8_table() {
+  std::array<float, 256> table{};
+  for (int i = 0; i < 256; ++i) {
+    const double encoded = i / 255.0;
+    table[static_cast<std::size_t>(i)] = static_cast<float>(
+        encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4));
+  }
+  return table;
+}
+
+}  // namespace
+
+Float3 linear_srgb_to_xyz(const Float3& rgb) { return multiply(kLinearSrgbToXyzE, rgb); }
+Float3 xyz_to_linear_srgb(const Float3& xyz) { return multiply(kXyzEToLinearSrgb, xyz); }
+
+LabPixel xyz_to_lab(const Float3& xyz) {
+  const float gx = lab_g(xyz.x), gy = lab_g(xyz.y), gz = lab_g(xyz.z);
+  return {116.f * gy - 16.f, 500.f * (gx - gy), 200.f * (gy - gz)};
+}
+
+Float3 lab_to_xyz(const LabPixel& lab) {
+  const float gy = (lab.x + 16.f) / 116.f;
+  return {lab_g_inverse(gy + lab.y / 500.f), lab_g_inverse(gy), lab_g_inverse(gy - lab.z / 200.f)};
+}
+
+LabPixel linear_srgb_to_lab(const Float3& rgb) { return xyz_to_lab(linear_srgb_to_xyz(rgb)); }
+Float3 lab_to_linear_srgb(const LabPixel& lab) { return xyz_to_linear_srgb(lab_to_xyz(lab)); }
+
+float srgb_to_linear(float encoded) {
+  return encoded <= 0.04045f ? encoded / 12.92f : std::pow((encoded + 0.055f) / 1.055f, 2.4f);
+}
+
+float linear_to_srgb(float linear) {
+  const float c = std::clamp(linear, 0.f, 1.f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
+}
+
+float srgb8_to_linear(std::uint8_t encoded) {
+  static const std::array<float, 256> table = make_srgb8_table();
+  return table[encoded];
+}
+
+Float3 decode_srgb8(const Rgb8& pixel) {
+  return {srgb8_to_linear(pixel.r), srgb8_to_linear(pixel.g), srgb8_to_linear(pixel.b)};
+}
+
+Rgb8 encode_srgb8(const Float3& linear) {
+  const auto byte = [](float c) { return static_cast<std::uint8_t>(std::lround(255.f * linear_to_srgb(c))); };
+  return {byte(linear.x), byte(linear.y), byte(linear.z)};
+}
+
+}  // namespace relight::colormap
