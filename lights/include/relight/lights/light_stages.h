@@ -1,0 +1,58 @@
+#pragma once
+// Frame-graph stage that turns the light probe into lights.
+//
+//   reads  RadianceImage "probe"       (linear radiance, fisheye or lat-long, see probe_geometry.h)
+//   writes LightSet      "lights_raw"  (importance-sampled VPLs or median-cut lights, real = true)
+// Add LightSmoothingStage (light_smoothing.h) after it for temporally stable "lights".
+// The importance method runs on the CPU (importance_sampling.h) or on Vulkan (same samples).
+#include <memory>
+#include <string>
+
+#include "relight/core/frame_graph.h"
+#include "relight/lights/importance_sampling.h"
+#include "relight/lights/median_cut.h"
+
+namespace relight {
+
+enum class LightMethod { Importance, MedianCut };
+/// "importance" or "median-cut"; throws relight::Error naming the value otherwise.
+[[nodiscard]] LightMethod parse_light_method(const std::string& text);
+
+struct LightExtractionOptions {
+  LightMethod method = LightMethod::Importance;
+  int lights = 64;
+  std::uint64_t seed = 0;  ///< importance only
+  ProbeCalibration calibration{};
+};
+
+struct LightExtractionBuffers {
+  std::string probe = "probe";
+  std::string lights = "lights_raw";
+};
+
+/// Either method on the CPU, or importance sampling on Vulkan when `context` is given.
+class LightExtractionStage final : public Stage {
+ public:
+  explicit LightExtractionStage(LightExtractionOptions options, LightExtractionBuffers buffers = {},
+                                vk::VulkanContext* context = nullptr);
+  ~LightExtractionStage() override;
+  [[nodiscard]] std::string name() const override { return "light_extraction"; }
+  [[nodiscard]] Backend backend() const override { return context_ ? Backend::Vulkan : Backend::Cpu; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  LightExtractionOptions options_;
+  LightExtractionBuffers buffers_;
+  vk::VulkanContext* context_;
+  ProbeGeometry geometry_;  // rebuilt when the probe size changes
+  ImportancePyramid pyramid_;
+  std::unique_ptr<ImportanceSamplerVk> vulkan_;
+  Read<RadianceImage> probe_;
+  Write<LightSet> lights_;
+};
+
+/// Runs the chosen method once on a probe (what the stage does per frame).
+[[nodiscard]] LightSet extract_lights(const RadianceImage& probe, const LightExtractionOptions& options);
+
+}  // namespace relight

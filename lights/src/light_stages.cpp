@@ -1,0 +1,51 @@
+#include "relight/lights/light_stages.h"
+
+#include "relight/core/error.h"
+
+namespace relight {
+
+LightMethod parse_light_method(const std::string& text) {
+  if (text == "importance") return LightMethod::Importance;
+  if (text == "median-cut") return LightMethod::MedianCut;
+  throw Error("unknown light extraction method '" + text + "' (expected importance or median-cut)");
+}
+
+LightExtractionStage::LightExtractionStage(LightExtractionOptions options, LightExtractionBuffers buffers,
+                                           vk::VulkanContext* context)
+    : options_(std::move(options)), buffers_(std::move(buffers)), context_(context) {
+  if (context_ && options_.method != LightMethod::Importance) {
+    throw LogicError("LightExtractionStage: only importance sampling has a Vulkan version");
+  }
+}
+
+LightExtractionStage::~LightExtractionStage() = default;
+
+void LightExtractionStage::declare(StageBuilder& builder) {
+  probe_ = builder.read<RadianceImage>(buffers_.probe);
+  lights_ = builder.write<LightSet>(buffers_.lights);
+}
+
+void LightExtractionStage::run(StageContext& context) {
+  const RadianceImage& probe = context.get(probe_);
+  if (!probe.same_shape(geometry_)) {
+    geometry_ = ProbeGeometry(options_.calibration, probe.width(), probe.height());
+    if (context_) vulkan_ = std::make_unique<ImportanceSamplerVk>(*context_, geometry_);
+  }
+  LightSet& lights = context.get(lights_);
+  if (options_.method == LightMethod::MedianCut) {
+    lights = median_cut(probe, geometry_, {options_.lights});
+  } else if (vulkan_) {
+    lights = vulkan_->run(probe, {options_.lights, options_.seed});
+    if (const auto ms = vulkan_->last_gpu_ms()) context.report_device_ms(*ms);
+  } else {
+    lights = sample_importance(probe, geometry_, {options_.lights, options_.seed}, pyramid_);
+  }
+}
+
+LightSet extract_lights(const RadianceImage& probe, const LightExtractionOptions& options) {
+  const ProbeGeometry geometry(options.calibration, probe.width(), probe.height());
+  if (options.method == LightMethod::MedianCut) return median_cut(probe, geometry, {options.lights});
+  return sample_importance(probe, geometry, {options.lights, options.seed});
+}
+
+}  // namespace relight
