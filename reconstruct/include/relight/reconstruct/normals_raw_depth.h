@@ -1,0 +1,78 @@
+#pragma once
+// Method 1 of Knecht 2013, §4.3.2: raw depth, raw position, temporally filtered normal.
+//
+//   positions = φ⁻¹(depth)                                  (raw, unfiltered; eq. 4.9)
+//   Pass 1, on the previous frame's filtered normals N' (camera frame of that frame):
+//     A(i,j)  = normalize(sum of valid N' over (i,j) and its 4-neighbourhood)
+//     curv_H  = N'(i−1,j)·N'(i+1,j), curv_V = N'(i,j−1)·N'(i,j+1)                (eq. 4.1–4.2)
+//     curv    = clamp(min(curv_H, curv_V), 0, 1)^128 (0 when a pair is missing)    (eq. 4.3)
+//     evaluated at every second pixel (half resolution), then a mip chain of `mip_levels`
+//     levels (2×2 means of the valid texels: normal renormalised, curvature averaged).
+//   Pass 2, per pixel with depth:
+//     N = normals_from_positions with stride 4 (eq. 4.4–4.6, towards the camera);
+//     p' = T_prev_from_current · p, where T_prev_from_current = camera_to_world_prev⁻¹ ·
+//          camera_to_world_current maps current camera-frame points into the previous camera
+//          frame; (u', v') = nearest pixel of φ(p');
+//     level = round(curv(u', v') · (mip_levels − 1)) (flat: coarse, edges: fine);
+//     N_p = R_current_from_prev · A_level(u', v');
+//     c_N = |N_p·N|, c = c_B·c_N + (1 − c_N)                                        (eq. 4.7–4.8)
+//     c = 0 when there is no previous frame, (u', v') is outside it, N_p is missing, or
+//           |z_prev(u', v') − p'.z| > disocclusion_m (disocclusion, moving objects);
+//     normal = normalize(c·N_p + (1 − c)·N).
+//   Holes (depth but no normal) get the normalised mean of their valid 4-neighbours.
+//
+// Stage NormalsRawDepthCpuStage reads DepthMap "depth", FrameInfo "frame" (intrinsics,
+// camera_to_world: identity when absent), and the previous frame's NormalMap "normals",
+// PositionMap "positions" and FrameInfo "frame"; it writes NormalMap "normals" and PositionMap
+// "positions".
+#include <string>
+
+#include "relight/core/camera.h"
+#include "relight/core/frame_graph.h"
+#include "relight/core/image.h"
+#include "relight/core/pose.h"
+#include "relight/core/rgbd_frame.h"
+
+namespace relight {
+
+struct NormalsRawDepthOptions {
+  int stride = 4;                 ///< pixel distance of the cross-product differences (eq. 4.4–4.5)
+  float blend_base = 0.9f;        ///< c_B of eq. 4.8
+  float disocclusion_m = 0.1f;    ///< depth change that resets the history
+  int mip_levels = 4;             ///< half, quarter, eighth and sixteenth resolution
+  float max_jump_rel = 0.05f;     ///< discontinuity test of the cross products (relative to z)
+  int threads = 0;                ///< 0 = all cores
+};
+
+/// What method 1 keeps from the previous frame: its outputs and its pose.
+struct NormalsHistory {
+  const NormalMap& normals;
+  const PositionMap& positions;
+  Pose camera_to_world;
+};
+
+/// One frame of method 1. `previous` is null on the first frame. Resizes the outputs.
+void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                       const NormalsHistory* previous, const NormalsRawDepthOptions& options,
+                       PositionMap& positions, NormalMap& normals);
+
+/// Frame-graph stage of method 1 (buffers in the header comment).
+class NormalsRawDepthCpuStage final : public Stage {
+ public:
+  explicit NormalsRawDepthCpuStage(NormalsRawDepthOptions options = {}) : options_(options) {}
+  [[nodiscard]] std::string name() const override { return "normals_raw_depth"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  NormalsRawDepthOptions options_;
+  Read<DepthMap> depth_;
+  Read<FrameInfo> frame_;
+  ReadPrevious<NormalMap> previous_normals_;
+  ReadPrevious<PositionMap> previous_positions_;
+  ReadPrevious<FrameInfo> previous_frame_;
+  Write<PositionMap> positions_;
+  Write<NormalMap> normals_;
+};
+
+}  // namespace relight
