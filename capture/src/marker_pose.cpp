@@ -1,0 +1,154 @@
+#include "relight/capture/marker_pose.h"
+
+#include <algorithm>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+namespace relight {
+
+namespace {
+
+bool coplanar(const std::vector<cv::Point3d>& points) {
+  if (points.size() < 4) return true;
+  Eigen::MatrixXd centred(3, static_cast<Eigen::Index>(points.size()));
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const auto& p : points) mean += Eigen::Vector3d(p.x, p.y, p.z);
+  mean /= static_cast<double>(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    centred.col(static_cast<Eigen::Index>(i)) = Eigen::Vector3d(points[i].x, points[i].y, points[i].z) - mean;
+  }
+  const Eigen::Vector3d singular = Eigen::JacobiSVD<Eigen::MatrixXd>(centred).singularValues();
+  return singular(2) < 1e-6 * std::max(1.0, singular(0));
+}
+
+double reprojection_rms(const std::vector<cv::Point3d>& world, const std::vector<cv::Point2d>& image,
+                        const cv::Mat& rvec, const cv::Mat& tvec, const cv::Matx33d& k) {
+  std::vector<cv::Point2d> projected;
+  cv::projectPoints(world, rvec, tvec, k, cv::noArray(), projected);
+  double sum = 0;
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    const cv::Point2d d = projected[i] - image[i];
+    sum += d.dot(d);
+  }
+  return std::sqrt(sum / static_cast<double>(image.size()));
+}
+
+}  // namespace
+
+std::optional<MarkerPose> estimate_camera_pose(const std::vector<TagDetection>& detections, const TagLayout& layout,
+                                               const PinholeIntrinsics& intrinsics) {
+  std::vector<cv::Point3d> world;
+  std::vector<cv::Point2d> image;
+  int tags_used = 0;
+  for (const auto& detection : detections) {
+    const TagLayout::Tag* tag = layout.find(detection.id);
+    if (!tag) continue;
+    ++tags_used;
+    for (std::size_t k = 0; k < 4; ++k) {
+      world.emplace_back(tag->corners_world[k].x(), tag->corners_world[k].y(), tag->corners_world[k].z());
+      image.emplace_back(detection.corners[k].x(), detection.corners[k].y());
+    }
+  }
+  if (tags_used == 0) return std::nullopt;
+
+  const cv::Matx33d k(intrinsics.fx, 0, intrinsics.cx, 0, intrinsics.fy, intrinsics.cy, 0, 0, 1);
+  cv::Mat rvec, tvec;
+  const int method = coplanar(world) ? cv::SOLVEPNP_IPPE : cv::SOLVEPNP_ITERATIVE;
+  if (!cv::solvePnP(world, image, k, cv::noArray(), rvec, tvec, false, method)) return std::nullopt;
+  cv::solvePnPRefineLM(world, image, k, cv::noArray(), rvec, tvec);
+
+  // solvePnP gives world-to-camera; the pose slot holds camera-to-world.
+  cv::Matx33d rotation;
+  cv::Rodrigues(rvec, rotation);
+  Pose world_to_camera = Pose::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) world_to_camera.linear()(r, c) = rotation(r, c);
+    world_to_camera.translation()(r) = tvec.at<double>(r);
+  }
+  MarkerPose pose;
+  pose.camera_to_world = world_to_camera.inverse();
+  pose.tags_used = tags_used;
+  pose.reprojection_rms_px = reprojection_rms(world, image, rvec, tvec, k);
+  return pose;
+}
+
+namespace {
+
+// Depth ratios measured / predicted at a grid of points on one tag's face (inset from the edges,
+// where depth is unreliable).
+void collect_depth_ratios(const TagLayout::Tag& tag, const Pose& world_to_camera, const PinholeIntrinsics& k,
+                          const DepthMap& depth, std::vector<double>& ratios) {
+  constexpr int kGrid = 9;
+  for (int i = 0; i < kGrid; ++i) {
+    for (int j = 0; j < kGrid; ++j) {
+      const double a = 0.15 + 0.7 * i / (kGrid - 1), b = 0.15 + 0.7 * j / (kGrid - 1);
+      const Eigen::Vector3d on_tag = tag.corners_world[0] + a * (tag.corners_world[1] - tag.corners_world[0]) +
+                                     b * (tag.corners_world[3] - tag.corners_world[0]);
+      const Eigen::Vector3d camera = world_to_camera * on_tag;
+      if (camera.z() <= 0) continue;
+      const Eigen::Vector2d pixel = k.project(camera);
+      const int col = static_cast<int>(std::lround(pixel.x())), row = static_cast<int>(std::lround(pixel.y()));
+      if (!depth.in_bounds(row, col) || !is_valid_depth(depth(row, col))) continue;
+      // The predicted depth at the rounded pixel: intersect its ray with the tag plane.
+      const Eigen::Vector3d normal = world_to_camera.linear() * (tag.corners_world[1] - tag.corners_world[0])
+                                                                   .cross(tag.corners_world[3] - tag.corners_world[0]);
+      const Eigen::Vector3d ray = k.ray(col, row);
+      const double denominator = normal.dot(ray);
+      if (std::abs(denominator) < 1e-9) continue;
+      const double predicted = normal.dot(camera) / denominator;  // z of the ray point (ray.z() == 1)
+      if (predicted > 0) ratios.push_back(depth(row, col) / predicted);
+    }
+  }
+}
+
+}  // namespace
+
+MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetection>& detections,
+                             const TagLayout& layout, const PinholeIntrinsics& intrinsics, const DepthMap& depth) {
+  const Pose world_to_camera = pose.camera_to_world.inverse();
+  std::vector<double> ratios;
+  Eigen::Vector3d centre_world = Eigen::Vector3d::Zero();
+  int tags = 0;
+  for (const auto& detection : detections) {
+    const TagLayout::Tag* tag = layout.find(detection.id);
+    if (!tag) continue;
+    collect_depth_ratios(*tag, world_to_camera, intrinsics, depth, ratios);
+    for (const auto& corner : tag->corners_world) centre_world += corner / 4.0;
+    ++tags;
+  }
+  if (ratios.size() < 10 || tags == 0) return pose;
+  centre_world /= tags;
+  std::nth_element(ratios.begin(), ratios.begin() + static_cast<long>(ratios.size() / 2), ratios.end());
+  const double scale = ratios[ratios.size() / 2];
+  // Move the tags' centre along its viewing ray by `scale`, keeping the rotation.
+  Pose refined = world_to_camera;
+  const Eigen::Vector3d centre_camera = world_to_camera * centre_world;
+  refined.translation() += (scale - 1.0) * centre_camera;
+  MarkerPose result = pose;
+  result.camera_to_world = refined.inverse();
+  return result;
+}
+
+void MarkerPoseStage::declare(StageBuilder& builder) {
+  color_ = builder.read<ColorImage>("color");
+  depth_ = builder.read<DepthMap>("depth");
+  frame_ = builder.read<FrameInfo>("frame");
+  pose_ = builder.write<CameraPose>("camera_pose");
+}
+
+void MarkerPoseStage::run(StageContext& context) {
+  const auto detections = detector_.detect(context.get(color_));
+  const PinholeIntrinsics& intrinsics = context.get(frame_).intrinsics;
+  auto estimate = estimate_camera_pose(detections, layout_, intrinsics);
+  if (estimate) estimate = refine_with_depth(*estimate, detections, layout_, intrinsics, context.get(depth_));
+  CameraPose& out = context.get(pose_);
+  if (estimate) last_ = estimate;
+  out.valid = last_.has_value();
+  out.held = last_.has_value() && !estimate;
+  out.camera_to_world = last_ ? last_->camera_to_world : Pose::Identity();
+  out.tags_used = estimate ? estimate->tags_used : 0;
+  out.reprojection_rms_px = estimate ? estimate->reprojection_rms_px : 0.0;
+}
+
+}  // namespace relight
