@@ -73,6 +73,7 @@ void register_commands(CLI::App& app) {
   register_replay(app);
   register_graph(app);
   register_synth(app, registry().runners);
+  register_lights(app, registry().runners);
 }
 
 int run_selected(CLI::App& app) {

@@ -11,6 +11,7 @@ void register_commands(CLI::App& app);
 /// Each subcommand registers its runner in `runners`, keyed by its CLI11 subcommand.
 using Runners = std::map<const CLI::App*, std::function<int()>>;
 void register_synth(CLI::App& app, Runners& runners);
+void register_lights(CLI::App& app, Runners& runners);
 
 /// Runs the subcommand that was selected on the command line; returns the exit code.
 int run_selected(CLI::App& app);
