@@ -20,6 +20,11 @@ void add_compute_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--device", options.device,
                      "Vulkan device: index, type (discrete, integrated, cpu) or part of its name "
                      "(default: $RELIGHT_VK_DEVICE, else the best device)");
+  command.add_option("--geometry", options.geometry,
+                     "normal estimation: method1 (raw depth, temporally filtered normals) or method2 "
+                     "(warped and merged depth, normals from its positions)")
+      ->check(CLI::IsMember({"method1", "method2"}))
+      ->capture_default_str();
 }
 
 struct Registry {

@@ -10,6 +10,7 @@ namespace relight::app {
 void FrameWriterStage::declare(StageBuilder& builder) {
   for (const auto& name : color_names_) colors_.push_back(builder.read<ColorImage>(name));
   for (const auto& name : depth_names_) depths_.push_back(builder.read<DepthMap>(name));
+  for (const auto& name : normal_names_) normals_.push_back(builder.read<NormalMap>(name));
 }
 
 std::filesystem::path FrameWriterStage::file_for(std::int64_t frame, const std::string& buffer) const {
@@ -29,6 +30,9 @@ void FrameWriterStage::run(StageContext& context) {
   }
   for (std::size_t i = 0; i < depths_.size(); ++i) {
     write_color(file_for(context.frame_index(), depth_names_[i]), depth_preview(context.get(depths_[i])));
+  }
+  for (std::size_t i = 0; i < normals_.size(); ++i) {
+    write_color(file_for(context.frame_index(), normal_names_[i]), normal_preview(context.get(normals_[i])));
   }
 }
 

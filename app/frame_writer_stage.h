@@ -1,7 +1,7 @@
 #pragma once
 // Sink stage of `relight replay`: writes, per frame, the buffers a person wants to look at into
 // DIR/frames/ as PNG (colour as it is; depth as a false-colour preview), each file atomically.
-// Reads: the buffers registered with add_color()/add_depth() before the stage joins the graph.
+// Reads: the buffers registered with add_color()/add_depth()/add_normals() before the stage joins the graph.
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -16,6 +16,8 @@ class FrameWriterStage final : public Stage {
   explicit FrameWriterStage(std::filesystem::path folder) : folder_(std::move(folder)) {}
   void add_color(std::string buffer) { color_names_.push_back(std::move(buffer)); }
   void add_depth(std::string buffer) { depth_names_.push_back(std::move(buffer)); }
+  /// A NormalMap, written as relight::normal_preview's colour coding.
+  void add_normals(std::string buffer) { normal_names_.push_back(std::move(buffer)); }
 
   [[nodiscard]] std::string name() const override { return "frame_writer"; }
   [[nodiscard]] bool has_side_effects() const override { return true; }
@@ -30,6 +32,8 @@ class FrameWriterStage final : public Stage {
   std::vector<std::string> depth_names_;
   std::vector<Read<ColorImage>> colors_;
   std::vector<Read<DepthMap>> depths_;
+  std::vector<std::string> normal_names_;
+  std::vector<Read<NormalMap>> normals_;
 };
 
 }  // namespace relight::app

@@ -12,6 +12,9 @@
 #include "relight/core/error.h"
 #include "relight/core/progress.h"
 #include "relight/reconstruct/depth_box_filter.h"
+#include "relight/reconstruct/depth_warp_merge.h"
+#include "relight/reconstruct/normals_from_positions.h"
+#include "relight/reconstruct/normals_raw_depth.h"
 #include "relight/vk/backend.h"
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
@@ -54,6 +57,9 @@ std::unique_ptr<vk::VulkanContext> make_vulkan(const ReplayOptions& options, vk:
 }  // namespace
 
 ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options) {
+  if (options.geometry != "method1" && options.geometry != "method2") {
+    throw Error("--geometry '" + options.geometry + "' is not one of method1, method2");
+  }
   const auto policy = vk::parse_backend_policy(options.backend);
   if (!policy) throw Error("--backend '" + options.backend + "' is not one of auto, cpu, vulkan");
   ReplayPipeline pipeline;
@@ -67,11 +73,23 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   FrameGraph& graph = *pipeline.graph;
   graph.emplace<SourceStage>(std::move(source));
   graph.add(make_depth_box_filter_stage(per_pixel, pipeline.vulkan.get()));
+  // Geometry (positions + normals) runs on the CPU: its Vulkan versions are not written yet.
+  const bool method2 = options.geometry == "method2";
+  if (method2) {
+    graph.emplace<DepthWarpMergeCpuStage>();
+    graph.emplace<NormalsFromPositionsCpuStage>();
+  } else {
+    graph.emplace<NormalsRawDepthCpuStage>();
+  }
+  graph.keep("normals");
+  graph.keep("positions");
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
     writer->add_color("color");
     writer->add_depth("depth");
     writer->add_depth("depth_smoothed");
+    if (method2) writer->add_depth("depth_filtered");
+    writer->add_normals("normals");
     graph.add(std::move(writer));
   }
   return pipeline;

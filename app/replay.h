@@ -22,6 +22,7 @@ struct ReplayOptions {
   bool write_frames = true;        ///< per-frame PNGs under out/frames
   std::string backend = "auto";    ///< auto | cpu | vulkan (see vk/backend.h)
   std::string device;              ///< Vulkan device selector (index, type or name part)
+  std::string geometry = "method1";  ///< normals: method1 (NormalsRawDepth) | method2 (DepthWarpMerge + NormalsFromPositions)
 };
 
 

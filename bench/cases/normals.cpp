@@ -1,0 +1,226 @@
+// normals/*: method 1 (NormalsRawDepth) and method 2 (DepthWarpMerge + NormalsFromPositions) on
+// the CPU against PCL's IntegralImageNormalEstimation (AVERAGE_3D_GRADIENT, max depth change
+// 0.02, smoothing 10: the dissertation's comparison), and normals/pcl_omp (NormalEstimationOMP,
+// k = 10) as its own line. Same process, same 640x480 synthetic frames (static camera, Kinect v1
+// noise), angular error against the ray caster's exact normals on the last frame.
+// "ms" is one steady-state frame (the previous frame's outputs as history); the errors are
+// after 10 frames. Without PCL (libpcl-dev, scripts/debian-packages-bench.txt) the baseline
+// fields are absent. The Vulkan cases (normals/method*_vulkan) are not implemented yet.
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "bench.h"
+#include "relight/reconstruct/depth_warp_merge.h"
+#include "relight/reconstruct/normal_error.h"
+#include "relight/reconstruct/normals_from_positions.h"
+#include "relight/reconstruct/normals_raw_depth.h"
+#include "relight/synth/kinect_noise.h"
+#include "relight/synth/raycast.h"
+#include "relight/synth/scene.h"
+#include "relight/synth/sequence.h"
+#include "relight/synth/trajectory.h"
+
+#ifdef RELIGHT_HAVE_PCL
+#include <pcl/features/integral_image_normal.h>
+#include <pcl/features/normal_3d_omp.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
+#endif
+
+namespace {
+
+using namespace relight;
+using relight::bench::Json;
+
+constexpr int kFrames = 10;
+
+struct BenchSequence {
+  PinholeIntrinsics intrinsics;
+  std::vector<DepthMap> noisy;
+  NormalMap truth;  // of the last frame
+  Pose pose = Pose::Identity();
+};
+
+const BenchSequence& sequence() {
+  static const BenchSequence data = [] {
+    synth::SynthOptions options;  // 640x480
+    BenchSequence s{synth::synth_intrinsics(options), {}, {}, {}};
+    const synth::Scene scene = synth::default_indoor_scene();
+    s.pose = synth::make_trajectory(synth::Trajectory::Static, 1, 0, scene).front();
+    const synth::RenderedFrame truth = synth::render_frame(scene, s.intrinsics, s.pose);
+    for (int i = 0; i < kFrames; ++i) {
+      s.noisy.push_back(synth::apply_kinect_noise(truth.depth, truth.normals, s.intrinsics, options.kinect, 7,
+                                                  static_cast<std::uint64_t>(i)));
+    }
+    s.truth = truth.normals;
+    return s;
+  }();
+  return data;
+}
+
+#ifdef RELIGHT_HAVE_PCL
+pcl::PointCloud<pcl::PointXYZ>::Ptr organised_cloud(const DepthMap& depth, const PinholeIntrinsics& k) {
+  PositionMap positions;
+  positions_from_depth(depth, k, positions);
+  auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(depth.width(), depth.height());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const Float3& p = positions.pixels()[i];
+    (*cloud)[i] = p.z > 0.f ? pcl::PointXYZ(p.x, p.y, p.z) : pcl::PointXYZ(nan, nan, nan);
+  }
+  cloud->is_dense = false;
+  return cloud;
+}
+
+NormalMap to_normal_map(const pcl::PointCloud<pcl::Normal>& normals, int width, int height) {
+  NormalMap out(width, height);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const auto& n = normals[i];
+    if (std::isfinite(n.normal_x) && std::isfinite(n.normal_y) && std::isfinite(n.normal_z)) {
+      out.pixels()[i] = {n.normal_x, n.normal_y, n.normal_z};
+    }
+  }
+  return out;
+}
+
+// PCL IntegralImage on the last noisy frame: the dissertation's baseline.
+struct IntegralImageBaseline {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr cloud;
+  pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> estimator;
+  pcl::PointCloud<pcl::Normal> normals;
+  explicit IntegralImageBaseline(const BenchSequence& s) : cloud(organised_cloud(s.noisy.back(), s.intrinsics)) {
+    estimator.setNormalEstimationMethod(estimator.AVERAGE_3D_GRADIENT);
+    estimator.setMaxDepthChangeFactor(0.02f);
+    estimator.setNormalSmoothingSize(10.0f);
+    estimator.setInputCloud(cloud);
+  }
+  void run() { estimator.compute(normals); }
+  [[nodiscard]] AngularError error(const BenchSequence& s) const {
+    return angular_error(to_normal_map(normals, s.intrinsics.width, s.intrinsics.height), s.truth);
+  }
+};
+
+void add_baseline(Json& json, const AngularError& baseline) {
+  json["baseline_angular_error_deg"] = baseline.mean_deg;
+  json["baseline_coverage"] = baseline.coverage;
+}
+#endif
+
+// Times `ours` (and the PCL baseline when available) and fills the standard fields.
+Json compare_with_pcl(const std::function<void()>& ours, const bench::Options& options) {
+#ifdef RELIGHT_HAVE_PCL
+  IntegralImageBaseline baseline(sequence());
+  Json json = bench::comparison_json(bench::compare_interleaved(ours, [&] { baseline.run(); }, options.repetitions),
+                                     "pcl_integral_image");
+  add_baseline(json, baseline.error(sequence()));
+  return json;
+#else
+  Json json;
+  json["ms"] = bench::median_ms(ours, options.repetitions);
+  json["baseline"] = "pcl_integral_image (not built: PCL not found)";
+  return json;
+#endif
+}
+
+Json method1_cpu(const bench::Options& options) {
+  const BenchSequence& s = sequence();
+  PositionMap positions[2];
+  NormalMap normals[2];
+  for (int i = 0; i < kFrames; ++i) {
+    const int cur = i % 2, prev = 1 - cur;
+    const NormalsHistory history{normals[prev], positions[prev], s.pose};
+    normals_raw_depth(s.noisy[static_cast<std::size_t>(i)], s.intrinsics, s.pose, i > 0 ? &history : nullptr, {},
+                      positions[cur], normals[cur]);
+  }
+  const int last = (kFrames - 1) % 2;
+  const AngularError error = angular_error(normals[last], s.truth);
+  // Steady state: frame 10 again with frame 9's outputs as history, into scratch outputs.
+  const NormalsHistory history{normals[last], positions[last], s.pose};
+  PositionMap scratch_positions;
+  NormalMap scratch_normals;
+  Json json = compare_with_pcl(
+      [&] {
+        normals_raw_depth(s.noisy.back(), s.intrinsics, s.pose, &history, {}, scratch_positions, scratch_normals);
+      },
+      options);
+  json["angular_error_deg"] = error.mean_deg;
+  json["coverage"] = error.coverage;
+  return json;
+}
+
+Json method2_cpu(const bench::Options& options) {
+  const BenchSequence& s = sequence();
+  DepthMap filtered, warped;
+  DepthWeightMap weight, warped_weight;
+  for (int i = 0; i < kFrames; ++i) {
+    if (i > 0) warp_depth(filtered, weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight);
+    DepthMap merged;
+    DepthWeightMap merged_weight;
+    merge_depth(s.noisy[static_cast<std::size_t>(i)], warped, warped_weight, {}, merged, merged_weight);
+    filtered = std::move(merged);
+    weight = std::move(merged_weight);
+  }
+  PositionMap positions;
+  NormalMap normals;
+  positions_from_depth(filtered, s.intrinsics, positions);
+  normals_from_positions(positions, normals);
+  const AngularError error = angular_error(normals, s.truth);
+
+  DepthMap scratch_depth;
+  DepthWeightMap scratch_weight;
+  Json json = compare_with_pcl(
+      [&] {
+        warp_depth(filtered, weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight);
+        merge_depth(s.noisy.back(), warped, warped_weight, {}, scratch_depth, scratch_weight);
+        positions_from_depth(scratch_depth, s.intrinsics, positions);
+        normals_from_positions(positions, normals);
+      },
+      options);
+  json["angular_error_deg"] = error.mean_deg;
+  json["coverage"] = error.coverage;
+  return json;
+}
+
+#ifdef RELIGHT_HAVE_PCL
+Json pcl_omp(const bench::Options& options) {
+  const BenchSequence& s = sequence();
+  const auto organised = organised_cloud(s.noisy.back(), s.intrinsics);
+  auto dense = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>();
+  std::vector<std::size_t> pixel_of;
+  for (std::size_t i = 0; i < organised->size(); ++i) {
+    if (std::isfinite((*organised)[i].z)) {
+      dense->push_back((*organised)[i]);
+      pixel_of.push_back(i);
+    }
+  }
+  pcl::NormalEstimationOMP<pcl::PointXYZ, pcl::Normal> estimator;
+  estimator.setInputCloud(dense);
+  estimator.setSearchMethod(pcl::make_shared<pcl::search::KdTree<pcl::PointXYZ>>());
+  estimator.setKSearch(10);
+  estimator.setViewPoint(0.f, 0.f, 0.f);  // orient towards the camera
+  pcl::PointCloud<pcl::Normal> normals;
+  const double ms = bench::median_ms([&] { estimator.compute(normals); }, std::max(1, options.repetitions / 2));
+  NormalMap map(s.intrinsics.width, s.intrinsics.height);
+  for (std::size_t i = 0; i < normals.size(); ++i) {
+    const auto& n = normals[i];
+    if (std::isfinite(n.normal_x)) map.pixels()[pixel_of[i]] = {n.normal_x, n.normal_y, n.normal_z};
+  }
+  const AngularError error = angular_error(map, s.truth);
+  Json json;
+  json["ms"] = ms;
+  json["angular_error_deg"] = error.mean_deg;
+  json["coverage"] = error.coverage;
+  json["k"] = 10;
+  return json;
+}
+#endif
+
+}  // namespace
+
+RELIGHT_BENCH_CASE("normals/method1_cpu", method1_cpu);
+RELIGHT_BENCH_CASE("normals/method2_cpu", method2_cpu);
+#ifdef RELIGHT_HAVE_PCL
+RELIGHT_BENCH_CASE("normals/pcl_omp", pcl_omp);
+#endif
