@@ -1,0 +1,56 @@
+// apriltag/detect_640x480: AprilTag detection + pose on a synthetic 640x480 frame of the tag at
+// ~1.6 m, at decimation 1 and 2, with the pose error against the synthetic ground truth.
+#include "bench.h"
+#include "relight/capture/marker_pose.h"
+#include "relight/synth/raycast.h"
+#include "relight/synth/scene.h"
+#include "relight/synth/trajectory.h"
+
+namespace {
+
+using relight::bench::Json;
+
+relight::TagLayout layout_of(const relight::synth::Scene& scene) {
+  relight::TagLayout layout;
+  const auto& decal = scene.tags.front();
+  relight::TagLayout::Tag tag;
+  tag.id = decal.id;
+  tag.size = decal.size;
+  const auto corners = decal.corners_world();
+  for (std::size_t k = 0; k < 4; ++k) tag.corners_world[k] = corners[k];
+  layout.tags.push_back(tag);
+  return layout;
+}
+
+Json detect_case(const relight::bench::Options& options, float decimate) {
+  const auto scene = relight::synth::default_indoor_scene();
+  const auto intrinsics = relight::PinholeIntrinsics::kinect_v1();
+  const Eigen::Vector3d tag = scene.tags.front().centre;
+  const relight::Pose truth = relight::synth::look_at(tag + Eigen::Vector3d(-0.9, -0.9, 0.9), tag, {0, 0, 1});
+  const auto frame = relight::synth::render_frame(scene, intrinsics, truth);
+  const relight::ColorImage color = relight::synth::encode_color(frame.radiance);
+  const relight::TagLayout layout = layout_of(scene);
+
+  relight::TagDetectorOptions detector_options;
+  detector_options.decimate = decimate;
+  relight::TagDetector detector(detector_options);
+  std::vector<relight::TagDetection> detections;
+  Json json;
+  json["ms"] = relight::bench::median_ms([&] { detections = detector.detect(color); }, options.repetitions);
+  json["decimate"] = decimate;
+  json["tags_found"] = detections.size();
+  auto pose = relight::estimate_camera_pose(detections, layout, intrinsics);
+  if (pose) {
+    json["pose_error_cm_colour_only"] = 100.0 * (pose->camera_to_world.translation() - truth.translation()).norm();
+    pose = relight::refine_with_depth(*pose, detections, layout, intrinsics, frame.depth);
+    json["pose_error_cm"] = 100.0 * (pose->camera_to_world.translation() - truth.translation()).norm();
+    json["pose_error_deg"] = relight::rotation_distance(pose->camera_to_world, truth) * 180.0 / 3.14159265358979;
+  }
+  return json;
+}
+
+RELIGHT_BENCH_CASE("apriltag/detect_640x480", [](const relight::bench::Options& o) { return detect_case(o, 1.0f); });
+RELIGHT_BENCH_CASE("apriltag/detect_640x480_decimate2",
+                   [](const relight::bench::Options& o) { return detect_case(o, 2.0f); });
+
+}  // namespace
