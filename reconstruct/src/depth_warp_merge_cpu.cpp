@@ -6,7 +6,7 @@
 #include <limits>
 #include <vector>
 
-#include "parallel_rows.h"
+#include "relight/core/parallel.h"
 #include "relight/reconstruct/depth_warp_merge.h"
 
 namespace relight {
@@ -88,7 +88,7 @@ void warp_depth(const DepthMap& previous_depth, const DepthWeightMap& previous_w
   const float fx = static_cast<float>(intrinsics.fx), fy = static_cast<float>(intrinsics.fy);
   const float cx = static_cast<float>(intrinsics.cx), cy = static_cast<float>(intrinsics.cy);
   std::vector<WarpedVertex> vertices(pixels);
-  detail::parallel_rows(height, options.threads, [&](int begin, int end) {
+  parallel_rows(height, options.threads, [&](int begin, int end) {
     for (int r = begin; r < end; ++r) {
       for (int c = 0; c < width; ++c) {
         const float z = previous_depth(r, c);
@@ -111,9 +111,9 @@ void warp_depth(const DepthMap& previous_depth, const DepthWeightMap& previous_w
     }
   });
 
-  const int bands = std::max(1, std::min(detail::worker_count(options.threads), (height - 1) / 64));
+  const int bands = std::max(1, std::min(worker_count(options.threads), (height - 1) / 64));
   std::vector<ZBuffer> buffers(static_cast<std::size_t>(bands), ZBuffer(pixels));
-  detail::parallel_rows(
+  parallel_rows(
       bands, bands,
       [&](int band_begin, int band_end) {
         for (int band = band_begin; band < band_end; ++band) {

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "parallel_rows.h"
+#include "relight/core/parallel.h"
 
 namespace relight {
 
@@ -42,7 +42,7 @@ void positions_from_depth(const DepthMap& depth, const PinholeIntrinsics& intrin
   const float inv_fy = static_cast<float>(1.0 / intrinsics.fy);
   const float cx = static_cast<float>(intrinsics.cx);
   const float cy = static_cast<float>(intrinsics.cy);
-  detail::parallel_rows(depth.height(), threads, [&](int begin, int end) {
+  parallel_rows(depth.height(), threads, [&](int begin, int end) {
     for (int r = begin; r < end; ++r) {
       const float* z_row = depth.row(r).data();
       Float3* out = positions.row(r).data();
@@ -62,7 +62,7 @@ void normals_from_positions(const PositionMap& positions, NormalMap& normals, co
   const int height = positions.height();
   const int s = options.stride;
   normals.resize(width, height);
-  detail::parallel_rows(height, options.threads, [&](int begin, int end) {
+  parallel_rows(height, options.threads, [&](int begin, int end) {
     for (int r = begin; r < end; ++r) {
       const Float3* row = positions.row(r).data();
       const Float3* below = r + s < height ? positions.row(r + s).data() : nullptr;

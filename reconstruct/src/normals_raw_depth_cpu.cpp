@@ -3,7 +3,7 @@
 #include <cmath>
 #include <vector>
 
-#include "parallel_rows.h"
+#include "relight/core/parallel.h"
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
 
@@ -35,7 +35,7 @@ NormalLevel average_and_curvature(const NormalMap& previous, int threads) {
   const auto at = [&](int r, int c) -> Float3 {
     return previous.in_bounds(r, c) ? previous(r, c) : Float3{};
   };
-  detail::parallel_rows(height, threads, [&](int begin, int end) {
+  parallel_rows(height, threads, [&](int begin, int end) {
     for (int hr = begin; hr < end; ++hr) {
       for (int hc = 0; hc < width; ++hc) {
         const int r = 2 * hr, c = 2 * hc;
@@ -169,7 +169,7 @@ void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsic
     const Pose prev_from_current_pose = previous->camera_to_world.inverse() * camera_to_world;
     const Rigid prev_from_current(prev_from_current_pose);
     const Rigid current_from_prev(prev_from_current_pose.inverse());
-    detail::parallel_rows(depth.height(), options.threads, [&](int begin, int end) {
+    parallel_rows(depth.height(), options.threads, [&](int begin, int end) {
       for (int r = begin; r < end; ++r) {
         for (int c = 0; c < depth.width(); ++c) {
           Float3& n = normals(r, c);

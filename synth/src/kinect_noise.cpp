@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "parallel.h"
+#include "relight/core/parallel.h"
 #include "random.h"
 #include "relight/core/error.h"
 
@@ -95,7 +95,7 @@ DepthMap apply_kinect_noise(const DepthMap& depth, const NormalMap& normals, con
                             const KinectNoiseOptions& options, std::uint64_t seed, std::uint64_t frame, int threads) {
   if (!normals.same_shape(depth)) throw Error("apply_kinect_noise: depth and normals differ in size");
   DepthMap noisy(depth.width(), depth.height());
-  detail::parallel_rows(depth.height(), threads, [&](int row) {
+  parallel_for_each_row(depth.height(), threads, [&](int row) {
     std::mt19937_64 rng(detail::stream_seed(seed, kNoiseStream ^ detail::mix(frame), static_cast<std::uint64_t>(row)));
     for (int col = 0; col < depth.width(); ++col) {
       noisy(row, col) = noisy_pixel(depth, normals, intrinsics, options, rng, row, col);

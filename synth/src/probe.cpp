@@ -4,7 +4,7 @@
 #include <limits>
 #include <numbers>
 
-#include "parallel.h"
+#include "relight/core/parallel.h"
 
 namespace relight::synth {
 
@@ -60,7 +60,7 @@ Vector3d incoming_radiance(const Scene& scene, const Ray& ray) {
 
 RadianceImage render_probe(const Scene& scene, const LightProbe& probe, int threads) {
   RadianceImage image(probe.camera.width, probe.camera.height);
-  detail::parallel_rows(image.height(), threads, [&](int row) {
+  parallel_for_each_row(image.height(), threads, [&](int row) {
     for (int col = 0; col < image.width(); ++col) image(row, col) = probe_pixel(scene, probe, row, col);
   });
   return image;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "parallel.h"
+#include "relight/core/parallel.h"
 
 namespace relight::synth {
 
@@ -218,7 +218,7 @@ RenderedFrame render_frame(const Scene& scene, const PinholeIntrinsics& intrinsi
                            int threads) {
   const int w = intrinsics.width, h = intrinsics.height;
   RenderedFrame out{DepthMap(w, h), NormalMap(w, h), RadianceImage(w, h), LabelImage(w, h), RadianceImage(w, h)};
-  detail::parallel_rows(h, threads, [&](int row) {
+  parallel_for_each_row(h, threads, [&](int row) {
     for (int col = 0; col < w; ++col) render_pixel(scene, intrinsics, camera_to_world, row, col, out);
   });
   return out;
