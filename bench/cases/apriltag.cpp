@@ -4,23 +4,12 @@
 #include "relight/capture/marker_pose.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/scene.h"
+#include "relight/synth/tag_layout.h"
 #include "relight/synth/trajectory.h"
 
 namespace {
 
 using relight::bench::Json;
-
-relight::TagLayout layout_of(const relight::synth::Scene& scene) {
-  relight::TagLayout layout;
-  const auto& decal = scene.tags.front();
-  relight::TagLayout::Tag tag;
-  tag.id = decal.id;
-  tag.size = decal.size;
-  const auto corners = decal.corners_world();
-  for (std::size_t k = 0; k < 4; ++k) tag.corners_world[k] = corners[k];
-  layout.tags.push_back(tag);
-  return layout;
-}
 
 Json detect_case(const relight::bench::Options& options, float decimate) {
   const auto scene = relight::synth::default_indoor_scene();
@@ -29,7 +18,7 @@ Json detect_case(const relight::bench::Options& options, float decimate) {
   const relight::Pose truth = relight::synth::look_at(tag + Eigen::Vector3d(-0.9, -0.9, 0.9), tag, {0, 0, 1});
   const auto frame = relight::synth::render_frame(scene, intrinsics, truth);
   const relight::ColorImage color = relight::synth::encode_color(frame.radiance);
-  const relight::TagLayout layout = layout_of(scene);
+  const relight::TagLayout layout = relight::synth::tag_layout(scene);
 
   relight::TagDetectorOptions detector_options;
   detector_options.decimate = decimate;

@@ -11,23 +11,11 @@
 #include "relight/synth/raycast.h"
 #include "relight/synth/scene.h"
 #include "relight/synth/sequence.h"
+#include "relight/synth/tag_layout.h"
 #include "relight/synth/trajectory.h"
 
 namespace relight {
 namespace {
-
-TagLayout layout_of(const synth::Scene& scene) {
-  TagLayout layout;
-  for (const auto& decal : scene.tags) {
-    TagLayout::Tag tag;
-    tag.id = decal.id;
-    tag.size = decal.size;
-    const auto corners = decal.corners_world();
-    for (std::size_t k = 0; k < 4; ++k) tag.corners_world[k] = corners[k];
-    layout.tags.push_back(tag);
-  }
-  return layout;
-}
 
 // The synthetic renderer shoots one ray per pixel, so tag edges alias; a real camera's optics
 // average over the pixel. Render at `factor`x resolution and average factor x factor blocks.
@@ -76,7 +64,7 @@ std::vector<Pose> viewpoints(const synth::Scene& scene) {
 TEST(MarkerPose, NoiseFreeSyntheticFramesGivePoseWithinOneCentimetreAndOneDegree) {
   const synth::Scene scene = synth::default_indoor_scene();
   const auto intrinsics = PinholeIntrinsics::kinect_v1();
-  const TagLayout layout = layout_of(scene);
+  const TagLayout layout = synth::tag_layout(scene);
   TagDetector detector;
   for (const Pose& truth : viewpoints(scene)) {
     const double distance = (truth.translation() - scene.tags.front().centre).norm();
@@ -113,7 +101,7 @@ TEST(MarkerPose, ImageNoiseDegradesThePoseGracefully) {
   };
   for (auto& p : color.pixels()) p = {perturb(p.r), perturb(p.g), perturb(p.b)};
   TagDetector detector;
-  const auto pose = estimate_camera_pose(detector.detect(color), layout_of(scene), intrinsics);
+  const auto pose = estimate_camera_pose(detector.detect(color), synth::tag_layout(scene), intrinsics);
   ASSERT_TRUE(pose.has_value());
   const PoseError error = pose_error(pose->camera_to_world, truth);
   EXPECT_LE(error.cm, 2.0);
@@ -160,7 +148,7 @@ TEST(MarkerPoseStage, HoldsTheLastPoseWhenTheTagIsLost) {
   const ColorImage blank(640, 480, Rgb8{128, 128, 128});
   FrameGraph graph;
   graph.emplace<PoseFrameSource>(std::vector<ColorImage>{blank, tagged, blank});
-  graph.emplace<MarkerPoseStage>(layout_of(scene));
+  graph.emplace<MarkerPoseStage>(synth::tag_layout(scene));
   graph.keep("camera_pose");
   std::vector<CameraPose> poses;
   while (graph.run_frame()) poses.push_back(*graph.find<CameraPose>("camera_pose"));

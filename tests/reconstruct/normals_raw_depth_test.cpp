@@ -171,32 +171,10 @@ TEST(NormalsRawDepth, DisocclusionResetsTheHistory) {
 
 // ---- Frame graph -------------------------------------------------------------------------
 
-class SequenceSource final : public Stage {
- public:
-  explicit SequenceSource(const test::SyntheticSequence& sequence) : sequence_(sequence) {}
-  std::string name() const override { return "source"; }
-  bool has_side_effects() const override { return true; }
-  void declare(StageBuilder& b) override {
-    depth_ = b.write<DepthMap>("depth");
-    frame_ = b.write<FrameInfo>("frame");
-  }
-  void run(StageContext& ctx) override {
-    const auto i = static_cast<std::size_t>(ctx.frame_index());
-    if (i >= sequence_.frames.size()) return ctx.end_of_stream();
-    ctx.get(depth_) = sequence_.frames[i].noisy;
-    ctx.get(frame_) = FrameInfo{ctx.frame_index(), 0.0, sequence_.frames[i].camera_to_world, sequence_.intrinsics};
-  }
-
- private:
-  const test::SyntheticSequence& sequence_;
-  Write<DepthMap> depth_;
-  Write<FrameInfo> frame_;
-};
-
 TEST(NormalsRawDepthStage, GraphRunEqualsDirectCallsWithHistory) {
   const auto sequence = test::render_sequence(synth::Trajectory::Orbit, 3, 160, 120);
   FrameGraph graph;
-  graph.emplace<SequenceSource>(sequence);
+  graph.emplace<test::SequenceSource>(sequence);
   graph.emplace<NormalsRawDepthCpuStage>();
   graph.keep("normals");
   graph.compile();

@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "relight/core/camera.h"
+#include "relight/core/frame_graph.h"
+#include "relight/core/rgbd_frame.h"
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
 #include "relight/synth/kinect_noise.h"
@@ -51,5 +53,29 @@ inline SyntheticSequence render_sequence(synth::Trajectory trajectory, int frame
   }
   return sequence;
 }
+
+/// Feeds a SyntheticSequence into a frame graph: writes "depth" (the noisy depth) and "frame"
+/// (intrinsics and the true camera-to-world pose), and ends the stream after the last frame.
+class SequenceSource final : public Stage {
+ public:
+  explicit SequenceSource(const SyntheticSequence& sequence) : sequence_(sequence) {}
+  std::string name() const override { return "source"; }
+  bool has_side_effects() const override { return true; }
+  void declare(StageBuilder& b) override {
+    depth_ = b.write<DepthMap>("depth");
+    frame_ = b.write<FrameInfo>("frame");
+  }
+  void run(StageContext& ctx) override {
+    const auto i = static_cast<std::size_t>(ctx.frame_index());
+    if (i >= sequence_.frames.size()) return ctx.end_of_stream();
+    ctx.get(depth_) = sequence_.frames[i].noisy;
+    ctx.get(frame_) = FrameInfo{ctx.frame_index(), 0.0, sequence_.frames[i].camera_to_world, sequence_.intrinsics};
+  }
+
+ private:
+  const SyntheticSequence& sequence_;
+  Write<DepthMap> depth_;
+  Write<FrameInfo> frame_;
+};
 
 }  // namespace relight::test

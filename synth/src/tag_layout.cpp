@@ -1,0 +1,18 @@
+#include "relight/synth/tag_layout.h"
+
+namespace relight::synth {
+
+TagLayout tag_layout(const Scene& scene) {
+  TagLayout layout;
+  for (const auto& decal : scene.tags) {
+    TagLayout::Tag tag;
+    tag.id = decal.id;
+    tag.size = decal.size;
+    const auto corners = decal.corners_world();
+    for (std::size_t k = 0; k < 4; ++k) tag.corners_world[k] = corners[k];
+    layout.tags.push_back(tag);
+  }
+  return layout;
+}
+
+}  // namespace relight::synth
