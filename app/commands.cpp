@@ -45,6 +45,10 @@ void register_replay(CLI::App& app) {
   replay->add_option("--intrinsics", options->intrinsics, "Override intrinsics: kinect, fr1, fr2, fr3");
   replay->add_flag("--quiet", options->quiet, "No progress or summary on stderr");
   replay->add_flag("!--no-frames", options->write_frames, "Do not write per-frame images");
+  replay->add_option("--markers", options->markers,
+                     "AprilTag layout for the camera pose: auto (the sequence's scene.json if it has a tag), "
+                     "none, or a layout JSON file; writes marker_trajectory.txt")
+      ->capture_default_str();
   add_compute_options(*replay, *options);
   registry().runners[replay] = [options] { return run_replay(*options); };
 }

@@ -6,6 +6,8 @@
 
 #include "frame_range.h"
 #include "frame_writer_stage.h"
+#include "marker_trajectory_stage.h"
+#include "relight/capture/marker_pose.h"
 #include "relight/capture/source_stage.h"
 #include "relight/capture/tum_sequence.h"
 #include "relight/core/atomic_file.h"
@@ -54,6 +56,24 @@ std::unique_ptr<vk::VulkanContext> make_vulkan(const ReplayOptions& options, vk:
   return vk::try_create_vulkan(vulkan_options);
 }
 
+// "auto" uses the sequence's scene.json when it describes a tag (sequences from `relight synth`).
+std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
+  if (options.markers == "none") return std::nullopt;
+  if (options.markers != "auto") return read_tag_layout(options.markers);
+  const auto scene = (options.sequence.empty() ? default_sequence() : options.sequence) / "scene.json";
+  if (!std::filesystem::exists(scene)) return std::nullopt;
+  const std::string text = read_text_file(scene);
+  if (text.find("\"tag\"") == std::string::npos) return std::nullopt;
+  return parse_tag_layout(text, scene.string());
+}
+
+void add_marker_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
+  auto layout = marker_layout(options);
+  if (!layout) return;
+  pipeline.graph->emplace<MarkerPoseStage>(std::move(*layout));
+  pipeline.markers = &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt");
+}
+
 }  // namespace
 
 ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options) {
@@ -83,6 +103,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   }
   graph.keep("normals");
   graph.keep("positions");
+  add_marker_pose(pipeline, options);
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
     writer->add_color("color");
@@ -113,11 +134,13 @@ int run_replay(const ReplayOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   while (graph.run_frame()) progress.update(graph.frames_run());
   progress.finish();
+  graph.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   auto report = timing_report(graph, seconds);
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
+  if (pipeline.markers) report["marker_pose"] = pipeline.markers->summary();
   write_file_atomically(options.out / "report.json", report.dump(2) + "\n");
   if (!options.quiet) {
     std::cerr << "relight replay: " << graph.frames_run() << " frames in " << seconds << " s; results in "

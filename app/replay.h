@@ -13,6 +13,8 @@ class VulkanContext;
 
 namespace relight::app {
 
+class MarkerTrajectoryStage;
+
 struct ReplayOptions {
   std::filesystem::path sequence;  ///< empty: the embedded sample (data/tum_fr1_rpy)
   std::filesystem::path out = "relight-out";
@@ -22,6 +24,9 @@ struct ReplayOptions {
   bool write_frames = true;        ///< per-frame PNGs under out/frames
   std::string backend = "auto";    ///< auto | cpu | vulkan (see vk/backend.h)
   std::string device;              ///< Vulkan device selector (index, type or name part)
+  /// AprilTag layout for the marker pose: "auto" (the sequence's scene.json when it has a tag),
+  /// "none", or a layout/scene JSON file.
+  std::string markers = "auto";
   std::string geometry = "method1";  ///< normals: method1 (NormalsRawDepth) | method2 (DepthWarpMerge + NormalsFromPositions)
 };
 
@@ -31,6 +36,7 @@ struct ReplayPipeline {
   std::unique_ptr<relight::vk::VulkanContext> vulkan;
   std::unique_ptr<FrameGraph> graph;
   std::string compute;  ///< one line: which backend runs the per-pixel stages, on which device
+  app::MarkerTrajectoryStage* markers = nullptr;  ///< set when the marker pose runs
   ReplayPipeline();
   ~ReplayPipeline();
   ReplayPipeline(ReplayPipeline&&) noexcept;

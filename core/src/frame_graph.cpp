@@ -239,6 +239,12 @@ bool FrameGraph::run_frame() {
   return true;
 }
 
+void FrameGraph::finish() {
+  for (std::size_t s : order_) {
+    if (!stages_[s].culled) stages_[s].stage->finish();
+  }
+}
+
 // Last frame's results become "previous" only now, so that between frames find() still sees them.
 void FrameGraph::begin_frame() {
   for (auto& buffer : buffers_) {

@@ -185,7 +185,22 @@ TEST(Cli, SynthWritesASequenceThatReplayReads) {
   const auto out = dir.path() / "out";
   const auto replayed = relight("replay " + sequence.string() + " --quiet --out " + out.string());
   ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
-  EXPECT_EQ(nlohmann::json::parse(read_text_file(out / "report.json"))["frames"], 2);
+  const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
+  EXPECT_EQ(report["frames"], 2);
+  // The synthetic scene.json describes its AprilTag, so the marker pose runs and is compared with
+  // the exact poses of the sequence (Kinect-noisy depth, aliased colour: a few centimetres at most).
+  ASSERT_TRUE(report.contains("marker_pose")) << report.dump();
+  EXPECT_EQ(report["marker_pose"]["frames_with_marker_pose"], 2);
+  EXPECT_LT(report["marker_pose"]["max_error_cm"].get<double>(), 3.0);
+  EXPECT_LT(report["marker_pose"]["max_error_deg"].get<double>(), 2.0);
+  const std::string trajectory = read_text_file(out / "marker_trajectory.txt");
+  EXPECT_EQ(std::count(trajectory.begin(), trajectory.end(), '\n'), 4);  // 2 comment lines + 2 poses
+  const auto without = dir.path() / "without";
+  ASSERT_EQ(relight("replay " + sequence.string() + " --markers none --quiet --out " + without.string()).exit_code, 0);
+  EXPECT_FALSE(std::filesystem::exists(without / "marker_trajectory.txt"));
+  expect_one_line_error(relight("replay " + sequence.string() + " --markers " + (dir.path() / "no.json").string() +
+                                " --quiet --out " + without.string()),
+                        1);
   EXPECT_EQ(relight("synth --out " + sequence.string() + " --trajectory loop").exit_code, 2);
   EXPECT_EQ(relight("synth --frames 3").exit_code, 2);  // --out is required
 }

@@ -188,6 +188,34 @@ TEST(FrameGraph, TimesEveryStageEveryFrame) {
   }
 }
 
+class FinishCounter final : public Stage {
+ public:
+  explicit FinishCounter(int& finished) : finished_(finished) {}
+  std::string name() const override { return "finish_counter"; }
+  bool has_side_effects() const override { return true; }
+  void declare(StageBuilder& b) override { in_ = b.read<DepthMap>("depth"); }
+  void run(StageContext&) override { ++frames; }
+  void finish() override { ++finished_; }
+  int frames = 0;
+
+ private:
+  int& finished_;
+  Read<DepthMap> in_;
+};
+
+TEST(FrameGraph, FinishReachesEveryStageOnceAfterTheLastFrame) {
+  int finished = 0;
+  FrameGraph graph;
+  graph.emplace<CountingSource>(2);
+  auto& counter = graph.emplace<FinishCounter>(finished);
+  while (graph.run_frame()) {
+  }
+  EXPECT_EQ(finished, 0);
+  graph.finish();
+  EXPECT_EQ(finished, 1);
+  EXPECT_EQ(counter.frames, 2);
+}
+
 TEST(FrameGraph, FindChecksTheType) {
   FrameGraph graph;
   graph.emplace<CountingSource>(1);

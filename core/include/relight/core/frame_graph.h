@@ -213,6 +213,9 @@ class Stage {
   [[nodiscard]] virtual bool has_side_effects() const { return false; }
   virtual void declare(StageBuilder& builder) = 0;
   virtual void run(StageContext& context) = 0;
+  /// Called once by FrameGraph::finish() after the last frame (end of stream, --frames limit or
+  /// Ctrl-C), so that writers can finalise files that cover the whole run.
+  virtual void finish() {}
 };
 
 /// Per-stage timing over all frames run so far (milliseconds).
@@ -248,6 +251,9 @@ class FrameGraph {
   void compile();
   /// Runs one frame. Returns false when a source signalled end of stream (nothing after it ran).
   bool run_frame();
+  /// Lets every (non-culled) stage finalise its outputs, in execution order. Call once, after the
+  /// last run_frame().
+  void finish();
 
   [[nodiscard]] std::int64_t frames_run() const { return frames_run_; }
   /// Stage names in execution order (after compile), culled stages excluded.
