@@ -5,12 +5,21 @@
 // noise), angular error against the ray caster's exact normals on the last frame.
 // "ms" is one steady-state frame (the previous frame's outputs as history); the errors are
 // after 10 frames. Without PCL (libpcl-dev, scripts/debian-packages-bench.txt) the baseline
-// fields are absent. The Vulkan cases (normals/method*_vulkan) are not implemented yet.
+// fields are absent.
+// normals/method1_vulkan: method 1 with positions and the stride-4 cross products (eq. 4.4–4.6)
+// on the GPU (CrossNormalsVk) and pass 1, the temporal blend (eq. 4.7–4.8) and hole filling on
+// the CPU (normals_raw_depth_blend); "ms" includes the depth upload and both downloads,
+// "gpu_ms" is the dispatch alone (timestamp queries), "gpu_passes" names what ran on the GPU.
+// normals/method2_vulkan is not implemented yet.
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "bench.h"
+#include "relight/core/error.h"
+#include "relight/reconstruct/cross_normals_vk.h"
 #include "relight/reconstruct/depth_warp_merge.h"
 #include "relight/reconstruct/normal_error.h"
 #include "relight/reconstruct/normals_from_positions.h"
@@ -20,6 +29,10 @@
 #include "relight/synth/scene.h"
 #include "relight/synth/sequence.h"
 #include "relight/synth/trajectory.h"
+#include "relight/vk/buffer.h"
+#include "relight/vk/context.h"
+#include "relight/vk/device_selection.h"
+#include "relight/vk/transfer.h"
 
 #ifdef RELIGHT_HAVE_PCL
 #include <pcl/features/integral_image_normal.h>
@@ -150,6 +163,59 @@ Json method1_cpu(const bench::Options& options) {
   return json;
 }
 
+Json method1_vulkan(const bench::Options& options) {
+  std::string why;
+  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);  // no validation in timings
+  if (!context) throw Error("no Vulkan device: " + why);
+  const BenchSequence& s = sequence();
+  const NormalsRawDepthOptions method;
+  const CrossNormalOptions cross{.stride = method.stride, .max_jump_rel = method.max_jump_rel};
+  const int width = s.intrinsics.width, height = s.intrinsics.height;
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  CrossNormalsVk gpu(*context);
+  vk::VulkanTransfer& transfer = context->transfer();
+  vk::VulkanBuffer depth_buffer(*context, pixels * sizeof(float));
+  vk::VulkanBuffer position_buffer(*context, pixels * sizeof(Float3));
+  vk::VulkanBuffer normal_buffer(*context, pixels * sizeof(Float3));
+  std::vector<double> gpu_ms;
+  // One frame as a pipeline pays it: upload, dispatch, download, then the CPU passes.
+  const auto frame = [&](const DepthMap& depth, const NormalsHistory* history, PositionMap& positions,
+                         NormalMap& normals) {
+    positions.resize(width, height);
+    normals.resize(width, height);
+    transfer.upload(depth.bytes(), depth_buffer);
+    if (const auto ms = gpu.run(depth_buffer, position_buffer, normal_buffer, width, height, s.intrinsics, cross)) {
+      gpu_ms.push_back(*ms);
+    }
+    transfer.download(position_buffer, positions.bytes());
+    transfer.download(normal_buffer, normals.bytes());
+    normals_raw_depth_blend(s.intrinsics, s.pose, history, method, positions, normals);
+  };
+  PositionMap positions[2];
+  NormalMap normals[2];
+  for (int i = 0; i < kFrames; ++i) {
+    const int cur = i % 2, prev = 1 - cur;
+    const NormalsHistory history{normals[prev], positions[prev], s.pose};
+    frame(s.noisy[static_cast<std::size_t>(i)], i > 0 ? &history : nullptr, positions[cur], normals[cur]);
+  }
+  const int last = (kFrames - 1) % 2;
+  const AngularError error = angular_error(normals[last], s.truth);
+  const NormalsHistory history{normals[last], positions[last], s.pose};
+  PositionMap scratch_positions;
+  NormalMap scratch_normals;
+  gpu_ms.clear();
+  Json json = compare_with_pcl([&] { frame(s.noisy.back(), &history, scratch_positions, scratch_normals); }, options);
+  json["angular_error_deg"] = error.mean_deg;
+  json["coverage"] = error.coverage;
+  std::sort(gpu_ms.begin(), gpu_ms.end());
+  json["gpu_ms"] = gpu_ms.empty() ? -1.0 : gpu_ms[gpu_ms.size() / 2];  // -1: no timestamp queries
+  json["device"] = context->device_info().name;
+  json["device_type"] = vk::to_string(context->device_info().type);
+  json["gpu_passes"] = "positions_from_depth + stride-4 cross-product normals (eq. 4.4-4.6); "
+                       "pass 1 pyramid, temporal blend (eq. 4.7-4.8) and hole filling on the CPU";
+  return json;
+}
+
 Json method2_cpu(const bench::Options& options) {
   const BenchSequence& s = sequence();
   DepthMap filtered, warped;
@@ -220,6 +286,7 @@ Json pcl_omp(const bench::Options& options) {
 }  // namespace
 
 RELIGHT_BENCH_CASE("normals/method1_cpu", method1_cpu);
+RELIGHT_BENCH_CASE("normals/method1_vulkan", method1_vulkan);
 RELIGHT_BENCH_CASE("normals/method2_cpu", method2_cpu);
 #ifdef RELIGHT_HAVE_PCL
 RELIGHT_BENCH_CASE("normals/pcl_omp", pcl_omp);

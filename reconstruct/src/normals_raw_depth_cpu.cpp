@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "relight/core/error.h"
 #include "relight/core/parallel.h"
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
@@ -162,16 +163,24 @@ void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsic
   positions_from_depth(depth, intrinsics, positions, options.threads);
   normals_from_positions(positions, normals,
                          {.stride = options.stride, .max_jump_rel = options.max_jump_rel, .threads = options.threads});
-  const bool usable_history = previous && previous->normals.same_shape(depth) && previous->positions.same_shape(depth);
+  normals_raw_depth_blend(intrinsics, camera_to_world, previous, options, positions, normals);
+}
+
+void normals_raw_depth_blend(const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                             const NormalsHistory* previous, const NormalsRawDepthOptions& options,
+                             const PositionMap& positions, NormalMap& normals) {
+  if (!normals.same_shape(positions)) throw LogicError("normals_raw_depth_blend: normals and positions differ in shape");
+  const bool usable_history =
+      previous && previous->normals.same_shape(positions) && previous->positions.same_shape(positions);
   if (usable_history) {
     const std::vector<NormalLevel> pyramid = build_pyramid(previous->normals, std::max(1, options.mip_levels),
                                                            options.threads);
     const Pose prev_from_current_pose = previous->camera_to_world.inverse() * camera_to_world;
     const Rigid prev_from_current(prev_from_current_pose);
     const Rigid current_from_prev(prev_from_current_pose.inverse());
-    parallel_rows(depth.height(), options.threads, [&](int begin, int end) {
+    parallel_rows(positions.height(), options.threads, [&](int begin, int end) {
       for (int r = begin; r < end; ++r) {
-        for (int c = 0; c < depth.width(); ++c) {
+        for (int c = 0; c < positions.width(); ++c) {
           Float3& n = normals(r, c);
           if (!is_valid_normal(n)) continue;
           n = blend_with_history(n, positions(r, c), *previous, pyramid, prev_from_current, current_from_prev,

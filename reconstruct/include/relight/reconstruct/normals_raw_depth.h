@@ -56,6 +56,15 @@ void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsic
                        const NormalsHistory* previous, const NormalsRawDepthOptions& options,
                        PositionMap& positions, NormalMap& normals);
 
+/// Everything of method 1 after the cross products: pass 1 on `previous`, pass 2's temporal
+/// blend (eq. 4.7–4.8) and hole filling, applied in place to `normals`, which must hold this
+/// frame's stride-s normals of `positions` (eq. 4.4–4.6). normals_raw_depth is positions_from_depth
+/// + normals_from_positions + this; a backend that computes the cross products elsewhere
+/// (CrossNormalsVk) finishes the frame with it. Throws LogicError when the shapes differ.
+void normals_raw_depth_blend(const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                             const NormalsHistory* previous, const NormalsRawDepthOptions& options,
+                             const PositionMap& positions, NormalMap& normals);
+
 /// Frame-graph stage of method 1 (buffers in the header comment).
 class NormalsRawDepthCpuStage final : public Stage {
  public:
