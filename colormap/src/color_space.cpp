@@ -8,9 +8,9 @@ namespace relight::colormap {
 
 namespace {
 
-constexpr float kDelta = 6.f / 29.f;
-constexpr float kDeltaCubed = kDelta * kDelta * kDelta;
-constexpr float kLinearSlope = 1.f / (3.f * kDelta * kDelta);
+constexpr float kDelta = kLabDelta;
+constexpr float kDeltaCubed = kLabDeltaCubed;
+constexpr float kLinearSlope = kLabLinearSlope;
 
 Float3 multiply(const float (&m)[3][3], const Float3& v) {
   return {m[0][0] * v.x + m[0][1] * v.y + m[0][2] * v.z, m[1][0] * v.x + m[1][1] * v.y + m[1][2] * v.z,

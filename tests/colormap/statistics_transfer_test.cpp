@@ -5,11 +5,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
 #include "colormap_test_scene.h"
+#include "statistics_reference.h"
 #include "reconstruct/vulkan_test_env.h"
 #include "relight/colormap/statistics_transfer_vk.h"
 #include "relight/core/error.h"
@@ -111,6 +114,100 @@ TEST(StatisticsTransfer, ReducesTheColourErrorOfTheVirtualObject) {
     EXPECT_GT(before, 6.0);
     EXPECT_LT(after, 4.0);
     EXPECT_LT(after, 0.5 * before);
+  }
+}
+
+TEST(StatisticsTransfer, FastCubeRootMatchesStdCbrt) {
+  // Every 101st float from delta^3 / 2 to 8: the Lab range [delta^3, 1] of the in-gamut colours
+  // and well beyond (about 1.6 million values, every mantissa region of every octave).
+  double worst = 0.0;
+  const auto last = std::bit_cast<std::int32_t>(8.f);
+  for (auto bits = std::bit_cast<std::int32_t>(0.5f * kLabDeltaCubed); bits < last; bits += 101) {
+    const float x = std::bit_cast<float>(bits);
+    const double exact = std::cbrt(static_cast<double>(x));
+    worst = std::max(worst, std::fabs(fast_cbrt(x) - exact) / exact);
+  }
+  EXPECT_LT(worst, 6e-7);  // std::cbrt in float: 1e-7
+  EXPECT_NEAR(fast_cbrt(1.f), 1.f, 1e-6f);
+  EXPECT_NEAR(fast_cbrt(0.125f), 0.5f, 1e-6f);
+  // The branch-free g keeps the linear part below delta^3 (and at t <= 0, where fast_cbrt is garbage).
+  EXPECT_FLOAT_EQ(lab_g_fast(0.f), 4.f / 29.f);
+  EXPECT_FLOAT_EQ(lab_g_fast(-0.01f), -0.01f * kLabLinearSlope + 4.f / 29.f);
+}
+
+// The synthetic triple with the kinds of pixels the mask must drop mixed in: NaN and infinite
+// radiance, black camera pixels, black renderings.
+SyntheticTriple triple_with_invalid_pixels() {
+  SyntheticTriple triple = test::orange_triple();
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (std::size_t i = 0; i < triple.real.size(); i += 7) {
+    switch (i % 4) {
+      case 0: triple.real.pixels()[i] = triple.real_virtual.pixels()[i] = {nan, 0.5f, 0.5f}; break;
+      case 1: triple.real.pixels()[i] = triple.real_virtual.pixels()[i] = {inf, inf, inf}; break;
+      case 2: triple.camera.pixels()[i] = {0, 0, 0}; break;
+      default: triple.real.pixels()[i] = triple.real_virtual.pixels()[i] = {0.f, -1.f, 0.f}; break;
+    }
+  }
+  return triple;
+}
+
+void expect_statistics_near(const LabStatistics& fast, const LabStatistics& reference, double tolerance) {
+  EXPECT_EQ(fast.count, reference.count);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(fast.mean[k], reference.mean[k], tolerance) << k;
+    EXPECT_NEAR(fast.stddev[k], reference.stddev[k], tolerance) << k;
+  }
+}
+
+TEST(StatisticsTransfer, FastStatisticsMatchThePlainReference) {
+  for (const SyntheticTriple& triple : {test::orange_triple(), test::green_triple(), triple_with_invalid_pixels()}) {
+    const TransferStatistics reference =
+        statistics_from_sums(test::masked_lab_sums_reference(triple.real, triple.real_virtual, triple.camera, {}));
+    const TransferStatistics fast = masked_lab_statistics(triple.real, triple.real_virtual, triple.camera, {});
+    ASSERT_GT(reference.source.count, 1000);
+    // Lab units: fast_cbrt's 5e-7 relative is at most 116 * 5e-7 = 6e-5 in L* per pixel.
+    expect_statistics_near(fast.source, reference.source, 1e-4);
+    expect_statistics_near(fast.target, reference.target, 1e-4);
+  }
+}
+
+TEST(StatisticsTransfer, FastMappingMatchesThePlainReference) {
+  for (const SyntheticTriple* triple : {&test::orange_triple(), &test::green_triple()}) {
+    const ReinhardTransfer reference = ReinhardTransfer::from(
+        statistics_from_sums(test::masked_lab_sums_reference(triple->real, triple->real_virtual, triple->camera, {})));
+    const RadianceImage reference_delta =
+        test::statistics_delta_reference(triple->real, triple->real_virtual, reference, {});
+    RadianceImage delta;
+    const ReinhardTransfer fast = statistics_color_map(triple->real, triple->real_virtual, triple->camera, {}, delta);
+    for (std::size_t k = 0; k < 3; ++k) {
+      EXPECT_NEAR(fast.scale[k], reference.scale[k], 1e-5f * reference.scale[k]) << k;
+      EXPECT_NEAR(fast.offset[k], reference.offset[k], 1e-3f) << k;
+    }
+    float worst = 0.f;
+    for (std::size_t i = 0; i < delta.size(); ++i) {
+      const Float3 d = delta.pixels()[i] - reference_delta.pixels()[i];
+      worst = std::max({worst, std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+    }
+    EXPECT_LT(worst, 1e-5f);
+    EXPECT_NEAR(test::virtual_delta_e(*triple, delta), test::virtual_delta_e(*triple, reference_delta), 1e-3);
+  }
+}
+
+TEST(StatisticsTransfer, ResultDoesNotDependOnTheThreadCount) {
+  const SyntheticTriple triple = triple_with_invalid_pixels();
+  const LabSums one = masked_lab_sums(triple.real, triple.real_virtual, triple.camera, {}, 1);
+  for (const int threads : {2, 3, 8}) {
+    const LabSums many = masked_lab_sums(triple.real, triple.real_virtual, triple.camera, {}, threads);
+    EXPECT_EQ(many.count, one.count);
+    EXPECT_EQ(many.source_sum, one.source_sum) << threads;  // bit for bit: fixed summation order
+    EXPECT_EQ(many.source_sum_sq, one.source_sum_sq) << threads;
+    EXPECT_EQ(many.target_sum, one.target_sum) << threads;
+    EXPECT_EQ(many.target_sum_sq, one.target_sum_sq) << threads;
+    RadianceImage delta_one, delta_many;
+    statistics_delta(triple.real, triple.real_virtual, {}, {}, delta_one, 1);
+    statistics_delta(triple.real, triple.real_virtual, {}, {}, delta_many, threads);
+    // Bytes, not floats: the NaN pixels give NaN deltas, which compare unequal to themselves.
+    EXPECT_TRUE(std::ranges::equal(delta_one.bytes(), delta_many.bytes())) << threads;
   }
 }
 

@@ -14,6 +14,8 @@
 //   L* = 116 g(Y) - 16, a* = 500 (g(X) - g(Y)), b* = 200 (g(Y) - g(Z)),
 //   g(t) = t^(1/3) for t > (6/29)^3, else t / (3 (6/29)^2) + 4/29
 // The linear branch extends to negative t, so out-of-gamut and difference colours round-trip.
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 
 #include "relight/core/pixel.h"
@@ -32,6 +34,37 @@ inline constexpr float kXyzEToLinearSrgb[3][3] = {
     {-1.0221081721f, 1.9782866167f, 0.0438215555f},
     {0.0612244898f, -0.2244897959f, 1.1632653061f},
 };
+
+/// delta = 6/29 of the Lab curve g: g is a cube root above delta^3 and linear below.
+inline constexpr float kLabDelta = 6.f / 29.f;
+inline constexpr float kLabDeltaCubed = kLabDelta * kLabDelta * kLabDelta;
+inline constexpr float kLabLinearSlope = 1.f / (3.f * kLabDelta * kLabDelta);
+
+/// Cube root of a positive, normal float to <= 5e-7 relative (std::cbrt: 1e-7), for the hot
+/// loops of the statistics-based mapping, where std::cbrt (a libm call, not vectorisable) cost
+/// most of the time. x^(-1/3) is guessed from the float's bits (the exponent field is a
+/// log2, divided by -3; the integer division is done in float so that SSE2 can vectorise it),
+/// refined by three Newton steps y <- y (4/3 - x/3 y^3) that need no division (the error
+/// squares each step: 8e-2, 6e-3, 4e-5, 5e-7), and cbrt(x) = x * y^2. Zero, negative, denormal
+/// and non-finite x give garbage: callers select another branch for those.
+[[nodiscard]] inline float fast_cbrt(float x) {
+  constexpr std::int32_t kMagic = 0x54a2fa8c;  // (4/3) * (127 - 0.045) * 2^23: bias of -log2(x)/3
+  const auto bits = std::bit_cast<std::int32_t>(x);
+  float y = std::bit_cast<float>(kMagic - static_cast<std::int32_t>(static_cast<float>(bits) * (1.f / 3.f)));
+  // Written out, not looped: a loop here keeps the callers' loops from vectorising.
+  const float third_x = x * (1.f / 3.f);
+  y = y * (4.f / 3.f - third_x * y * y * y);
+  y = y * (4.f / 3.f - third_x * y * y * y);
+  y = y * (4.f / 3.f - third_x * y * y * y);
+  return x * y * y;
+}
+
+/// The Lab curve g(t) with fast_cbrt (same branches as lab_g in color_space.cpp); branch-free
+/// (a select) so that loops over many values vectorise.
+[[nodiscard]] inline float lab_g_fast(float t) {
+  const float cube_root = fast_cbrt(std::max(t, kLabDeltaCubed));
+  return t > kLabDeltaCubed ? cube_root : t * kLabLinearSlope + 4.f / 29.f;
+}
 
 /// CIELab colour (L* in [0, 100] for colours in gamut), stored in Float3 as (L, a, b).
 using LabPixel = Float3;

@@ -1,5 +1,5 @@
 #pragma once
-// Statistics-based colour mapping (Knecht §4.5.3), CPU reference.
+// Statistics-based colour mapping (Knecht §4.5.3) on the CPU.
 //
 //   tau_st(c) = f^-1(tau_ct(f(TM(c))))                                        (eq. 4.30)
 // f: linear sRGB -> CIELab, illuminant E (color_space.h); TM: tone_map.h. tau_ct is Reinhard's
@@ -10,7 +10,8 @@
 // pixels, the same set for source and target:
 //   valid(p) = L_r(p) finite, L_rv(p) == L_r(p) (no virtual object there), TM(L_r(p)) != 0 and
 //              camera(p) != (0,0,0) (black/invalid pixels carry no colour information).
-// Sums run in double; a channel with sigma_s = 0 keeps scale 1 (only the mean shifts), and no
+// Sums run in double (per row, then added in row order, so that the row-parallel result does not
+// depend on the thread count); a channel with sigma_s = 0 keeps scale 1 (only the mean shifts), and no
 // valid pixel at all gives the identity transfer.
 //
 // The difference image and the composite (eqs. 4.28-4.29, camera-linear sRGB):
@@ -50,9 +51,14 @@ struct TransferStatistics {
 [[nodiscard]] bool is_statistics_pixel(const Float3& real, const Float3& real_virtual, const Rgb8& camera,
                                        const ToneMap& tm);
 
-/// The masked reduction of eqs. 4.31-4.34. All images must have the same shape (else relight::Error).
+/// The masked sums of eqs. 4.31-4.34 on `threads` threads (0 = all, see relight::worker_count);
+/// the result is the same for every thread count. All images must have the same shape (else
+/// relight::Error). The cube roots of the Lab conversion use fast_cbrt (<= 5e-7 relative).
+[[nodiscard]] LabSums masked_lab_sums(const RadianceImage& real, const RadianceImage& real_virtual,
+                                      const ColorImage& camera, const ToneMap& tm, int threads = 0);
+/// statistics_from_sums(masked_lab_sums(...)).
 [[nodiscard]] TransferStatistics masked_lab_statistics(const RadianceImage& real, const RadianceImage& real_virtual,
-                                                       const ColorImage& camera, const ToneMap& tm);
+                                                       const ColorImage& camera, const ToneMap& tm, int threads = 0);
 
 /// tau_ct as scale/offset per Lab channel: x' = scale * x + offset.
 struct ReinhardTransfer {
@@ -68,13 +74,15 @@ struct ReinhardTransfer {
 /// tau_st(c) of eq. 4.30 for one linear radiance c.
 [[nodiscard]] Float3 map_statistics(const Float3& radiance, const ReinhardTransfer& transfer, const ToneMap& tm);
 
-/// delta_L = tau_st(L_rv) - tau_st(L_r) per pixel; resizes `delta`.
+/// delta_L = tau_st(L_rv) - tau_st(L_r) per pixel (map_statistics with fast_cbrt, row-parallel);
+/// resizes `delta`.
 void statistics_delta(const RadianceImage& real, const RadianceImage& real_virtual, const ReinhardTransfer& transfer,
-                      const ToneMap& tm, RadianceImage& delta);
+                      const ToneMap& tm, RadianceImage& delta, int threads = 0);
 
 /// Statistics + transfer + delta in one call (the CPU stage's work).
 [[nodiscard]] ReinhardTransfer statistics_color_map(const RadianceImage& real, const RadianceImage& real_virtual,
-                                                    const ColorImage& camera, const ToneMap& tm, RadianceImage& delta);
+                                                    const ColorImage& camera, const ToneMap& tm, RadianceImage& delta,
+                                                    int threads = 0);
 
 /// L_final = L_cam + delta_L (eq. 4.29), in linear sRGB, clamped and encoded back to 8-bit sRGB.
 [[nodiscard]] ColorImage composite(const ColorImage& camera, const RadianceImage& delta);
