@@ -22,11 +22,7 @@ float pow128(float x) {
   return x;
 }
 
-// One level of the pass-1 pyramid: mean normal and curvature coefficient per texel.
-struct NormalLevel {
-  Image<Float3> normal;
-  Image<float> curvature;
-};
+using NormalLevel = NormalsPyramidLevel;
 
 // Pass 1 at half resolution: texel (r, c) summarises full-resolution pixel (2r, 2c).
 NormalLevel average_and_curvature(const NormalMap& previous, int threads) {
@@ -156,6 +152,10 @@ void fill_holes(const PositionMap& positions, NormalMap& normals) {
 }
 
 }  // namespace
+
+std::vector<NormalsPyramidLevel> normals_history_pyramid(const NormalMap& previous, int levels, int threads) {
+  return build_pyramid(previous, std::max(1, levels), threads);
+}
 
 void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
                        const NormalsHistory* previous, const NormalsRawDepthOptions& options,

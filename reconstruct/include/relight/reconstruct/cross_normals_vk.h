@@ -11,8 +11,9 @@
 // Positions equal the CPU's bit for bit (no fused multiply-add); normals agree to float
 // rounding of the cross product, length and division.
 //
-// The temporal blend of method 1 (eq. 4.7–4.8) is not on the GPU: run normals_raw_depth_blend
-// (normals_raw_depth.h) on the downloaded maps. This header includes no Vulkan headers.
+// Method 1's temporal blend (eq. 4.7–4.8) follows in NormalsRawDepthVk (normals_raw_depth_vk.h),
+// or on the CPU with normals_raw_depth_blend (normals_raw_depth.h) on the downloaded maps.
+// This header includes no Vulkan headers.
 #include <memory>
 #include <optional>
 

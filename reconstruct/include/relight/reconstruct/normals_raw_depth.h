@@ -26,6 +26,7 @@
 // PositionMap "positions" and FrameInfo "frame"; it writes NormalMap "normals" and PositionMap
 // "positions".
 #include <string>
+#include <vector>
 
 #include "relight/core/camera.h"
 #include "relight/core/frame_graph.h"
@@ -55,6 +56,16 @@ struct NormalsHistory {
 void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
                        const NormalsHistory* previous, const NormalsRawDepthOptions& options,
                        PositionMap& positions, NormalMap& normals);
+
+/// One level of the pass-1 pyramid: mean normal and curvature coefficient per texel.
+struct NormalsPyramidLevel {
+  Image<Float3> normal;
+  Image<float> curvature;
+};
+/// Pass 1 (eq. 4.1–4.3) on the previous frame's normals: level 0 at half resolution, then up to
+/// `levels` − 1 coarser levels (fewer when a side reaches 1 texel).
+[[nodiscard]] std::vector<NormalsPyramidLevel> normals_history_pyramid(const NormalMap& previous, int levels,
+                                                                       int threads = 0);
 
 /// Everything of method 1 after the cross products: pass 1 on `previous`, pass 2's temporal
 /// blend (eq. 4.7–4.8) and hole filling, applied in place to `normals`, which must hold this
