@@ -13,8 +13,10 @@
 // This header includes no Vulkan headers.
 #include <memory>
 #include <optional>
+#include <string>
 
 #include "relight/core/camera.h"
+#include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
 #include "relight/reconstruct/cross_normals_vk.h"
@@ -43,6 +45,33 @@ class NormalsRawDepthVk {
   CrossNormalsVk cross_;
   std::unique_ptr<Pipelines> pipelines_;
   std::optional<double> last_gpu_ms_;
+};
+
+/// Frame-graph stage of method 1 on Vulkan, a drop-in for NormalsRawDepthCpuStage (same name and
+/// buffers: reads DepthMap "depth", FrameInfo "frame" and the previous frame's "normals",
+/// "positions" and "frame"; writes NormalMap "normals" and PositionMap "positions").
+/// It works on the graph's host buffers and does its own uploads and downloads, because the
+/// graph hands previous-frame buffers to stages on the host only and pass 1 runs on the CPU
+/// anyway; so backend() is Cpu in the graph's sense, while the GPU time of the dispatches is
+/// reported to the graph's timing table.
+class NormalsRawDepthVkStage final : public Stage {
+ public:
+  explicit NormalsRawDepthVkStage(vk::VulkanContext& context, NormalsRawDepthOptions options = {})
+      : method_(context), options_(options) {}
+  [[nodiscard]] std::string name() const override { return "normals_raw_depth"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  NormalsRawDepthVk method_;
+  NormalsRawDepthOptions options_;
+  Read<DepthMap> depth_;
+  Read<FrameInfo> frame_;
+  ReadPrevious<NormalMap> previous_normals_;
+  ReadPrevious<PositionMap> previous_positions_;
+  ReadPrevious<FrameInfo> previous_frame_;
+  Write<PositionMap> positions_;
+  Write<NormalMap> normals_;
 };
 
 }  // namespace relight
