@@ -192,7 +192,7 @@ void normals_raw_depth_blend(const PinholeIntrinsics& intrinsics, const Pose& ca
   fill_holes(positions, normals);
 }
 
-void NormalsRawDepthCpuStage::declare(StageBuilder& builder) {
+void NormalsRawDepthStageBase::declare(StageBuilder& builder) {
   depth_ = builder.read<DepthMap>("depth");
   frame_ = builder.read<FrameInfo>("frame");
   previous_normals_ = builder.read_previous<NormalMap>("normals");
@@ -202,7 +202,7 @@ void NormalsRawDepthCpuStage::declare(StageBuilder& builder) {
   normals_ = builder.write<NormalMap>("normals");
 }
 
-void NormalsRawDepthCpuStage::run(StageContext& context) {
+void NormalsRawDepthStageBase::run(StageContext& context) {
   const FrameInfo& frame = context.get(frame_);
   const Pose camera_to_world = frame.camera_to_world.value_or(Pose::Identity());
   const NormalMap* previous_normals = context.get(previous_normals_);
@@ -214,8 +214,14 @@ void NormalsRawDepthCpuStage::run(StageContext& context) {
         previous_frame && previous_frame->camera_to_world ? *previous_frame->camera_to_world : Pose::Identity();
     history.emplace(NormalsHistory{*previous_normals, *previous_positions, previous_pose});
   }
-  normals_raw_depth(context.get(depth_), frame.intrinsics, camera_to_world, history ? &*history : nullptr, options_,
-                    context.get(positions_), context.get(normals_));
+  estimate(context, context.get(depth_), frame.intrinsics, camera_to_world, history ? &*history : nullptr,
+           context.get(positions_), context.get(normals_));
+}
+
+void NormalsRawDepthCpuStage::estimate(StageContext&, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
+                                       const Pose& camera_to_world, const NormalsHistory* previous,
+                                       PositionMap& positions, NormalMap& normals) {
+  normals_raw_depth(depth, intrinsics, camera_to_world, previous, options(), positions, normals);
 }
 
 }  // namespace relight

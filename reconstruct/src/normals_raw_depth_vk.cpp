@@ -118,31 +118,10 @@ void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intr
   transfer.download(fill_output, normals.bytes());
 }
 
-void NormalsRawDepthVkStage::declare(StageBuilder& builder) {
-  depth_ = builder.read<DepthMap>("depth");
-  frame_ = builder.read<FrameInfo>("frame");
-  previous_normals_ = builder.read_previous<NormalMap>("normals");
-  previous_positions_ = builder.read_previous<PositionMap>("positions");
-  previous_frame_ = builder.read_previous<FrameInfo>("frame");
-  positions_ = builder.write<PositionMap>("positions");
-  normals_ = builder.write<NormalMap>("normals");
-}
-
-void NormalsRawDepthVkStage::run(StageContext& context) {
-  // Same history rules as NormalsRawDepthCpuStage: identity poses when the frame has none.
-  const FrameInfo& frame = context.get(frame_);
-  const Pose camera_to_world = frame.camera_to_world.value_or(Pose::Identity());
-  const NormalMap* previous_normals = context.get(previous_normals_);
-  const PositionMap* previous_positions = context.get(previous_positions_);
-  const FrameInfo* previous_frame = context.get(previous_frame_);
-  std::optional<NormalsHistory> history;
-  if (previous_normals && previous_positions) {
-    const Pose previous_pose =
-        previous_frame && previous_frame->camera_to_world ? *previous_frame->camera_to_world : Pose::Identity();
-    history.emplace(NormalsHistory{*previous_normals, *previous_positions, previous_pose});
-  }
-  method_.run(context.get(depth_), frame.intrinsics, camera_to_world, history ? &*history : nullptr, options_,
-              context.get(positions_), context.get(normals_));
+void NormalsRawDepthVkStage::estimate(StageContext& context, const DepthMap& depth,
+                                      const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                                      const NormalsHistory* previous, PositionMap& positions, NormalMap& normals) {
+  method_.run(depth, intrinsics, camera_to_world, previous, options(), positions, normals);
   if (const auto ms = method_.last_gpu_ms()) context.report_device_ms(*ms);
 }
 

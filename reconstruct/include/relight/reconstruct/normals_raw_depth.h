@@ -76,13 +76,21 @@ void normals_raw_depth_blend(const PinholeIntrinsics& intrinsics, const Pose& ca
                              const NormalsHistory* previous, const NormalsRawDepthOptions& options,
                              const PositionMap& positions, NormalMap& normals);
 
-/// Frame-graph stage of method 1 (buffers in the header comment).
-class NormalsRawDepthCpuStage final : public Stage {
+/// What the CPU and Vulkan stages of method 1 share: the buffers they declare (see the header
+/// comment) and how last frame's normals, positions and pose become the NormalsHistory
+/// (identity poses when a frame has none). Subclasses only estimate.
+class NormalsRawDepthStageBase : public Stage {
  public:
-  explicit NormalsRawDepthCpuStage(NormalsRawDepthOptions options = {}) : options_(options) {}
-  [[nodiscard]] std::string name() const override { return "normals_raw_depth"; }
-  void declare(StageBuilder& builder) override;
-  void run(StageContext& context) override;
+  explicit NormalsRawDepthStageBase(NormalsRawDepthOptions options) : options_(options) {}
+  [[nodiscard]] std::string name() const final { return "normals_raw_depth"; }
+  void declare(StageBuilder& builder) final;
+  void run(StageContext& context) final;
+
+ protected:
+  virtual void estimate(StageContext& context, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
+                        const Pose& camera_to_world, const NormalsHistory* previous, PositionMap& positions,
+                        NormalMap& normals) = 0;
+  [[nodiscard]] const NormalsRawDepthOptions& options() const { return options_; }
 
  private:
   NormalsRawDepthOptions options_;
@@ -93,6 +101,17 @@ class NormalsRawDepthCpuStage final : public Stage {
   ReadPrevious<FrameInfo> previous_frame_;
   Write<PositionMap> positions_;
   Write<NormalMap> normals_;
+};
+
+/// Frame-graph stage of method 1 on the CPU (the reference).
+class NormalsRawDepthCpuStage final : public NormalsRawDepthStageBase {
+ public:
+  explicit NormalsRawDepthCpuStage(NormalsRawDepthOptions options = {}) : NormalsRawDepthStageBase(options) {}
+
+ private:
+  void estimate(StageContext& context, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
+                const Pose& camera_to_world, const NormalsHistory* previous, PositionMap& positions,
+                NormalMap& normals) override;
 };
 
 }  // namespace relight

@@ -54,24 +54,16 @@ class NormalsRawDepthVk {
 /// graph hands previous-frame buffers to stages on the host only and pass 1 runs on the CPU
 /// anyway; so backend() is Cpu in the graph's sense, while the GPU time of the dispatches is
 /// reported to the graph's timing table.
-class NormalsRawDepthVkStage final : public Stage {
+class NormalsRawDepthVkStage final : public NormalsRawDepthStageBase {
  public:
   explicit NormalsRawDepthVkStage(vk::VulkanContext& context, NormalsRawDepthOptions options = {})
-      : method_(context), options_(options) {}
-  [[nodiscard]] std::string name() const override { return "normals_raw_depth"; }
-  void declare(StageBuilder& builder) override;
-  void run(StageContext& context) override;
+      : NormalsRawDepthStageBase(options), method_(context) {}
 
  private:
+  void estimate(StageContext& context, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
+                const Pose& camera_to_world, const NormalsHistory* previous, PositionMap& positions,
+                NormalMap& normals) override;
   NormalsRawDepthVk method_;
-  NormalsRawDepthOptions options_;
-  Read<DepthMap> depth_;
-  Read<FrameInfo> frame_;
-  ReadPrevious<NormalMap> previous_normals_;
-  ReadPrevious<PositionMap> previous_positions_;
-  ReadPrevious<FrameInfo> previous_frame_;
-  Write<PositionMap> positions_;
-  Write<NormalMap> normals_;
 };
 
 }  // namespace relight
