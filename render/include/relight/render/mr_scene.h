@@ -1,0 +1,89 @@
+#pragma once
+// MrScene: the mixed-reality scene that both the reference path tracer and the DIR renderer
+// consume (Knecht's dissertation §5.2). Everything is in the world frame (metres, linear RGB).
+//
+// Every mesh and every light carries the real/virtual flag r(x) of differential rendering:
+// L_rv is the light transport of the whole scene, L_r that of the real elements alone (virtual
+// meshes invisible to every ray, virtual lights switched off). Real geometry comes from the
+// synthetic scene's exact shapes (scene_from_synth.h) or from the reconstructed depth of a frame
+// (depth_mesh.h); virtual objects from OBJ/glTF files (model_io.h).
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "relight/core/camera.h"
+#include "relight/core/pose.h"
+
+namespace relight::render {
+
+/// Phong material as the renderer evaluates it (phong_brdf.h):
+///   f(wi, wo) = k_d / pi + k_s (n + 2) / (2 pi) max(0, r(wi) . wo)^n
+/// plus an emitted radiance (a virtual light source shaped like its mesh).
+struct PhongMaterial {
+  std::string name;
+  Eigen::Vector3f kd{0.5f, 0.5f, 0.5f};
+  float ks = 0.f;
+  float n = 1.f;
+  Eigen::Vector3f emission{0.f, 0.f, 0.f};
+};
+
+/// An indexed triangle mesh with one material per triangle. `normals` is either empty (flat
+/// shading with the geometric normal) or one unit normal per vertex (interpolated).
+struct TriangleMesh {
+  std::string name;
+  std::vector<Eigen::Vector3f> positions;
+  std::vector<Eigen::Vector3f> normals;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::uint32_t> triangle_material;  ///< index into MrScene::materials
+  bool real = true;                              ///< r(x): measured surface or virtual object
+
+  [[nodiscard]] std::size_t triangle_count() const { return triangles.size(); }
+};
+
+enum class LightKind { Point, Spot, Directional };
+
+/// A primary light. Point and spot lights have a radiant intensity `intensity` (W/sr, RGB);
+/// a spot light scales it by a smooth falloff between cos_inner (full) and cos_outer (zero)
+/// around `direction`. A directional light delivers the irradiance `intensity` (W/m^2, RGB) to a
+/// surface facing it, coming from `direction` (unit, towards the light) - the environment
+/// lights of the light-extraction stage.
+struct MrLight {
+  LightKind kind = LightKind::Point;
+  Eigen::Vector3f position{0.f, 0.f, 0.f};
+  Eigen::Vector3f direction{0.f, 0.f, -1.f};
+  Eigen::Vector3f intensity{1.f, 1.f, 1.f};
+  float cos_inner = 0.9f;
+  float cos_outer = 0.8f;
+  bool real = true;
+};
+
+/// Radiance arriving from every direction where a ray leaves the scene (real: it is part of the
+/// camera's world, like the synthetic scene's open sky).
+struct Environment {
+  Eigen::Vector3f radiance{0.f, 0.f, 0.f};
+};
+
+struct MrScene {
+  std::vector<PhongMaterial> materials;
+  std::vector<TriangleMesh> meshes;
+  std::vector<MrLight> lights;
+  Environment environment;
+
+  /// Adds a material and returns its index.
+  std::uint32_t add_material(PhongMaterial material);
+  [[nodiscard]] std::size_t triangle_count(bool real) const;
+  /// Throws relight::Error when a mesh refers to a missing material or vertex, or has a
+  /// non-finite position, or a normal array of the wrong size.
+  void validate() const;
+};
+
+/// The camera of one frame: pinhole intrinsics (with the image size) and camera-to-world pose
+/// (OpenCV camera convention: x right, y down, z forward).
+struct MrCamera {
+  PinholeIntrinsics intrinsics;
+  Pose camera_to_world = Pose::Identity();
+};
+
+}  // namespace relight::render

@@ -1,0 +1,48 @@
+#include "relight/render/mr_scene.h"
+
+#include <cmath>
+
+#include "relight/core/error.h"
+
+namespace relight::render {
+
+std::uint32_t MrScene::add_material(PhongMaterial material) {
+  materials.push_back(std::move(material));
+  return static_cast<std::uint32_t>(materials.size() - 1);
+}
+
+std::size_t MrScene::triangle_count(bool real) const {
+  std::size_t count = 0;
+  for (const TriangleMesh& mesh : meshes)
+    if (mesh.real == real) count += mesh.triangle_count();
+  return count;
+}
+
+namespace {
+
+void validate_mesh(const TriangleMesh& mesh, std::size_t material_count) {
+  const std::string where = "mesh '" + mesh.name + "': ";
+  if (mesh.triangle_material.size() != mesh.triangles.size())
+    throw Error(where + "needs one material per triangle");
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+    throw Error(where + "needs one normal per vertex or none");
+  for (const Eigen::Vector3f& p : mesh.positions)
+    if (!p.allFinite()) throw Error(where + "has a non-finite vertex position");
+  for (const auto& triangle : mesh.triangles)
+    for (std::uint32_t v : triangle)
+      if (v >= mesh.positions.size()) throw Error(where + "refers to a missing vertex");
+  for (std::uint32_t m : mesh.triangle_material)
+    if (m >= material_count) throw Error(where + "refers to a missing material");
+}
+
+}  // namespace
+
+void MrScene::validate() const {
+  for (const TriangleMesh& mesh : meshes) validate_mesh(mesh, materials.size());
+  for (const PhongMaterial& material : materials)
+    if (!material.kd.allFinite() || !std::isfinite(material.ks) || !std::isfinite(material.n) || material.n < 0.f ||
+        !material.emission.allFinite())
+      throw Error("material '" + material.name + "' has invalid Phong parameters");
+}
+
+}  // namespace relight::render

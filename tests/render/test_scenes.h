@@ -1,0 +1,49 @@
+#pragma once
+// Small analytic mixed-reality scenes with known answers for the renderer tests.
+#include "relight/render/mr_scene.h"
+#include "relight/render/scene_from_synth.h"
+#include "relight/synth/trajectory.h"
+
+namespace relight::render::test {
+
+inline PhongMaterial diffuse(const Eigen::Vector3f& kd, const char* name = "diffuse") {
+  PhongMaterial m;
+  m.name = name;
+  m.kd = kd;
+  return m;
+}
+
+/// A real square floor (z = 0, 4 m wide, albedo `albedo`) lit by one real point light of
+/// intensity `intensity` at `light`.
+inline MrScene floor_scene(const Eigen::Vector3f& albedo, const Eigen::Vector3f& light, float intensity) {
+  MrScene scene;
+  const std::uint32_t floor_material = scene.add_material(diffuse(albedo, "floor"));
+  TriangleMesh floor = tessellate(synth::Rect{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, 2, 2}, floor_material);
+  floor.name = "floor";
+  scene.meshes.push_back(floor);
+  MrLight point;
+  point.position = light;
+  point.intensity = Eigen::Vector3f::Constant(intensity);
+  scene.lights.push_back(point);
+  return scene;
+}
+
+/// Adds a virtual box with the given material.
+inline void add_virtual_box(MrScene& scene, const synth::Box& box, const PhongMaterial& material) {
+  TriangleMesh mesh = tessellate(box, scene.add_material(material));
+  mesh.name = "virtual box";
+  mesh.real = false;
+  scene.meshes.push_back(mesh);
+}
+
+/// A camera of `width` x `height` pixels (focal length scaled from the Kinect's) at `eye`
+/// looking at `target`.
+inline MrCamera camera_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, int width, int height) {
+  MrCamera camera;
+  const double scale = width / 640.0;
+  camera.intrinsics = {525.0 * scale, 525.0 * scale, (width - 1) / 2.0, (height - 1) / 2.0, width, height};
+  camera.camera_to_world = synth::look_at(eye, target);
+  return camera;
+}
+
+}  // namespace relight::render::test
