@@ -1,0 +1,99 @@
+#include "relight/brdf/highlight.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "relight/core/parallel.h"
+
+namespace relight::brdf {
+
+bool is_highlight(Rgb8 color, const HighlightOptions& options) {
+  const int sum = color.r + color.g + color.b;
+  if (sum == 0) return false;
+  const float intensity = static_cast<float>(sum) / (3.f * 255.f);
+  const int lowest = std::min({color.r, color.g, color.b});
+  const float saturation = 1.f - static_cast<float>(3 * lowest) / static_cast<float>(sum);
+  return intensity >= options.intensity_min && saturation <= options.saturation_max;
+}
+
+void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
+  const int w = input.width(), h = input.height();
+  output.resize(w, h);
+  if (radius <= 0) {
+    output = input;
+    return;
+  }
+  // Per row, the horizontal distance to the nearest set pixel (capped at radius + 1); a pixel is
+  // set in the output when some row dy away holds a set pixel within sqrt(r^2 - dy^2) columns.
+  const int far = radius + 1;
+  std::vector<std::uint8_t> distance(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  parallel_for_each_row(h, threads, [&](int r) {
+    std::uint8_t* d = distance.data() + static_cast<std::size_t>(r) * static_cast<std::size_t>(w);
+    int last = -far - 1;
+    for (int c = 0; c < w; ++c) {
+      if (input(r, c)) last = c;
+      d[c] = static_cast<std::uint8_t>(std::min(far, c - last));
+    }
+    last = std::numeric_limits<int>::max() / 2;
+    for (int c = w - 1; c >= 0; --c) {
+      if (input(r, c)) last = c;
+      d[c] = static_cast<std::uint8_t>(std::min<int>(d[c], std::min(far, last - c)));
+    }
+  });
+  std::vector<int> reach(static_cast<std::size_t>(radius) + 1);
+  for (int dy = 0; dy <= radius; ++dy) {
+    reach[static_cast<std::size_t>(dy)] = static_cast<int>(std::floor(std::sqrt(static_cast<double>(radius * radius - dy * dy))));
+  }
+  parallel_for_each_row(h, threads, [&](int r) {
+    for (int c = 0; c < w; ++c) {
+      std::uint8_t on = 0;
+      for (int dy = -radius; dy <= radius && !on; ++dy) {
+        const int rr = r + dy;
+        if (rr < 0 || rr >= h) continue;
+        const int d = distance[static_cast<std::size_t>(rr) * static_cast<std::size_t>(w) + static_cast<std::size_t>(c)];
+        on = d <= reach[static_cast<std::size_t>(std::abs(dy))] ? 1 : 0;
+      }
+      output(r, c) = on;
+    }
+  });
+}
+
+void remove_highlights(const ColorImage& color, const HighlightOptions& options, ColorImage& cleaned, Mask& mask) {
+  const int w = color.width(), h = color.height();
+  Mask seeds(w, h);
+  parallel_for_each_row(h, options.threads, [&](int r) {
+    for (int c = 0; c < w; ++c) seeds(r, c) = is_highlight(color(r, c), options) ? 1 : 0;
+  });
+  dilate_disk(seeds, options.dilate_radius, mask, options.threads);
+  cleaned = color;
+  parallel_for_each_row(h, options.threads, [&](int r) {
+    for (int c = 0; c < w; ++c) {
+      if (!mask(r, c)) continue;
+      for (int ring = 1; ring <= options.fill_radius_max; ++ring) {
+        int best = std::numeric_limits<int>::max();
+        Rgb8 best_color{};
+        const int r0 = std::max(0, r - ring), r1 = std::min(h - 1, r + ring);
+        for (int rr = r0; rr <= r1; ++rr) {
+          const bool edge_row = rr == r - ring || rr == r + ring;
+          const int step = edge_row ? 1 : 2 * ring;
+          for (int cc = c - ring; cc <= c + ring; cc += step) {
+            if (cc < 0 || cc >= w || mask(rr, cc)) continue;
+            const int d2 = (rr - r) * (rr - r) + (cc - c) * (cc - c);
+            if (d2 < best) {
+              best = d2;
+              best_color = color(rr, cc);
+            }
+          }
+        }
+        if (best != std::numeric_limits<int>::max()) {
+          cleaned(r, c) = best_color;
+          break;
+        }
+      }
+    }
+  });
+}
+
+}  // namespace relight::brdf

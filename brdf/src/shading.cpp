@@ -1,0 +1,83 @@
+#include "relight/brdf/shading.h"
+
+#include <array>
+#include <cmath>
+#include <numbers>
+
+namespace relight::brdf {
+
+ShadingLights to_camera_frame(const LightSet& set, const Pose& camera_to_world, const Eigen::Vector3f& ambient) {
+  const Pose world_to_camera = camera_to_world.inverse();
+  ShadingLights out;
+  out.ambient = ambient;
+  for (const Light& light : set.lights) {
+    if (!light.real) continue;
+    ShadingLight l;
+    l.point = light.kind == LightKind::Point;
+    l.vector = l.point ? (world_to_camera * light.position).cast<float>()
+                       : (world_to_camera.linear() * light.direction).normalized().cast<float>();
+    l.power = light.power.cast<float>();
+    out.lights.push_back(l);
+  }
+  return out;
+}
+
+LightAtPoint light_at(const ShadingLight& light, const Eigen::Vector3f& position) {
+  if (!light.point) return {light.vector, light.power};
+  const Eigen::Vector3f offset = light.vector - position;
+  const float distance2 = offset.squaredNorm();
+  return {offset / std::sqrt(distance2), light.power / distance2};
+}
+
+Eigen::Vector3f diffuse_shading(const ShadingLights& lights, const Eigen::Vector3f& position,
+                                const Eigen::Vector3f& normal) {
+  constexpr float inv_pi = std::numbers::inv_pi_v<float>;
+  Eigen::Vector3f sum = lights.ambient;
+  for (const ShadingLight& light : lights.lights) {
+    const LightAtPoint at = light_at(light, position);
+    const float cosine = normal.dot(at.direction);
+    if (cosine > 0.f) sum += at.irradiance * (cosine * inv_pi);
+  }
+  return sum;
+}
+
+Eigen::Vector3f phong_radiance(const ShadingLights& lights, const Eigen::Vector3f& position,
+                               const Eigen::Vector3f& normal, const Eigen::Vector3f& kd, float ks, float n) {
+  constexpr float inv_pi = std::numbers::inv_pi_v<float>;
+  const Eigen::Vector3f view = -position.normalized();
+  Eigen::Vector3f radiance = kd.cwiseProduct(lights.ambient);
+  const float lobe_scale = ks * (n + 2.f) * 0.5f * inv_pi;
+  for (const ShadingLight& light : lights.lights) {
+    const LightAtPoint at = light_at(light, position);
+    const float cosine = normal.dot(at.direction);
+    if (cosine <= 0.f) continue;
+    const Eigen::Vector3f mirror = 2.f * cosine * normal - at.direction;
+    const float lobe = std::pow(std::max(0.f, mirror.dot(view)), n);
+    radiance += (at.irradiance * cosine).cwiseProduct(kd * inv_pi + Eigen::Vector3f::Constant(lobe_scale * lobe));
+  }
+  return radiance;
+}
+
+float srgb8_to_linear(std::uint8_t value) {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (int i = 0; i < 256; ++i) {
+      const double e = i / 255.0;
+      t[static_cast<std::size_t>(i)] =
+          static_cast<float>(e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4));
+    }
+    return t;
+  }();
+  return table[value];
+}
+
+RadianceImage linearize(const ColorImage& color) {
+  RadianceImage out(color.width(), color.height());
+  for (std::size_t i = 0; i < color.size(); ++i) {
+    const Rgb8 c = color.pixels()[i];
+    out.pixels()[i] = {srgb8_to_linear(c.r), srgb8_to_linear(c.g), srgb8_to_linear(c.b)};
+  }
+  return out;
+}
+
+}  // namespace relight::brdf
