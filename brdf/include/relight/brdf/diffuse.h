@@ -1,0 +1,38 @@
+#pragma once
+// Diffuse reflectance per pixel (Knecht eq. 4.13), in linear RGB:
+//
+//   k_d(x) = L(x) / D(x),   D(x) = A + sum_l E_l(x) / pi            (shading.h)
+//
+// i.e. Knecht's k_d = I / sum_i I_i <omega_i . n>+ with the ambient term A of shading.h added
+// to the denominator (the synthetic scene's constant environment; zero for lights sampled from
+// the whole probe). L is the camera colour after highlight removal, linearised (sRGB decode);
+// exposure is taken as 1, so k_d is only as absolute as the light set's calibration.
+//
+// Shadows are NOT modelled: every light facing the surface is assumed to reach it, so a pixel in
+// a cast shadow gets a k_d that is too dark. Inter-reflections are not modelled either.
+//
+// A pixel is invalid (mask 0, k_d = 0) when it has no position or normal, when D's luminance is
+// below min_shading (too little light for a stable ratio), or when the colour's luminance is
+// below min_brightness (dark pixels are dominated by quantisation and noise).
+#include "relight/brdf/shading.h"
+#include "relight/core/image.h"
+
+namespace relight::brdf {
+
+struct DiffuseOptions {
+  float min_shading = 0.02f;     ///< radiance units (luminance of D)
+  float min_brightness = 0.004f;  ///< linear luminance of the pixel colour
+  float max_kd = 2.f;            ///< k_d channels are clamped to [0, max_kd]
+  int threads = 0;
+};
+
+/// k_d and validity for every pixel. `color` is the 8-bit sRGB camera image (highlights removed);
+/// positions and normals are camera-frame (reconstruct/), lights from to_camera_frame().
+void estimate_diffuse(const ColorImage& color, const PositionMap& positions, const NormalMap& normals,
+                      const ShadingLights& lights, const DiffuseOptions& options, RadianceImage& kd, Mask& valid);
+
+/// The same for a linear-RGB input (tests on exact radiance, renderer output).
+void estimate_diffuse(const RadianceImage& linear, const PositionMap& positions, const NormalMap& normals,
+                      const ShadingLights& lights, const DiffuseOptions& options, RadianceImage& kd, Mask& valid);
+
+}  // namespace relight::brdf
