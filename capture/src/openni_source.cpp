@@ -1,0 +1,348 @@
+#include "relight/capture/openni_source.h"
+
+#include <OpenNI.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <mutex>
+
+#include "relight/capture/depth_millimetres.h"
+#include "relight/core/error.h"
+
+namespace relight {
+
+namespace {
+
+std::string extended_error() {
+  const char* text = openni::OpenNI::getExtendedError();
+  std::string message = text == nullptr ? "" : text;
+  while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
+  return message;
+}
+
+// OpenNI::initialize/shutdown for as long as any user needs it (shutdown unloads the drivers, so
+// it must come after every device is closed: holders keep it alive).
+class OpenNiRuntime {
+ public:
+  OpenNiRuntime() {
+    if (openni::OpenNI::initialize() != openni::STATUS_OK) {
+      throw Error("OpenNI2 did not start: " + extended_error());
+    }
+  }
+  ~OpenNiRuntime() { openni::OpenNI::shutdown(); }
+  OpenNiRuntime(const OpenNiRuntime&) = delete;
+  OpenNiRuntime& operator=(const OpenNiRuntime&) = delete;
+
+  static std::shared_ptr<OpenNiRuntime> acquire() {
+    static std::mutex mutex;
+    static std::weak_ptr<OpenNiRuntime> current;
+    std::lock_guard lock(mutex);
+    auto runtime = current.lock();
+    if (!runtime) {
+      runtime = std::make_shared<OpenNiRuntime>();
+      current = runtime;
+    }
+    return runtime;
+  }
+};
+
+// Sets a flag when the device with our URI goes away (called on a driver thread).
+class DisconnectWatch final : public openni::OpenNI::DeviceDisconnectedListener {
+ public:
+  explicit DisconnectWatch(std::string uri) : uri_(std::move(uri)) { openni::OpenNI::addDeviceDisconnectedListener(this); }
+  ~DisconnectWatch() override { openni::OpenNI::removeDeviceDisconnectedListener(this); }
+  DisconnectWatch(const DisconnectWatch&) = delete;
+  DisconnectWatch& operator=(const DisconnectWatch&) = delete;
+  void onDeviceDisconnected(const openni::DeviceInfo* info) override {
+    if (info != nullptr && uri_ == info->getUri()) disconnected_ = true;
+  }
+  [[nodiscard]] bool disconnected() const { return disconnected_; }
+
+ private:
+  std::string uri_;
+  std::atomic<bool> disconnected_{false};
+};
+
+bool is_oni_file(const std::string& uri) {
+  const std::filesystem::path path(uri);
+  return path.extension() == ".oni" || path.extension() == ".ONI";
+}
+
+// openni::VideoStream, stopped and destroyed on scope exit.
+struct Stream {
+  openni::VideoStream stream;
+  Stream() = default;
+  Stream(const Stream&) = delete;
+  Stream& operator=(const Stream&) = delete;
+  ~Stream() {
+    if (stream.isValid()) {
+      stream.stop();
+      stream.destroy();
+    }
+  }
+};
+
+struct Device {
+  openni::Device device;
+  Device() = default;
+  Device(const Device&) = delete;
+  Device& operator=(const Device&) = delete;
+  ~Device() {
+    if (device.isValid()) device.close();
+  }
+};
+
+void open_device(Device& device, const std::string& uri, bool file) {
+  if (file) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(uri, ec)) throw Error(uri + ": no such .oni file");
+    if (std::filesystem::file_size(uri, ec) == 0) throw Error(uri + ": empty file, not an .oni recording");
+  }
+  const char* target = uri.empty() ? openni::ANY_DEVICE : uri.c_str();
+  if (device.device.open(target) == openni::STATUS_OK) return;
+  const std::string detail = extended_error();
+  if (file) {
+    // OpenNI2 gives no message for a cut recording (platform.md): say what it most likely is.
+    throw Error(uri + ": cannot play this .oni file (truncated or corrupt recording)" +
+                (detail.empty() ? std::string() : ": " + detail));
+  }
+  if (uri.empty()) throw Error("no OpenNI2 device found" + (detail.empty() ? std::string() : ": " + detail));
+  throw Error("cannot open OpenNI2 device " + uri + (detail.empty() ? std::string() : ": " + detail));
+}
+
+void create_stream(Stream& stream, Device& device, openni::SensorType type, const char* what, const std::string& uri) {
+  if (device.device.getSensorInfo(type) == nullptr) throw Error(uri + " has no " + what + " stream");
+  if (stream.stream.create(device.device, type) != openni::STATUS_OK) {
+    throw Error("cannot create the " + std::string(what) + " stream of " + uri + ": " + extended_error());
+  }
+}
+
+}  // namespace
+
+std::vector<OpenNiDeviceInfo> list_openni_devices() {
+  const auto runtime = OpenNiRuntime::acquire();
+  openni::Array<openni::DeviceInfo> devices;
+  openni::OpenNI::enumerateDevices(&devices);
+  std::vector<OpenNiDeviceInfo> list;
+  for (int i = 0; i < devices.getSize(); ++i) {
+    list.push_back({devices[i].getUri(), devices[i].getVendor(), devices[i].getName()});
+  }
+  return list;
+}
+
+OniRecordingSummary inspect_oni(const std::filesystem::path& file) {
+  const auto runtime = OpenNiRuntime::acquire();
+  Device device;
+  open_device(device, file.string(), true);
+  Stream depth, color;
+  OniRecordingSummary summary;
+  openni::PlaybackControl* playback = device.device.getPlaybackControl();
+  if (playback == nullptr) throw Error(file.string() + " did not open as a recording");
+  if (device.device.hasSensor(openni::SENSOR_DEPTH)) {
+    create_stream(depth, device, openni::SENSOR_DEPTH, "depth", file.string());
+    summary.depth_frames = playback->getNumberOfFrames(depth.stream);
+  }
+  if (device.device.hasSensor(openni::SENSOR_COLOR)) {
+    create_stream(color, device, openni::SENSOR_COLOR, "colour", file.string());
+    summary.color_frames = playback->getNumberOfFrames(color.stream);
+  }
+  return summary;
+}
+
+struct OpenNiSource::Impl {
+  OpenNiOptions options;
+  bool file = false;
+  std::shared_ptr<OpenNiRuntime> runtime;  // first member: destroyed last, after the device
+  Device device;
+  std::unique_ptr<DisconnectWatch> watch;
+  Stream depth, color;
+  openni::Recorder recorder;
+  std::string uri;  // the device's own URI (for a file: the path)
+  std::string name;
+  PinholeIntrinsics intrinsics;
+  std::int64_t total = 0;
+  std::int64_t delivered = 0;
+  std::int64_t dropped = 0;
+  std::uint64_t half_period_us = 16667;
+  std::uint64_t last_timestamp_us = 0;
+  int last_depth_index = -1;
+  std::optional<openni::VideoFrameRef> pending_depth, pending_color;
+
+  void open();
+  [[nodiscard]] RgbdFrame convert(const openni::VideoFrameRef& depth_frame, const openni::VideoFrameRef& color_frame);
+  void note_depth_index(int index) {
+    if (last_depth_index >= 0 && index > last_depth_index + 1) dropped += index - last_depth_index - 1;
+    last_depth_index = index;
+  }
+};
+
+void OpenNiSource::Impl::open() {
+  file = is_oni_file(options.uri);
+  runtime = OpenNiRuntime::acquire();
+  open_device(device, options.uri, file);
+  uri = device.device.getDeviceInfo().getUri();
+  name = device.device.getDeviceInfo().getName();
+  watch = std::make_unique<DisconnectWatch>(uri);
+  create_stream(depth, device, openni::SENSOR_DEPTH, "depth", uri);
+  create_stream(color, device, openni::SENSOR_COLOR, "colour", uri);
+  if (file) {
+    // Sequential reads only (seek crashes in OpenNI2 2.2); speed -1: as fast as we read, no repeat.
+    openni::PlaybackControl* playback = device.device.getPlaybackControl();
+    if (playback == nullptr) throw Error(uri + " did not open as a recording");
+    playback->setRepeatEnabled(false);
+    playback->setSpeed(-1.0f);
+    total = playback->getNumberOfFrames(depth.stream);
+  } else {
+    if (device.device.isImageRegistrationModeSupported(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR)) {
+      device.device.setImageRegistrationMode(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR);
+    }
+    device.device.setDepthColorSyncEnabled(true);  // best effort: pairing below works without it
+  }
+  const openni::VideoMode depth_mode = depth.stream.getVideoMode(), color_mode = color.stream.getVideoMode();
+  if (depth_mode.getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_1_MM) {
+    throw Error(uri + ": depth stream is not in millimetres (pixel format " +
+                std::to_string(static_cast<int>(depth_mode.getPixelFormat())) + ")");
+  }
+  if (color_mode.getPixelFormat() != openni::PIXEL_FORMAT_RGB888) {
+    throw Error(uri + ": colour stream is not RGB888 (pixel format " +
+                std::to_string(static_cast<int>(color_mode.getPixelFormat())) + ")");
+  }
+  if (depth_mode.getResolutionX() != color_mode.getResolutionX() || depth_mode.getResolutionY() != color_mode.getResolutionY()) {
+    throw Error(uri + ": depth " + std::to_string(depth_mode.getResolutionX()) + "x" +
+                std::to_string(depth_mode.getResolutionY()) + " and colour " + std::to_string(color_mode.getResolutionX()) +
+                "x" + std::to_string(color_mode.getResolutionY()) + " differ; relight needs registered images of one size");
+  }
+  if (depth_mode.getFps() > 0) half_period_us = static_cast<std::uint64_t>(500000 / depth_mode.getFps());
+  const int width = depth_mode.getResolutionX(), height = depth_mode.getResolutionY();
+  if (options.intrinsics) {
+    intrinsics = *options.intrinsics;
+  } else {
+    const double hfov = depth.stream.getHorizontalFieldOfView(), vfov = depth.stream.getVerticalFieldOfView();
+    if (!(hfov > 0.0 && vfov > 0.0)) throw Error(uri + ": the depth stream reports no field of view");
+    intrinsics = {width / (2.0 * std::tan(hfov / 2.0)), height / (2.0 * std::tan(vfov / 2.0)), (width - 1) / 2.0,
+                  (height - 1) / 2.0, width, height};
+  }
+  if (depth.stream.start() != openni::STATUS_OK) throw Error("cannot start the depth stream of " + uri + ": " + extended_error());
+  if (color.stream.start() != openni::STATUS_OK) throw Error("cannot start the colour stream of " + uri + ": " + extended_error());
+}
+
+RgbdFrame OpenNiSource::Impl::convert(const openni::VideoFrameRef& depth_frame, const openni::VideoFrameRef& color_frame) {
+  const int width = depth_frame.getWidth(), height = depth_frame.getHeight();
+  if (color_frame.getWidth() != width || color_frame.getHeight() != height) {
+    throw Error(uri + ": frame " + std::to_string(depth_frame.getFrameIndex()) + " has depth and colour of different sizes");
+  }
+  RgbdFrame frame;
+  frame.depth = DepthMap(width, height);
+  frame.color = ColorImage(width, height);
+  const auto* depth_bytes = static_cast<const std::uint8_t*>(depth_frame.getData());
+  const auto* color_bytes = static_cast<const std::uint8_t*>(color_frame.getData());
+  for (int row = 0; row < height; ++row) {
+    const std::uint8_t* depth_row = depth_bytes + static_cast<std::size_t>(row) * depth_frame.getStrideInBytes();
+    const std::uint8_t* color_row = color_bytes + static_cast<std::size_t>(row) * color_frame.getStrideInBytes();
+    for (int col = 0; col < width; ++col) {
+      std::uint16_t mm = 0;
+      std::memcpy(&mm, depth_row + 2 * col, sizeof(mm));
+      frame.depth(row, col) = millimetres_to_depth(mm);
+      frame.color(row, col) = {color_row[3 * col], color_row[3 * col + 1], color_row[3 * col + 2]};
+    }
+  }
+  frame.info.index = delivered++;
+  frame.info.timestamp = static_cast<double>(depth_frame.getTimestamp()) * 1e-6;
+  frame.info.intrinsics = intrinsics;
+  last_timestamp_us = depth_frame.getTimestamp();
+  return frame;
+}
+
+OpenNiSource::OpenNiSource(OpenNiOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = std::move(options);
+  impl_->open();
+}
+
+OpenNiSource::~OpenNiSource() {
+  if (impl_->recorder.isValid()) stop_recording();
+}
+
+std::optional<RgbdFrame> OpenNiSource::next() {
+  Impl& s = *impl_;
+  openni::VideoStream* streams[] = {&s.depth.stream, &s.color.stream};
+  const auto timeout = static_cast<int>(s.options.timeout.count());
+  while (true) {
+    if (s.pending_depth && s.pending_color) {
+      const std::uint64_t td = s.pending_depth->getTimestamp(), tc = s.pending_color->getTimestamp();
+      const std::uint64_t gap = td > tc ? td - tc : tc - td;
+      if (gap <= s.half_period_us) {
+        RgbdFrame frame = s.convert(*s.pending_depth, *s.pending_color);
+        s.pending_depth.reset();
+        s.pending_color.reset();
+        return frame;
+      }
+      (td < tc ? s.pending_depth : s.pending_color).reset();  // the older one has no partner
+      ++s.dropped;
+    }
+    // After a disconnect only frames already queued remain: wait briefly for them.
+    const int wait_ms = s.watch->disconnected() ? 100 : timeout;
+    int ready = -1;
+    const openni::Status status = openni::OpenNI::waitForAnyStream(streams, 2, &ready, wait_ms);
+    if (status == openni::STATUS_TIME_OUT) {
+      if (s.file) return std::nullopt;  // the end of a recording shows only as a timeout
+      if (s.watch->disconnected()) {
+        throw Error("OpenNI2 device " + s.uri + " disconnected after " + std::to_string(s.delivered) + " frames");
+      }
+      throw Error("OpenNI2 device " + s.uri + " sent no frame for " + std::to_string(timeout) + " ms (after " +
+                  std::to_string(s.delivered) + " frames)");
+    }
+    if (status != openni::STATUS_OK || ready < 0 || ready > 1) {
+      throw Error("waiting for frames from " + s.uri + " failed: " + extended_error());
+    }
+    openni::VideoFrameRef frame;
+    if (streams[ready]->readFrame(&frame) != openni::STATUS_OK || !frame.isValid()) {
+      throw Error("reading a frame from " + s.uri + " failed: " + extended_error());
+    }
+    if (ready == 0) {
+      if (s.pending_depth) ++s.dropped;  // replaced before its colour came
+      s.note_depth_index(frame.getFrameIndex());
+      s.pending_depth = frame;
+    } else {
+      s.pending_color = frame;
+    }
+  }
+}
+
+std::int64_t OpenNiSource::size_hint() const { return impl_->total; }
+
+std::string OpenNiSource::describe() const {
+  const auto& k = impl_->intrinsics;
+  std::string text = impl_->file ? "OpenNI2 recording " + impl_->uri + " (" + std::to_string(impl_->total) + " frames"
+                                 : "OpenNI2 device " + impl_->uri + " (" + impl_->name;
+  return text + ", " + std::to_string(k.width) + "x" + std::to_string(k.height) + ")";
+}
+
+bool OpenNiSource::is_file() const { return impl_->file; }
+const std::string& OpenNiSource::uri() const { return impl_->uri; }
+std::int64_t OpenNiSource::dropped() const { return impl_->dropped; }
+std::uint64_t OpenNiSource::last_timestamp_us() const { return impl_->last_timestamp_us; }
+
+void OpenNiSource::start_recording(const std::filesystem::path& file) {
+  Impl& s = *impl_;
+  if (s.recorder.isValid()) throw LogicError("start_recording: already recording");
+  // The streams are started already: Recorder::attach fails on a stream that is not.
+  if (s.recorder.create(file.c_str()) != openni::STATUS_OK) {
+    throw Error("cannot create recording " + file.string() + ": " + extended_error());
+  }
+  if (s.recorder.attach(s.depth.stream, false) != openni::STATUS_OK ||
+      s.recorder.attach(s.color.stream, false) != openni::STATUS_OK || s.recorder.start() != openni::STATUS_OK) {
+    const std::string detail = extended_error();
+    s.recorder.destroy();
+    throw Error("cannot record to " + file.string() + ": " + detail);
+  }
+}
+
+void OpenNiSource::stop_recording() {
+  Impl& s = *impl_;
+  if (!s.recorder.isValid()) return;
+  s.recorder.stop();
+  s.recorder.destroy();  // closes the file
+}
+
+}  // namespace relight
