@@ -1,0 +1,122 @@
+#pragma once
+// K-means (Lloyd) on per-pixel diffuse reflectance (Knecht §4.4.3), CPU reference and the
+// policy that runs it every frame.
+//
+// One Lloyd iteration assigns every point to its nearest centre (squared Euclidean distance in
+// float, evaluated as ((dx*dx + dy*dy) + dz*dz) without contraction; ties go to the lower index)
+// and accumulates, per cluster, the colour sum, the count and the sum of squared distances. The
+// sums are fixed-point integers (brdf_shared.h), so they are exact and do not depend on the order
+// of addition: the multi-threaded CPU loop and the Vulkan dispatch (kmeans_vk.h) produce
+// identical sums, centres and assignments from the same initial centres.
+//
+// A run iterates at most max_iterations times and stops when the total variance (the sum of
+// squared distances, "compactness") changes by less than epsilon relative to the previous
+// iteration. Centres are updated to the cluster means after each assignment; an empty cluster
+// keeps its centre. The result's labels are the last assignment and its compactness the sum of
+// squared distances of that assignment.
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "relight/core/pixel.h"
+
+namespace relight::brdf {
+
+struct KMeansOptions {
+  int clusters = 6;          ///< K, 1..16
+  int max_iterations = 20;
+  double epsilon = 1e-4;     ///< relative change of the total variance that counts as converged
+  int threads = 0;           ///< CPU threads (0 = worker_count(0))
+};
+
+struct KMeansResult {
+  std::vector<Eigen::Vector3f> centres;
+  std::vector<std::uint8_t> labels;  ///< per point, cluster index
+  double compactness = 0.0;          ///< sum of squared distances of the last assignment
+  int iterations = 0;
+  bool converged = false;
+};
+
+/// Exact per-cluster sums of one assignment step (fixed point, see brdf_shared.h).
+struct ClusterSums {
+  struct Cluster {
+    std::uint64_t sum[3] = {0, 0, 0};
+    std::uint64_t count = 0;
+    std::uint64_t distance = 0;
+  };
+  std::vector<Cluster> clusters;
+  [[nodiscard]] double total_variance() const;
+  /// Means of non-empty clusters; empty clusters keep `centres[k]`.
+  void update(std::vector<Eigen::Vector3f>& centres) const;
+};
+
+/// A feature clamped to the K-means range [0, RELIGHT_KMEANS_FEATURE_MAX].
+[[nodiscard]] Float3 kmeans_feature(const Float3& value);
+
+/// One Lloyd implementation: step() assigns and sums; the loop around it is shared (lloyd()).
+class KMeansEngine {
+ public:
+  virtual ~KMeansEngine() = default;
+  /// Makes `points` (already clamped features) the data of the following step() calls.
+  virtual void set_points(std::span<const Float3> points) = 0;
+  /// One assignment + reduction with `centres`; writes the labels when `labels` is non-null.
+  virtual ClusterSums step(std::span<const Eigen::Vector3f> centres, std::vector<std::uint8_t>* labels) = 0;
+};
+
+/// The CPU engine: points split into chunks over threads, integer sums per chunk added up.
+class KMeansCpu final : public KMeansEngine {
+ public:
+  explicit KMeansCpu(int threads = 0) : threads_(threads) {}
+  void set_points(std::span<const Float3> points) override;
+  ClusterSums step(std::span<const Eigen::Vector3f> centres, std::vector<std::uint8_t>* labels) override;
+
+ private:
+  int threads_;
+  std::vector<Float3> points_;
+};
+
+/// Lloyd iterations from `initial` centres on the engine's points.
+[[nodiscard]] KMeansResult lloyd(KMeansEngine& engine, std::vector<Eigen::Vector3f> initial,
+                                 const KMeansOptions& options);
+
+/// k-means++ seeding (Arthur & Vassilvitskii): first centre uniform, then D^2 sampling.
+[[nodiscard]] std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> points, int clusters,
+                                                             std::mt19937_64& rng);
+
+/// `attempts` runs from k-means++ seeds, the lowest compactness kept (cv::kmeans' setting).
+[[nodiscard]] KMeansResult kmeans(KMeansEngine& engine, std::span<const Float3> points, const KMeansOptions& options,
+                                  int attempts, std::mt19937_64& rng);
+
+/// The per-frame policy of the issue: a warm start from the previous frame's centres; when that
+/// does not converge, and on every `random_every`-th frame regardless, also a run from k-means++
+/// seeds, keeping the lower compactness. The first frame (or after reset) runs from seeds only.
+class KMeansTracker {
+ public:
+  explicit KMeansTracker(KMeansOptions options = {}, std::uint64_t seed = 1, int random_every = 5)
+      : options_(options), rng_(seed), random_every_(random_every) {}
+  /// Clusters this frame's points (clamped features).
+  [[nodiscard]] KMeansResult run(KMeansEngine& engine, std::span<const Float3> points);
+  void reset() { previous_.reset(); frame_ = 0; }
+  [[nodiscard]] const KMeansOptions& options() const { return options_; }
+  /// What the last run() did, for tests and reports.
+  [[nodiscard]] bool last_used_warm_start() const { return last_warm_; }
+  [[nodiscard]] bool last_ran_random() const { return last_random_; }
+
+ private:
+  KMeansOptions options_;
+  std::mt19937_64 rng_;
+  int random_every_;
+  std::int64_t frame_ = 0;
+  std::optional<std::vector<Eigen::Vector3f>> previous_;
+  bool last_warm_ = false;
+  bool last_random_ = false;
+};
+
+/// Adjusted Rand index (Hubert & Arabie) of two labelings of the same points.
+[[nodiscard]] double adjusted_rand_index(std::span<const int> a, std::span<const int> b);
+
+}  // namespace relight::brdf

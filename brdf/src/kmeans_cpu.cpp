@@ -1,0 +1,228 @@
+// K-means CPU engine, the shared Lloyd loop, seeding and the per-frame policy (kmeans.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "relight/brdf/brdf_shared.h"
+#include "relight/brdf/kmeans.h"
+#include "relight/core/error.h"
+#include "relight/core/parallel.h"
+
+namespace relight::brdf {
+
+namespace {
+
+constexpr float kFeatureMax = static_cast<float>(RELIGHT_KMEANS_FEATURE_MAX);
+constexpr float kValueScale = static_cast<float>(RELIGHT_KMEANS_VALUE_SCALE);
+constexpr float kDistanceScale = static_cast<float>(RELIGHT_KMEANS_DISTANCE_SCALE);
+constexpr std::size_t kChunk = 8192;
+
+void check_clusters(std::size_t clusters) {
+  if (clusters < 1 || clusters > RELIGHT_KMEANS_MAX_CLUSTERS) {
+    throw Error("brdf K-means: the number of clusters must be 1.." + std::to_string(RELIGHT_KMEANS_MAX_CLUSTERS));
+  }
+}
+
+// The same float expressions as brdf_kmeans.comp (no contraction: this file is built with
+// -ffp-contract=off).
+inline std::uint32_t quantise(float value, float scale) { return static_cast<std::uint32_t>(value * scale + 0.5f); }
+
+}  // namespace
+
+Float3 kmeans_feature(const Float3& v) {
+  auto clamp = [](float x) { return std::isfinite(x) ? std::clamp(x, 0.f, kFeatureMax) : 0.f; };
+  return {clamp(v.x), clamp(v.y), clamp(v.z)};
+}
+
+double ClusterSums::total_variance() const {
+  std::uint64_t total = 0;
+  for (const Cluster& c : clusters) total += c.distance;
+  return static_cast<double>(total) / RELIGHT_KMEANS_DISTANCE_SCALE;
+}
+
+void ClusterSums::update(std::vector<Eigen::Vector3f>& centres) const {
+  for (std::size_t k = 0; k < clusters.size() && k < centres.size(); ++k) {
+    const Cluster& c = clusters[k];
+    if (c.count == 0) continue;
+    const double scale = 1.0 / (RELIGHT_KMEANS_VALUE_SCALE * static_cast<double>(c.count));
+    centres[k] = Eigen::Vector3f(static_cast<float>(static_cast<double>(c.sum[0]) * scale),
+                                 static_cast<float>(static_cast<double>(c.sum[1]) * scale),
+                                 static_cast<float>(static_cast<double>(c.sum[2]) * scale));
+  }
+}
+
+void KMeansCpu::set_points(std::span<const Float3> points) { points_.assign(points.begin(), points.end()); }
+
+ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres, std::vector<std::uint8_t>* labels) {
+  const std::size_t k_count = centres.size();
+  check_clusters(k_count);
+  const std::size_t n = points_.size();
+  if (labels) labels->resize(n);
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<ClusterSums::Cluster> partial(chunks * k_count);
+  float cx[RELIGHT_KMEANS_MAX_CLUSTERS], cy[RELIGHT_KMEANS_MAX_CLUSTERS], cz[RELIGHT_KMEANS_MAX_CLUSTERS];
+  for (std::size_t k = 0; k < k_count; ++k) {
+    cx[k] = centres[k].x();
+    cy[k] = centres[k].y();
+    cz[k] = centres[k].z();
+  }
+  parallel_rows(
+      static_cast<int>(chunks), threads_,
+      [&](int begin, int end) {
+        for (int chunk = begin; chunk < end; ++chunk) {
+          ClusterSums::Cluster* sums = partial.data() + static_cast<std::size_t>(chunk) * k_count;
+          const std::size_t first = static_cast<std::size_t>(chunk) * kChunk;
+          const std::size_t last = std::min(n, first + kChunk);
+          for (std::size_t i = first; i < last; ++i) {
+            const Float3 p = points_[i];
+            float best = std::numeric_limits<float>::infinity();
+            std::size_t label = 0;
+            for (std::size_t k = 0; k < k_count; ++k) {
+              const float dx = p.x - cx[k], dy = p.y - cy[k], dz = p.z - cz[k];
+              const float d = (dx * dx + dy * dy) + dz * dz;
+              if (d < best) {
+                best = d;
+                label = k;
+              }
+            }
+            if (labels) (*labels)[i] = static_cast<std::uint8_t>(label);
+            ClusterSums::Cluster& s = sums[label];
+            s.sum[0] += quantise(p.x, kValueScale);
+            s.sum[1] += quantise(p.y, kValueScale);
+            s.sum[2] += quantise(p.z, kValueScale);
+            s.count += 1;
+            s.distance += quantise(best, kDistanceScale);
+          }
+        }
+      },
+      1);
+  ClusterSums total;
+  total.clusters.resize(k_count);
+  for (std::size_t chunk = 0; chunk < chunks; ++chunk) {
+    for (std::size_t k = 0; k < k_count; ++k) {
+      const ClusterSums::Cluster& s = partial[chunk * k_count + k];
+      ClusterSums::Cluster& t = total.clusters[k];
+      for (int c = 0; c < 3; ++c) t.sum[c] += s.sum[c];
+      t.count += s.count;
+      t.distance += s.distance;
+    }
+  }
+  return total;
+}
+
+KMeansResult lloyd(KMeansEngine& engine, std::vector<Eigen::Vector3f> initial, const KMeansOptions& options) {
+  check_clusters(initial.size());
+  KMeansResult result;
+  result.centres = std::move(initial);
+  double previous = std::numeric_limits<double>::infinity();
+  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
+    // Labels are only needed from the final step; the step that converges is not known in
+    // advance, so every step writes them (cheap next to the distances).
+    const ClusterSums sums = engine.step(result.centres, &result.labels);
+    const double variance = sums.total_variance();
+    sums.update(result.centres);
+    result.compactness = variance;
+    result.iterations = iteration + 1;
+    if (std::isfinite(previous) && std::abs(previous - variance) <= options.epsilon * previous) {
+      result.converged = true;
+      break;
+    }
+    previous = variance;
+  }
+  return result;
+}
+
+std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> points, int clusters, std::mt19937_64& rng) {
+  check_clusters(static_cast<std::size_t>(clusters));
+  if (points.empty()) throw Error("brdf K-means: no points to seed from");
+  std::vector<Eigen::Vector3f> centres;
+  std::uniform_int_distribution<std::size_t> pick(0, points.size() - 1);
+  const Float3 first = points[pick(rng)];
+  centres.emplace_back(first.x, first.y, first.z);
+  std::vector<double> d2(points.size(), std::numeric_limits<double>::infinity());
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  while (static_cast<int>(centres.size()) < clusters) {
+    const Eigen::Vector3f& c = centres.back();
+    double total = 0.0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const double dx = points[i].x - c.x(), dy = points[i].y - c.y(), dz = points[i].z - c.z();
+      d2[i] = std::min(d2[i], dx * dx + dy * dy + dz * dz);
+      total += d2[i];
+    }
+    std::size_t chosen = pick(rng);
+    if (total > 0.0) {
+      double target = unit(rng) * total;
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        target -= d2[i];
+        if (target <= 0.0) {
+          chosen = i;
+          break;
+        }
+      }
+    }
+    centres.emplace_back(points[chosen].x, points[chosen].y, points[chosen].z);
+  }
+  return centres;
+}
+
+KMeansResult kmeans(KMeansEngine& engine, std::span<const Float3> points, const KMeansOptions& options, int attempts,
+                    std::mt19937_64& rng) {
+  engine.set_points(points);
+  KMeansResult best;
+  for (int attempt = 0; attempt < std::max(1, attempts); ++attempt) {
+    KMeansResult r = lloyd(engine, kmeans_pp_centres(points, options.clusters, rng), options);
+    if (attempt == 0 || r.compactness < best.compactness) best = std::move(r);
+  }
+  return best;
+}
+
+KMeansResult KMeansTracker::run(KMeansEngine& engine, std::span<const Float3> points) {
+  last_warm_ = last_random_ = false;
+  KMeansResult best;
+  if (points.empty()) {
+    best.centres.assign(static_cast<std::size_t>(options_.clusters), Eigen::Vector3f::Zero());
+    best.converged = true;
+    ++frame_;
+    return best;
+  }
+  engine.set_points(points);
+  bool have = false;
+  if (previous_ && static_cast<int>(previous_->size()) == options_.clusters) {
+    best = lloyd(engine, *previous_, options_);
+    have = true;
+    last_warm_ = true;
+  }
+  if (!have || !best.converged || (random_every_ > 0 && frame_ % random_every_ == 0)) {
+    KMeansResult fresh = lloyd(engine, kmeans_pp_centres(points, options_.clusters, rng_), options_);
+    last_random_ = true;
+    if (!have || fresh.compactness < best.compactness) best = std::move(fresh);
+  }
+  previous_ = best.centres;
+  ++frame_;
+  return best;
+}
+
+double adjusted_rand_index(std::span<const int> a, std::span<const int> b) {
+  if (a.size() != b.size()) throw Error("adjusted_rand_index: labelings of different length");
+  std::map<std::pair<int, int>, std::int64_t> table;
+  std::map<int, std::int64_t> rows, cols;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ++table[{a[i], b[i]}];
+    ++rows[a[i]];
+    ++cols[b[i]];
+  }
+  auto pairs = [](std::int64_t n) { return static_cast<double>(n) * static_cast<double>(n - 1) / 2.0; };
+  double index = 0.0, sum_rows = 0.0, sum_cols = 0.0;
+  for (const auto& [key, n] : table) index += pairs(n);
+  for (const auto& [key, n] : rows) sum_rows += pairs(n);
+  for (const auto& [key, n] : cols) sum_cols += pairs(n);
+  const double total = pairs(static_cast<std::int64_t>(a.size()));
+  if (total == 0.0) return 1.0;
+  const double expected = sum_rows * sum_cols / total;
+  const double maximum = 0.5 * (sum_rows + sum_cols);
+  if (maximum == expected) return 1.0;
+  return (index - expected) / (maximum - expected);
+}
+
+}  // namespace relight::brdf
