@@ -54,11 +54,11 @@ void ClusterSums::update(std::vector<Eigen::Vector3f>& centres) const {
 
 void KMeansCpu::set_points(std::span<const Float3> points) { points_.assign(points.begin(), points.end()); }
 
-ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres, std::vector<std::uint8_t>* labels) {
+ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres) {
   const std::size_t k_count = centres.size();
   check_clusters(k_count);
   const std::size_t n = points_.size();
-  if (labels) labels->resize(n);
+  labels_.resize(n);
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<ClusterSums::Cluster> partial(chunks * k_count);
   float cx[RELIGHT_KMEANS_MAX_CLUSTERS], cy[RELIGHT_KMEANS_MAX_CLUSTERS], cz[RELIGHT_KMEANS_MAX_CLUSTERS];
@@ -86,7 +86,7 @@ ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres, std::vecto
                 label = k;
               }
             }
-            if (labels) (*labels)[i] = static_cast<std::uint8_t>(label);
+            labels_[i] = static_cast<std::uint8_t>(label);
             ClusterSums::Cluster& s = sums[label];
             s.sum[0] += quantise(p.x, kValueScale);
             s.sum[1] += quantise(p.y, kValueScale);
@@ -117,9 +117,7 @@ KMeansResult lloyd(KMeansEngine& engine, std::vector<Eigen::Vector3f> initial, c
   result.centres = std::move(initial);
   double previous = std::numeric_limits<double>::infinity();
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    // Labels are only needed from the final step; the step that converges is not known in
-    // advance, so every step writes them (cheap next to the distances).
-    const ClusterSums sums = engine.step(result.centres, &result.labels);
+    const ClusterSums sums = engine.step(result.centres);
     const double variance = sums.total_variance();
     sums.update(result.centres);
     result.compactness = variance;
@@ -130,6 +128,7 @@ KMeansResult lloyd(KMeansEngine& engine, std::vector<Eigen::Vector3f> initial, c
     }
     previous = variance;
   }
+  engine.read_labels(result.labels);
   return result;
 }
 

@@ -63,8 +63,10 @@ class KMeansEngine {
   virtual ~KMeansEngine() = default;
   /// Makes `points` (already clamped features) the data of the following step() calls.
   virtual void set_points(std::span<const Float3> points) = 0;
-  /// One assignment + reduction with `centres`; writes the labels when `labels` is non-null.
-  virtual ClusterSums step(std::span<const Eigen::Vector3f> centres, std::vector<std::uint8_t>* labels) = 0;
+  /// One assignment + reduction with `centres`.
+  virtual ClusterSums step(std::span<const Eigen::Vector3f> centres) = 0;
+  /// The assignment of the last step(), one cluster index per point.
+  virtual void read_labels(std::vector<std::uint8_t>& labels) = 0;
 };
 
 /// The CPU engine: points split into chunks over threads, integer sums per chunk added up.
@@ -72,11 +74,13 @@ class KMeansCpu final : public KMeansEngine {
  public:
   explicit KMeansCpu(int threads = 0) : threads_(threads) {}
   void set_points(std::span<const Float3> points) override;
-  ClusterSums step(std::span<const Eigen::Vector3f> centres, std::vector<std::uint8_t>* labels) override;
+  ClusterSums step(std::span<const Eigen::Vector3f> centres) override;
+  void read_labels(std::vector<std::uint8_t>& labels) override { labels = labels_; }
 
  private:
   int threads_;
   std::vector<Float3> points_;
+  std::vector<std::uint8_t> labels_;
 };
 
 /// Lloyd iterations from `initial` centres on the engine's points.
