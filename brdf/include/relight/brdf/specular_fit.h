@@ -1,0 +1,93 @@
+#pragma once
+// Specular fit per cluster (Knecht §4.4.4, eq. 4.15). With k_d fixed to the cluster's centre,
+// find the scalar k_s (white highlights) and the Phong exponent n, letting the strongest lights
+// move within a small box (they come from importance sampling and need not be exact), that
+// minimise over the cluster's pixel samples i
+//
+//   F = sum_i sum_c ( L_i,c - model_c(x_i; k_d, k_s, n, lights) )^2
+//
+// with the model of shading.h (both the diffuse and the specular term subtracted). Two solvers
+// behind one interface:
+//   - Nelder-Mead (own implementation): parameters (k_s, log n, light offsets), kept inside the
+//     bounds by projecting every vertex onto the box, restarted from the best vertex with a fresh
+//     simplex until a restart no longer improves F;
+//   - Ceres: one ceres::AutoDiffCostFunction per sample (3 residuals; blocks (k_s, n) and one
+//     3-vector offset per moving light), parameter bounds on every block, Levenberg-Marquardt.
+// Ceres stays out of this header (compile time, shared/design/platform.md).
+//
+// When the fit's RMS residual stays above `max_rms`, or k_s comes out below `min_ks`, the cluster
+// is declared diffuse (k_s = 0).
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "relight/brdf/shading.h"
+#include "relight/core/image.h"
+
+namespace relight::brdf {
+
+struct SpecularSample {
+  Eigen::Vector3f radiance;  ///< linear RGB as observed (not highlight-cleaned), unclipped
+  Eigen::Vector3f position;  ///< camera frame, metres
+  Eigen::Vector3f normal;    ///< camera frame, unit
+};
+
+struct SpecularProblem {
+  Eigen::Vector3f kd = Eigen::Vector3f::Zero();
+  std::vector<SpecularSample> samples;
+  ShadingLights lights;
+};
+
+struct SpecularOptions {
+  float ks_max = 1.f;
+  float n_min = 1.f;
+  float n_max = 1000.f;
+  float ks_start = 0.3f;
+  float n_start = 20.f;
+  /// How many of the strongest lights may move (at most 2); 0 keeps every light fixed.
+  int moving_lights = 2;
+  float point_offset_max = 0.05f;      ///< metres, per axis, for point lights
+  float direction_offset_max = 0.05f;  ///< per component of a directional light's unit vector
+  float max_rms = 0.05f;               ///< radiance units; above it the cluster is diffuse
+  float min_ks = 1e-3f;
+  int max_evaluations = 4000;          ///< Nelder-Mead objective evaluations in all
+  int max_iterations = 100;            ///< Ceres iterations
+};
+
+struct SpecularFit {
+  float ks = 0.f;
+  float n = 1.f;
+  bool specular = false;                     ///< false: declared diffuse (ks set to 0)
+  double rms = 0.0;                          ///< RMS residual per channel at the optimum
+  double objective = 0.0;                    ///< F at the optimum (before the diffuse decision)
+  std::vector<Eigen::Vector3f> light_offsets;  ///< per moving light, in the problem's light order
+  int evaluations = 0;                       ///< objective evaluations (NM) or iterations (Ceres)
+};
+
+class SpecularSolver {
+ public:
+  virtual ~SpecularSolver() = default;
+  [[nodiscard]] virtual std::string name() const = 0;
+  [[nodiscard]] virtual SpecularFit fit(const SpecularProblem& problem, const SpecularOptions& options) const = 0;
+};
+
+[[nodiscard]] std::unique_ptr<SpecularSolver> make_nelder_mead_solver();
+[[nodiscard]] std::unique_ptr<SpecularSolver> make_ceres_solver();
+
+/// F for given parameters (offsets: one per moving light, may be empty), for tests.
+[[nodiscard]] double specular_objective(const SpecularProblem& problem, const SpecularOptions& options, float ks,
+                                        float n, const std::vector<Eigen::Vector3f>& offsets = {});
+
+/// Indices of the lights that move, strongest (luminance of power) first.
+[[nodiscard]] std::vector<int> moving_light_indices(const ShadingLights& lights, int moving);
+
+/// Picks at most `max_samples` pixels of `cluster` (ids hold cluster + 1): every pixel of
+/// `highlights` first (up to half the budget), the rest on an even stride through the cluster's
+/// pixels in row-major order (stratified over the image). Pixels whose 8-bit colour is clipped
+/// (a channel >= 254) or that lack position/normal are skipped: they do not show the model's value.
+[[nodiscard]] std::vector<SpecularSample> select_samples(const ColorImage& color, const PositionMap& positions,
+                                                         const NormalMap& normals, const LabelImage& ids, int cluster,
+                                                         const Mask* highlights, int max_samples = 2048);
+
+}  // namespace relight::brdf
