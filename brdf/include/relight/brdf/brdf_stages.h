@@ -1,0 +1,183 @@
+#pragma once
+// Frame-graph stages of BRDF estimation (Knecht §4.4). Buffers (names configurable):
+//
+//   highlight_removal  reads ColorImage "color"
+//                      writes ColorImage "color_diffuse" (highlights painted over), Mask "highlight_mask"
+//   diffuse            reads "color_diffuse", PositionMap "positions", NormalMap "normals",
+//                      LightSet "lights", FrameInfo "frame" (camera_to_world; identity when unknown)
+//                      writes RadianceImage "kd", Mask "kd_valid"
+//   kmeans (CPU|Vulkan) reads "kd", "kd_valid"; writes Materials "clusters" (centres as k_d,
+//                      k_s = 0, ids = cluster + 1 on valid pixels); warm-started from its own
+//                      previous result (KMeansTracker)
+//   specular_fit       reads "clusters", "color", "highlight_mask", "positions", "normals",
+//                      "lights", "frame"; writes Materials "materials" (k_s, n per cluster)
+//
+// add_brdf_stages() adds all four.
+#include <memory>
+#include <string>
+
+#include "relight/brdf/diffuse.h"
+#include "relight/brdf/highlight.h"
+#include "relight/brdf/kmeans.h"
+#include "relight/brdf/materials.h"
+#include "relight/brdf/specular_fit.h"
+#include "relight/core/frame_graph.h"
+#include "relight/core/rgbd_frame.h"
+#include "relight/lights/light_set.h"
+
+namespace relight {
+namespace vk {
+class VulkanContext;
+}  // namespace vk
+
+namespace brdf {
+
+struct BrdfBuffers {
+  std::string color = "color";
+  std::string positions = "positions";
+  std::string normals = "normals";
+  std::string lights = "lights";
+  std::string frame = "frame";
+  std::string color_diffuse = "color_diffuse";
+  std::string highlight_mask = "highlight_mask";
+  std::string kd = "kd";
+  std::string kd_valid = "kd_valid";
+  std::string clusters = "clusters";
+  std::string materials = "materials";
+};
+
+enum class SpecularMethod { NelderMead, Ceres };
+[[nodiscard]] const char* to_string(SpecularMethod method);
+
+struct BrdfOptions {
+  HighlightOptions highlight;
+  DiffuseOptions diffuse;
+  KMeansOptions kmeans;
+  SpecularOptions specular;
+  SpecularMethod solver = SpecularMethod::NelderMead;
+  int max_samples = 2048;               ///< per cluster
+  Eigen::Vector3f ambient = Eigen::Vector3f::Zero();  ///< shading.h's A
+  std::uint64_t seed = 1;               ///< K-means seeding
+  int threads = 0;                      ///< clusters fitted in parallel
+};
+
+class HighlightRemovalStage final : public Stage {
+ public:
+  explicit HighlightRemovalStage(HighlightOptions options = {}, BrdfBuffers buffers = {})
+      : options_(options), buffers_(std::move(buffers)) {}
+  [[nodiscard]] std::string name() const override { return "highlight_removal"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  HighlightOptions options_;
+  BrdfBuffers buffers_;
+  Read<ColorImage> color_;
+  Write<ColorImage> cleaned_;
+  Write<Mask> mask_;
+};
+
+class DiffuseStage final : public Stage {
+ public:
+  explicit DiffuseStage(DiffuseOptions options = {}, Eigen::Vector3f ambient = Eigen::Vector3f::Zero(),
+                        BrdfBuffers buffers = {})
+      : options_(options), ambient_(ambient), buffers_(std::move(buffers)) {}
+  [[nodiscard]] std::string name() const override { return "diffuse"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  DiffuseOptions options_;
+  Eigen::Vector3f ambient_;
+  BrdfBuffers buffers_;
+  Read<ColorImage> color_;
+  Read<PositionMap> positions_;
+  Read<NormalMap> normals_;
+  Read<LightSet> lights_;
+  Read<FrameInfo> frame_;
+  Write<RadianceImage> kd_;
+  Write<Mask> valid_;
+};
+
+/// K-means on the CPU engine, or on the Vulkan engine when constructed with a context.
+class KMeansStage final : public Stage {
+ public:
+  explicit KMeansStage(KMeansOptions options = {}, std::uint64_t seed = 1, BrdfBuffers buffers = {});
+  KMeansStage(vk::VulkanContext& context, KMeansOptions options = {}, std::uint64_t seed = 1, BrdfBuffers buffers = {});
+  ~KMeansStage() override;
+  [[nodiscard]] std::string name() const override { return "kmeans"; }
+  [[nodiscard]] Backend backend() const override { return backend_; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+  [[nodiscard]] const KMeansResult& last_result() const { return result_; }
+
+ private:
+  Backend backend_;
+  std::unique_ptr<KMeansEngine> engine_;
+  KMeansTracker tracker_;
+  BrdfBuffers buffers_;
+  Read<RadianceImage> kd_;
+  Read<Mask> valid_;
+  Write<Materials> clusters_;
+  std::vector<Float3> points_;
+  std::vector<std::uint32_t> pixels_;
+  KMeansResult result_;
+};
+
+class SpecularFitStage final : public Stage {
+ public:
+  explicit SpecularFitStage(BrdfOptions options = {}, BrdfBuffers buffers = {});
+  [[nodiscard]] std::string name() const override { return "specular_fit"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  BrdfOptions options_;
+  BrdfBuffers buffers_;
+  std::unique_ptr<SpecularSolver> solver_;
+  Read<Materials> clusters_;
+  Read<ColorImage> color_;
+  Read<Mask> highlights_;
+  Read<PositionMap> positions_;
+  Read<NormalMap> normals_;
+  Read<LightSet> lights_;
+  Read<FrameInfo> frame_;
+  Write<Materials> materials_;
+};
+
+/// The four stages; K-means on Vulkan when `kmeans_backend` is Vulkan (needs `context`).
+void add_brdf_stages(FrameGraph& graph, const BrdfOptions& options = {}, Backend kmeans_backend = Backend::Cpu,
+                     vk::VulkanContext* context = nullptr, const BrdfBuffers& buffers = {});
+
+/// Clusters and materials for one frame without a graph (benchmarks, tools): the same work as the
+/// four stages. `tracker` and `engine` carry the K-means state across frames.
+struct BrdfFrame {
+  ColorImage cleaned;
+  Mask highlights;
+  RadianceImage kd;
+  Mask kd_valid;
+  Materials materials;
+};
+void estimate_brdf(const ColorImage& color, const PositionMap& positions, const NormalMap& normals,
+                   const ShadingLights& lights, const BrdfOptions& options, KMeansEngine& engine,
+                   KMeansTracker& tracker, const SpecularSolver& solver, BrdfFrame& out);
+
+/// Fits every cluster of `materials` (ids and k_d set) in parallel; fills k_s, n, fit_rms.
+void fit_materials(const ColorImage& color, const Mask* highlights, const PositionMap& positions,
+                   const NormalMap& normals, const ShadingLights& lights, const BrdfOptions& options,
+                   const SpecularSolver& solver, Materials& materials);
+
+/// Materials from a K-means result on the pixels `pixels` (indices into a width x height image).
+[[nodiscard]] Materials materials_from_clusters(const KMeansResult& result, const std::vector<std::uint32_t>& pixels,
+                                                int width, int height);
+
+/// Gathers the K-means points (clamped k_d of valid pixels) and their pixel indices.
+void gather_points(const RadianceImage& kd, const Mask& valid, std::vector<Float3>& points,
+                   std::vector<std::uint32_t>& pixels);
+
+/// Phong re-render of the estimated materials (camera frame), black where ids is 0.
+[[nodiscard]] RadianceImage render_materials(const Materials& materials, const PositionMap& positions,
+                                             const NormalMap& normals, const ShadingLights& lights);
+
+}  // namespace brdf
+}  // namespace relight

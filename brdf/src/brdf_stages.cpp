@@ -1,0 +1,193 @@
+// Frame-graph stages of BRDF estimation (brdf_stages.h).
+#include "relight/brdf/brdf_stages.h"
+
+#include "relight/brdf/kmeans_vk.h"
+#include "relight/core/error.h"
+#include "relight/core/parallel.h"
+
+namespace relight::brdf {
+
+namespace {
+
+ShadingLights camera_lights(const LightSet& set, const FrameInfo& frame, const Eigen::Vector3f& ambient) {
+  return to_camera_frame(set, frame.camera_to_world.value_or(Pose::Identity()), ambient);
+}
+
+std::unique_ptr<SpecularSolver> make_solver(SpecularMethod method) {
+  return method == SpecularMethod::Ceres ? make_ceres_solver() : make_nelder_mead_solver();
+}
+
+}  // namespace
+
+const char* to_string(SpecularMethod method) {
+  return method == SpecularMethod::Ceres ? "ceres" : "nelder_mead";
+}
+
+void gather_points(const RadianceImage& kd, const Mask& valid, std::vector<Float3>& points,
+                   std::vector<std::uint32_t>& pixels) {
+  if (!kd.same_shape(valid)) throw Error("brdf K-means: k_d and its validity mask differ in size");
+  points.clear();
+  pixels.clear();
+  for (std::size_t i = 0; i < kd.size(); ++i) {
+    if (!valid.pixels()[i]) continue;
+    points.push_back(kmeans_feature(kd.pixels()[i]));
+    pixels.push_back(static_cast<std::uint32_t>(i));
+  }
+}
+
+Materials materials_from_clusters(const KMeansResult& result, const std::vector<std::uint32_t>& pixels, int width,
+                                  int height) {
+  Materials m;
+  m.ids = LabelImage(width, height);
+  m.clusters.resize(result.centres.size());
+  for (std::size_t k = 0; k < result.centres.size(); ++k) m.clusters[k].kd = result.centres[k];
+  for (std::size_t i = 0; i < pixels.size() && i < result.labels.size(); ++i) {
+    m.ids.pixels()[pixels[i]] = static_cast<std::uint16_t>(result.labels[i] + 1);
+    ++m.clusters[result.labels[i]].pixels;
+  }
+  return m;
+}
+
+void fit_materials(const ColorImage& color, const Mask* highlights, const PositionMap& positions,
+                   const NormalMap& normals, const ShadingLights& lights, const BrdfOptions& options,
+                   const SpecularSolver& solver, Materials& materials) {
+  const int clusters = static_cast<int>(materials.clusters.size());
+  parallel_rows(
+      clusters, options.threads,
+      [&](int begin, int end) {
+        for (int k = begin; k < end; ++k) {
+          MaterialParams& m = materials.clusters[static_cast<std::size_t>(k)];
+          SpecularProblem problem;
+          problem.kd = m.kd;
+          problem.lights = lights;
+          problem.samples = select_samples(color, positions, normals, materials.ids, k, highlights, options.max_samples);
+          if (problem.samples.empty()) {
+            m.ks = 0.f;
+            m.fit_rms = -1.f;
+            continue;
+          }
+          const SpecularFit fit = solver.fit(problem, options.specular);
+          m.ks = fit.ks;
+          m.n = fit.n;
+          m.fit_rms = static_cast<float>(fit.rms);
+        }
+      },
+      1);
+}
+
+void estimate_brdf(const ColorImage& color, const PositionMap& positions, const NormalMap& normals,
+                   const ShadingLights& lights, const BrdfOptions& options, KMeansEngine& engine,
+                   KMeansTracker& tracker, const SpecularSolver& solver, BrdfFrame& out) {
+  remove_highlights(color, options.highlight, out.cleaned, out.highlights);
+  estimate_diffuse(out.cleaned, positions, normals, lights, options.diffuse, out.kd, out.kd_valid);
+  std::vector<Float3> points;
+  std::vector<std::uint32_t> pixels;
+  gather_points(out.kd, out.kd_valid, points, pixels);
+  const KMeansResult result = tracker.run(engine, points);
+  out.materials = materials_from_clusters(result, pixels, color.width(), color.height());
+  fit_materials(color, &out.highlights, positions, normals, lights, options, solver, out.materials);
+}
+
+RadianceImage render_materials(const Materials& materials, const PositionMap& positions, const NormalMap& normals,
+                               const ShadingLights& lights) {
+  RadianceImage out(materials.ids.width(), materials.ids.height());
+  parallel_for_each_row(out.height(), 0, [&](int r) {
+    for (int c = 0; c < out.width(); ++c) {
+      const int id = materials.ids(r, c);
+      if (id == 0) continue;
+      const MaterialParams& m = materials.clusters[static_cast<std::size_t>(id - 1)];
+      const Float3 p = positions(r, c), n = normals(r, c);
+      const Eigen::Vector3f l = phong_radiance(lights, {p.x, p.y, p.z}, {n.x, n.y, n.z}, m.kd, m.ks, m.n);
+      out(r, c) = {l.x(), l.y(), l.z()};
+    }
+  });
+  return out;
+}
+
+void HighlightRemovalStage::declare(StageBuilder& builder) {
+  color_ = builder.read<ColorImage>(buffers_.color);
+  cleaned_ = builder.write<ColorImage>(buffers_.color_diffuse);
+  mask_ = builder.write<Mask>(buffers_.highlight_mask);
+}
+
+void HighlightRemovalStage::run(StageContext& context) {
+  remove_highlights(context.get(color_), options_, context.get(cleaned_), context.get(mask_));
+}
+
+void DiffuseStage::declare(StageBuilder& builder) {
+  color_ = builder.read<ColorImage>(buffers_.color_diffuse);
+  positions_ = builder.read<PositionMap>(buffers_.positions);
+  normals_ = builder.read<NormalMap>(buffers_.normals);
+  lights_ = builder.read<LightSet>(buffers_.lights);
+  frame_ = builder.read<FrameInfo>(buffers_.frame);
+  kd_ = builder.write<RadianceImage>(buffers_.kd);
+  valid_ = builder.write<Mask>(buffers_.kd_valid);
+}
+
+void DiffuseStage::run(StageContext& context) {
+  const ShadingLights lights = camera_lights(context.get(lights_), context.get(frame_), ambient_);
+  estimate_diffuse(context.get(color_), context.get(positions_), context.get(normals_), lights, options_,
+                   context.get(kd_), context.get(valid_));
+}
+
+KMeansStage::KMeansStage(KMeansOptions options, std::uint64_t seed, BrdfBuffers buffers)
+    : backend_(Backend::Cpu), engine_(std::make_unique<KMeansCpu>(options.threads)), tracker_(options, seed),
+      buffers_(std::move(buffers)) {}
+
+KMeansStage::KMeansStage(vk::VulkanContext& context, KMeansOptions options, std::uint64_t seed, BrdfBuffers buffers)
+    : backend_(Backend::Vulkan), engine_(std::make_unique<KMeansVk>(context)), tracker_(options, seed),
+      buffers_(std::move(buffers)) {}
+
+KMeansStage::~KMeansStage() = default;
+
+void KMeansStage::declare(StageBuilder& builder) {
+  kd_ = builder.read<RadianceImage>(buffers_.kd);
+  valid_ = builder.read<Mask>(buffers_.kd_valid);
+  clusters_ = builder.write<Materials>(buffers_.clusters);
+}
+
+void KMeansStage::run(StageContext& context) {
+  const RadianceImage& kd = context.get(kd_);
+  gather_points(kd, context.get(valid_), points_, pixels_);
+  if (auto* gpu = dynamic_cast<KMeansVk*>(engine_.get())) gpu->reset_gpu_ms();
+  result_ = tracker_.run(*engine_, points_);
+  if (auto* gpu = dynamic_cast<KMeansVk*>(engine_.get()); gpu && gpu->gpu_ms()) context.report_device_ms(*gpu->gpu_ms());
+  context.get(clusters_) = materials_from_clusters(result_, pixels_, kd.width(), kd.height());
+}
+
+SpecularFitStage::SpecularFitStage(BrdfOptions options, BrdfBuffers buffers)
+    : options_(std::move(options)), buffers_(std::move(buffers)), solver_(make_solver(options_.solver)) {}
+
+void SpecularFitStage::declare(StageBuilder& builder) {
+  clusters_ = builder.read<Materials>(buffers_.clusters);
+  color_ = builder.read<ColorImage>(buffers_.color);
+  highlights_ = builder.read<Mask>(buffers_.highlight_mask);
+  positions_ = builder.read<PositionMap>(buffers_.positions);
+  normals_ = builder.read<NormalMap>(buffers_.normals);
+  lights_ = builder.read<LightSet>(buffers_.lights);
+  frame_ = builder.read<FrameInfo>(buffers_.frame);
+  materials_ = builder.write<Materials>(buffers_.materials);
+}
+
+void SpecularFitStage::run(StageContext& context) {
+  Materials& out = context.get(materials_);
+  out = context.get(clusters_);
+  const ShadingLights lights = camera_lights(context.get(lights_), context.get(frame_), options_.ambient);
+  fit_materials(context.get(color_), &context.get(highlights_), context.get(positions_), context.get(normals_), lights,
+                options_, *solver_, out);
+}
+
+void add_brdf_stages(FrameGraph& graph, const BrdfOptions& options, Backend kmeans_backend,
+                     vk::VulkanContext* context, const BrdfBuffers& buffers) {
+  graph.emplace<HighlightRemovalStage>(options.highlight, buffers);
+  graph.emplace<DiffuseStage>(options.diffuse, options.ambient, buffers);
+  if (kmeans_backend == Backend::Vulkan) {
+    if (!context) throw LogicError("add_brdf_stages: Vulkan K-means needs a VulkanContext");
+    graph.emplace<KMeansStage>(*context, options.kmeans, options.seed, buffers);
+  } else {
+    graph.emplace<KMeansStage>(options.kmeans, options.seed, buffers);
+  }
+  graph.emplace<SpecularFitStage>(options, buffers);
+}
+
+}  // namespace relight::brdf
