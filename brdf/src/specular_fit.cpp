@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 
 #include "relight/core/error.h"
@@ -66,46 +67,164 @@ class NelderMeadSolver final : public SpecularSolver {
     const int moving = static_cast<int>(moving_ids.size());
     const ShadingLights ordered = detail::moving_first(problem.lights, moving_ids);
     const Bounds bounds = bounds_for(ordered, moving, options);
-    const std::size_t dims = bounds.lower.size();
     int evaluations = 0;
-    auto clamp = [&](std::vector<double>& x) {
-      for (std::size_t i = 0; i < dims; ++i) x[i] = std::clamp(x[i], bounds.lower[i], bounds.upper[i]);
-    };
-    auto f = [&](const std::vector<double>& x) {
-      ++evaluations;
-      return objective_ordered(problem, ordered, moving, x[0], std::exp(x[1]), dims > 2 ? x.data() + 2 : nullptr);
-    };
-    std::vector<double> start(dims, 0.0);
-    start[0] = options.ks_start;
-    start[1] = std::log(static_cast<double>(options.n_start));
-    clamp(start);
-    std::vector<double> steps(dims);
-    steps[0] = 0.25 * options.ks_max;
-    steps[1] = 0.7;
-    for (std::size_t i = 2; i < dims; ++i) steps[i] = 0.5 * bounds.upper[i];
+    const Bounds shape_bounds{{bounds.lower[0], bounds.lower[1]}, {bounds.upper[0], bounds.upper[1]}};
 
-    std::vector<double> best = start;
-    double best_f = f(best);
-    for (int restart = 0; restart < 4 && evaluations < options.max_evaluations; ++restart) {
-      const double before = best_f;
-      minimise(f, clamp, best, best_f, steps, options.max_evaluations, evaluations);
-      if (restart > 0 && before - best_f <= 1e-9 * std::max(1.0, before)) break;
-      for (double& s : steps) s *= 0.5;  // restarts search closer to the optimum
+    // Phase A: (k_s, log n) with the lights where they are. With fixed lights the diffuse part
+    // and log<r.v> of every sample are constants, so F costs one exp per lit sample and light.
+    std::vector<double> shape{std::clamp<double>(options.ks_start, 0.0, options.ks_max),
+                              std::clamp(std::log(static_cast<double>(options.n_start)), bounds.lower[1], bounds.upper[1])};
+    std::vector<double> offsets(static_cast<std::size_t>(3 * moving), 0.0);
+    double best_f = fit_shape(problem, ordered, moving, offsets, shape_bounds, options, shape, evaluations);
+
+    const double residuals = 3.0 * static_cast<double>(std::max<std::size_t>(1, problem.samples.size()));
+    const bool diffuse = shape[0] < options.min_ks;
+    const bool explained = std::sqrt(best_f / residuals) <= options.light_refine_rms;
+    if (moving > 0 && !diffuse && !explained) {
+      // Phase B: every parameter, on a strided subset (the light offsets are few and smooth).
+      SpecularProblem subset;
+      subset.kd = problem.kd;
+      subset.lights = problem.lights;
+      const std::size_t stride = problem.samples.size() / kLightSamples + 1;
+      for (std::size_t i = 0; i < problem.samples.size(); i += stride) subset.samples.push_back(problem.samples[i]);
+      std::vector<double> x = shape;
+      x.insert(x.end(), offsets.begin(), offsets.end());
+      auto clamp = [&](std::vector<double>& v) {
+        for (std::size_t i = 0; i < v.size(); ++i) v[i] = std::clamp(v[i], bounds.lower[i], bounds.upper[i]);
+      };
+      auto f = [&](const std::vector<double>& v) {
+        ++evaluations;
+        return objective_ordered(subset, ordered, moving, v[0], std::exp(v[1]), v.data() + 2);
+      };
+      std::vector<double> steps(x.size());
+      steps[0] = 0.05 * options.ks_max;
+      steps[1] = 0.1;
+      for (std::size_t i = 2; i < x.size(); ++i) steps[i] = 0.5 * bounds.upper[i];
+      double fx = f(x);
+      restarts(f, clamp, x, fx, steps, evaluations + options.light_evaluations, evaluations);
+      // Phase C: (k_s, log n) again on all samples with the moved lights; kept if F drops.
+      std::vector<double> moved(x.begin() + 2, x.end());
+      std::vector<double> shape_c(x.begin(), x.begin() + 2);
+      const double f_c = fit_shape(problem, ordered, moving, moved, shape_bounds, options, shape_c, evaluations);
+      if (f_c < best_f) {
+        best_f = f_c;
+        shape = shape_c;
+        offsets = moved;
+      }
     }
     SpecularFit fit;
-    fit.ks = static_cast<float>(best[0]);
-    fit.n = static_cast<float>(std::exp(best[1]));
+    fit.ks = static_cast<float>(shape[0]);
+    fit.n = static_cast<float>(std::exp(shape[1]));
     fit.objective = best_f;
     fit.evaluations = evaluations;
     for (int l = 0; l < moving; ++l) {
-      fit.light_offsets.emplace_back(static_cast<float>(best[2 + 3 * l]), static_cast<float>(best[3 + 3 * l]),
-                                     static_cast<float>(best[4 + 3 * l]));
+      const auto o = static_cast<std::size_t>(3 * l);
+      fit.light_offsets.emplace_back(static_cast<float>(offsets[o]), static_cast<float>(offsets[o + 1]),
+                                     static_cast<float>(offsets[o + 2]));
     }
     finish(fit, problem, options);
     return fit;
   }
 
  private:
+  static constexpr std::size_t kLightSamples = 256;
+
+  /// Restarted Nelder-Mead: fresh simplices of halving size from the best vertex until a restart
+  /// no longer improves F.
+  template <class F, class Clamp>
+  static void restarts(F& f, Clamp& clamp, std::vector<double>& x, double& fx, std::vector<double> steps,
+                       int max_evaluations, int& evaluations) {
+    for (int restart = 0; restart < 4 && evaluations < max_evaluations; ++restart) {
+      const double before = fx;
+      minimise(f, clamp, x, fx, steps, max_evaluations, evaluations);
+      if (restart > 0 && before - fx <= 1e-9 * std::max(1.0, before)) break;
+      for (double& step : steps) step *= 0.5;
+    }
+  }
+
+  /// Fits (k_s, log n) with the lights fixed at `offsets`; returns F on all samples.
+  static double fit_shape(const SpecularProblem& problem, const ShadingLights& ordered, int moving,
+                          const std::vector<double>& offsets, const Bounds& bounds, const SpecularOptions& options,
+                          std::vector<double>& shape, int& evaluations) {
+    const FixedTerms terms = fixed_terms(problem, ordered, moving, offsets);
+    auto clamp = [&](std::vector<double>& v) {
+      for (std::size_t i = 0; i < 2; ++i) v[i] = std::clamp(v[i], bounds.lower[i], bounds.upper[i]);
+    };
+    auto f = [&](const std::vector<double>& v) {
+      ++evaluations;
+      return terms.objective(v[0], std::exp(v[1]));
+    };
+    double fx = f(shape);
+    restarts(f, clamp, shape, fx, {0.25 * options.ks_max, 0.7}, evaluations + options.max_evaluations, evaluations);
+    return fx;
+  }
+
+  /// Per sample: the residual without the specular term and, per light that lights it with
+  /// <r.v> > 0, the irradiance and log<r.v>.
+  struct FixedTerms {
+    struct Lobe {
+      double irradiance[3];
+      double log_rv;
+    };
+    std::vector<double> base;  // 3 per sample
+    std::vector<Lobe> lobes;
+    std::vector<std::uint32_t> first;  // per sample + 1: range into lobes
+
+    [[nodiscard]] double objective(double ks, double n) const {
+      const double scale = ks * (n + 2.0) * 0.5 / std::numbers::pi;
+      double sum = 0.0;
+      for (std::size_t i = 0; i + 1 < first.size(); ++i) {
+        double spec[3] = {0.0, 0.0, 0.0};
+        for (std::uint32_t j = first[i]; j < first[i + 1]; ++j) {
+          const double lobe = std::exp(n * lobes[j].log_rv);
+          for (int c = 0; c < 3; ++c) spec[c] += lobes[j].irradiance[c] * lobe;
+        }
+        for (int c = 0; c < 3; ++c) {
+          const double r = base[3 * i + static_cast<std::size_t>(c)] - scale * spec[c];
+          sum += r * r;
+        }
+      }
+      return sum;
+    }
+  };
+
+  static FixedTerms fixed_terms(const SpecularProblem& problem, const ShadingLights& ordered, int moving,
+                                const std::vector<double>& offsets) {
+    // The lights moved by `offsets`, then the model with k_s = 0 gives the diffuse part.
+    ShadingLights moved = ordered;
+    for (int l = 0; l < moving; ++l) {
+      for (int c = 0; c < 3; ++c) {
+        moved.lights[static_cast<std::size_t>(l)].vector[c] += static_cast<float>(offsets[static_cast<std::size_t>(3 * l + c)]);
+      }
+    }
+    FixedTerms t;
+    t.first.push_back(0);
+    const double inv_pi = 1.0 / std::numbers::pi;
+    for (const SpecularSample& s : problem.samples) {
+      const Eigen::Vector3d p = s.position.cast<double>(), n = s.normal.cast<double>();
+      const Eigen::Vector3d view = -p.normalized();
+      Eigen::Vector3d diffuse = moved.ambient.cast<double>();
+      for (const ShadingLight& light : moved.lights) {
+        Eigen::Vector3d dir = light.vector.cast<double>();
+        double scale = 1.0;
+        if (light.point) {
+          dir -= p;
+          scale = 1.0 / dir.squaredNorm();
+        }
+        dir.normalize();
+        const double cosine = n.dot(dir);
+        if (!(cosine > 0.0)) continue;
+        const Eigen::Vector3d e = light.power.cast<double>() * (scale * cosine);
+        diffuse += e * inv_pi;
+        const double rv = (2.0 * cosine * n - dir).dot(view);
+        if (rv > 1e-12) t.lobes.push_back({{e.x(), e.y(), e.z()}, std::log(rv)});
+      }
+      for (int c = 0; c < 3; ++c) t.base.push_back(double(s.radiance[c]) - double(problem.kd[c]) * diffuse[c]);
+      t.first.push_back(static_cast<std::uint32_t>(t.lobes.size()));
+    }
+    return t;
+  }
+
   // One Nelder-Mead run (reflection 1, expansion 2, contraction 1/2, shrink 1/2) from `x` with
   // the given initial steps; every vertex is projected onto the bounds.
   template <class F, class Clamp>

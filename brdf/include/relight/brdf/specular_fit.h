@@ -8,9 +8,12 @@
 //
 // with the model of shading.h (both the diffuse and the specular term subtracted). Two solvers
 // behind one interface:
-//   - Nelder-Mead (own implementation): parameters (k_s, log n, light offsets), kept inside the
-//     bounds by projecting every vertex onto the box, restarted from the best vertex with a fresh
-//     simplex until a restart no longer improves F;
+//   - Nelder-Mead (own implementation), every vertex projected onto the parameter box, restarted
+//     from the best vertex with a fresh simplex until a restart no longer improves F; in phases:
+//     (A) k_s and log n with the lights fixed (precomputed per-sample terms: one exp per lit
+//     sample and light), (B) if the residual is still above light_refine_rms and the cluster is
+//     not diffuse, every parameter on a subset of 256 samples, (C) k_s and log n again on all
+//     samples with the moved lights, kept if F drops;
 //   - Ceres: one ceres::AutoDiffCostFunction per sample (3 residuals; blocks (k_s, n) and one
 //     3-vector offset per moving light), parameter bounds on every block, Levenberg-Marquardt.
 // Ceres stays out of this header (compile time, shared/design/platform.md).
@@ -51,7 +54,11 @@ struct SpecularOptions {
   float direction_offset_max = 0.05f;  ///< per component of a directional light's unit vector
   float max_rms = 0.05f;               ///< radiance units; above it the cluster is diffuse
   float min_ks = 1e-3f;
-  int max_evaluations = 4000;          ///< Nelder-Mead objective evaluations in all
+  int max_evaluations = 2000;          ///< Nelder-Mead evaluations per (k_s, n) phase
+  int light_evaluations = 600;         ///< Nelder-Mead evaluations of the light phase
+  /// Nelder-Mead moves the lights only when the fit with fixed lights leaves an RMS residual
+  /// above this (about one 8-bit step at mid grey) and the cluster is not diffuse.
+  float light_refine_rms = 0.004f;
   int max_iterations = 100;            ///< Ceres iterations
 };
 
