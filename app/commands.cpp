@@ -38,8 +38,8 @@ Registry& registry() {
 
 void register_replay(CLI::App& app) {
   auto options = std::make_shared<ReplayOptions>();
-  CLI::App* replay = app.add_subcommand("replay", "Run the pipeline on a recorded RGB-D sequence (TUM folder)");
-  replay->add_option("sequence", options->sequence, "TUM RGB-D folder (default: the embedded sample)");
+  CLI::App* replay = app.add_subcommand("replay", "Run the pipeline on a recorded RGB-D sequence (TUM folder or .oni)");
+  replay->add_option("sequence", options->sequence, "TUM RGB-D folder or OpenNI2 .oni recording (default: the embedded sample)");
   replay->add_option("--out", options->out, "Output folder")->capture_default_str();
   replay->add_option("--frames", options->frames, "Frame range A:B (B exclusive), A:, :B or N");
   replay->add_option("--intrinsics", options->intrinsics, "Override intrinsics: kinect, fr1, fr2, fr3");
@@ -83,6 +83,7 @@ void register_commands(CLI::App& app) {
   register_graph(app);
   register_synth(app, registry().runners);
   register_lights(app, registry().runners);
+  register_live(app, registry().runners);
 }
 
 int run_selected(CLI::App& app) {

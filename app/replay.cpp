@@ -1,5 +1,6 @@
 #include "replay.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <iostream>
@@ -8,6 +9,7 @@
 #include "frame_writer_stage.h"
 #include "marker_trajectory_stage.h"
 #include "relight/capture/marker_pose.h"
+#include "relight/capture/openni_source.h"
 #include "relight/capture/source_stage.h"
 #include "relight/capture/tum_sequence.h"
 #include "relight/core/atomic_file.h"
@@ -31,6 +33,36 @@ std::filesystem::path data_folder() {
 
 std::filesystem::path default_sequence() { return data_folder() / "tum_fr1_rpy"; }
 
+namespace {
+
+// Frames [first, last) of a source that can only be read sequentially (a .oni recording).
+class RangeSource final : public FrameSource {
+ public:
+  RangeSource(std::unique_ptr<FrameSource> source, FrameRange range) : source_(std::move(source)), range_(range) {}
+  std::optional<RgbdFrame> next() override {
+    for (; position_ < range_.first; ++position_) {
+      if (!source_->next()) return std::nullopt;
+    }
+    if (range_.last && position_ >= *range_.last) return std::nullopt;
+    auto frame = source_->next();
+    if (frame) frame->info.index = static_cast<std::int64_t>(position_++ - range_.first);
+    return frame;
+  }
+  std::int64_t size_hint() const override {
+    const auto total = static_cast<std::size_t>(std::max<std::int64_t>(source_->size_hint(), 0));
+    const std::size_t end = std::min(total, range_.last.value_or(total));
+    return end > range_.first ? static_cast<std::int64_t>(end - range_.first) : 0;
+  }
+  std::string describe() const override { return source_->describe(); }
+
+ private:
+  std::unique_ptr<FrameSource> source_;
+  FrameRange range_;
+  std::size_t position_ = 0;
+};
+
+}  // namespace
+
 std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options) {
   TumOptions tum;
   if (!options.intrinsics.empty()) {
@@ -39,6 +71,12 @@ std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options) {
   }
   const FrameRange range = options.frames.empty() ? FrameRange{} : parse_frame_range(options.frames);
   const auto folder = options.sequence.empty() ? default_sequence() : options.sequence;
+  if (folder.extension() == ".oni") {  // OpenNI2 recording, played back through its file device
+    OpenNiOptions oni;
+    oni.uri = folder.string();
+    oni.intrinsics = tum.intrinsics;
+    return std::make_unique<RangeSource>(std::make_unique<OpenNiSource>(oni), range);
+  }
   return std::make_unique<TumSource>(TumSequence::open(folder, tum), range.first, range.last);
 }
 

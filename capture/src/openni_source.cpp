@@ -2,6 +2,7 @@
 
 #include <OpenNI.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -14,10 +15,24 @@ namespace relight {
 
 namespace {
 
+// OpenNI2's error log, one line per message with tabs: joined into one line for relight::Error.
 std::string extended_error() {
   const char* text = openni::OpenNI::getExtendedError();
-  std::string message = text == nullptr ? "" : text;
-  while (!message.empty() && (message.back() == '\n' || message.back() == ' ')) message.pop_back();
+  std::string message;
+  std::string line;
+  auto flush = [&] {
+    const auto begin = line.find_first_not_of(" \t"), end = line.find_last_not_of(" \t");
+    if (begin != std::string::npos) message += (message.empty() ? "" : "; ") + line.substr(begin, end - begin + 1);
+    line.clear();
+  };
+  for (const char* c = text; c != nullptr && *c != '\0'; ++c) {
+    if (*c == '\n' || *c == '\r') {
+      flush();
+    } else {
+      line += *c;
+    }
+  }
+  flush();
   return message;
 }
 
@@ -63,6 +78,8 @@ class DisconnectWatch final : public openni::OpenNI::DeviceDisconnectedListener 
   std::string uri_;
   std::atomic<bool> disconnected_{false};
 };
+
+constexpr int kWaitSliceMs = 100;
 
 bool is_oni_file(const std::string& uri) {
   const std::filesystem::path path(uri);
@@ -268,6 +285,7 @@ std::optional<RgbdFrame> OpenNiSource::next() {
   openni::VideoStream* streams[] = {&s.depth.stream, &s.color.stream};
   const auto timeout = static_cast<int>(s.options.timeout.count());
   while (true) {
+    if (s.file && s.total > 0 && s.delivered >= s.total) return std::nullopt;  // all frames read
     if (s.pending_depth && s.pending_color) {
       const std::uint64_t td = s.pending_depth->getTimestamp(), tc = s.pending_color->getTimestamp();
       const std::uint64_t gap = td > tc ? td - tc : tc - td;
@@ -280,12 +298,26 @@ std::optional<RgbdFrame> OpenNiSource::next() {
       (td < tc ? s.pending_depth : s.pending_color).reset();  // the older one has no partner
       ++s.dropped;
     }
-    // After a disconnect only frames already queued remain: wait briefly for them.
-    const int wait_ms = s.watch->disconnected() ? 100 : timeout;
+    // Waits in short slices: a disconnect does not wake waitForAnyStream, so the listener's flag is
+    // checked between slices; once it is set only frames already queued remain.
     int ready = -1;
-    const openni::Status status = openni::OpenNI::waitForAnyStream(streams, 2, &ready, wait_ms);
+    openni::Status status = openni::STATUS_TIME_OUT;
+    for (int waited = 0; waited < timeout && status == openni::STATUS_TIME_OUT;) {
+      const bool gone = s.watch->disconnected();
+      const int slice = std::min(kWaitSliceMs, timeout - waited);
+      status = openni::OpenNI::waitForAnyStream(streams, 2, &ready, slice);
+      waited += slice;
+      if (gone) break;  // one more slice after the disconnect was seen, for frames in flight
+    }
     if (status == openni::STATUS_TIME_OUT) {
-      if (s.file) return std::nullopt;  // the end of a recording shows only as a timeout
+      if (s.file) {
+        // The end of a recording shows only as a timeout; before the frame count it is a cut file.
+        if (s.delivered < s.total) {
+          throw Error(s.uri + ": the recording ends after " + std::to_string(s.delivered) + " of " +
+                      std::to_string(s.total) + " frames (truncated or corrupt file)");
+        }
+        return std::nullopt;
+      }
       if (s.watch->disconnected()) {
         throw Error("OpenNI2 device " + s.uri + " disconnected after " + std::to_string(s.delivered) + " frames");
       }

@@ -1,0 +1,275 @@
+// `relight devices`, `relight live` and `relight record`: OpenNI2 devices (a Kinect-class camera,
+// or relight's own virtual device relight://synthetic | relight://tum/<folder>).
+//
+// live runs the replay frame graph (build_replay_pipeline) on a device; record writes what a
+// device sends to a .oni file (openni::Recorder) or a TUM folder. Both stop after --frames N,
+// on Ctrl-C (outputs finalised, device closed, exit 0) or when the device goes away (outputs
+// finalised, then a one-line error, exit 1).
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "interrupt.h"
+#include "marker_trajectory_stage.h"
+#include "relight/capture/openni_source.h"
+#include "relight/capture/tum_writer.h"
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+#include "replay.h"
+#include "report.h"
+
+namespace relight::app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// "live: 120 frames, 29.8 fps, 0 dropped" on one terminal line, redrawn at most every 0.5 s.
+class LiveStatus {
+ public:
+  LiveStatus(std::string label, bool quiet) : label_(std::move(label)), enabled_(!quiet && isatty(STDERR_FILENO)) {}
+  void update(std::int64_t frames, std::int64_t dropped) {
+    if (!enabled_ || Clock::now() - last_ < std::chrono::milliseconds(500)) return;
+    last_ = Clock::now();
+    const double elapsed = seconds_since(start_);
+    std::fprintf(stderr, "\r%s: %lld frames, %.1f fps, %lld dropped   ", label_.c_str(), static_cast<long long>(frames),
+                 elapsed > 0 ? static_cast<double>(frames) / elapsed : 0.0, static_cast<long long>(dropped));
+    drawn_ = true;
+  }
+  void finish() {
+    if (drawn_) std::fputc('\n', stderr);
+    drawn_ = false;
+  }
+
+ private:
+  std::string label_;
+  bool enabled_;
+  bool drawn_ = false;
+  Clock::time_point start_ = Clock::now();
+  Clock::time_point last_{};
+};
+
+// Ends the stream after `limit` frames (0: no limit) or on Ctrl-C, as the end of a recording would,
+// so that the frame graph finishes normally.
+class StoppableSource final : public FrameSource {
+ public:
+  StoppableSource(std::unique_ptr<OpenNiSource> source, std::int64_t limit) : source_(std::move(source)), limit_(limit) {}
+  std::optional<RgbdFrame> next() override {
+    if (InterruptGuard::interrupted() || (limit_ > 0 && frames_ >= limit_)) return std::nullopt;
+    auto frame = source_->next();
+    if (frame) ++frames_;
+    return frame;
+  }
+  std::int64_t size_hint() const override { return limit_; }
+  std::string describe() const override { return source_->describe(); }
+  [[nodiscard]] const OpenNiSource& device() const { return *source_; }
+
+ private:
+  std::unique_ptr<OpenNiSource> source_;
+  std::int64_t limit_;
+  std::int64_t frames_ = 0;
+};
+
+struct LiveOptions {
+  std::string device;  ///< OpenNI2 URI; empty = first device
+  std::int64_t frames = 0;
+  ReplayOptions replay;
+};
+
+int run_devices() {
+  const auto devices = list_openni_devices();
+  if (devices.empty()) std::cerr << "relight devices: OpenNI2 sees no device\n";
+  for (const auto& device : devices) std::cout << device.uri << "\t" << device.vendor << "\t" << device.name << "\n";
+  return 0;
+}
+
+int run_live(const LiveOptions& options) {
+  InterruptGuard interrupt;
+  OpenNiOptions device_options;
+  device_options.uri = options.device;
+  auto device = std::make_unique<OpenNiSource>(device_options);
+  if (device->is_file()) throw Error(options.device + " is a recording: use relight replay for .oni files");
+  auto source = std::make_unique<StoppableSource>(std::move(device), options.frames);
+  const StoppableSource& stoppable = *source;
+  const std::string description = source->describe();
+  std::error_code ec;
+  std::filesystem::create_directories(options.replay.out, ec);
+  if (ec) throw Error("cannot create output folder " + options.replay.out.string() + ": " + ec.message());
+
+  ReplayPipeline pipeline = build_replay_pipeline(std::move(source), options.replay);
+  FrameGraph& graph = *pipeline.graph;
+  graph.compile();
+  write_file_atomically(options.replay.out / "graph.dot", graph.to_dot());
+  const bool quiet = options.replay.quiet;
+  if (!quiet) std::cerr << "relight live: " << description << "; " << pipeline.compute << "; Ctrl-C stops\n";
+
+  LiveStatus status("live", quiet);
+  const auto start = Clock::now();
+  std::string failure;
+  try {
+    while (graph.run_frame()) status.update(graph.frames_run(), stoppable.device().dropped());
+  } catch (const Error& e) {
+    failure = e.what();  // e.g. the device was unplugged: keep what was processed, then report it
+  }
+  status.finish();
+  graph.finish();
+  const double seconds = seconds_since(start);
+  const std::int64_t dropped = stoppable.device().dropped();
+
+  auto report = timing_report(graph, seconds);
+  report["source"] = description;
+  report["compute"] = pipeline.compute;
+  report["dropped_frames"] = dropped;
+  report["stopped_by"] = !failure.empty() ? "error: " + failure : InterruptGuard::interrupted() ? "interrupt" : "end";
+  if (pipeline.markers) report["marker_pose"] = pipeline.markers->summary();
+  write_file_atomically(options.replay.out / "report.json", report.dump(2) + "\n");
+  if (!quiet) {
+    std::cerr << "relight live: " << graph.frames_run() << " frames in " << seconds << " s ("
+              << (seconds > 0 ? static_cast<double>(graph.frames_run()) / seconds : 0.0) << " fps), " << dropped
+              << " dropped" << (InterruptGuard::interrupted() ? ", interrupted" : "") << "; results in "
+              << options.replay.out.string() << "\n";
+  }
+  if (!failure.empty()) throw Error(failure);
+  return 0;
+}
+
+struct RecordOptions {
+  std::string device;
+  std::int64_t frames = 0;
+  std::filesystem::path out;
+  bool quiet = false;
+};
+
+// A .oni is written under a temporary name and renamed once it is complete and checked, so a
+// failed run never leaves a half-written recording under the requested name.
+std::filesystem::path temporary_oni(const std::filesystem::path& out) {
+  return out.parent_path() / (out.stem().string() + ".tmp-" + std::to_string(getpid()) + ".oni");
+}
+
+std::string camera_json(const PinholeIntrinsics& k, const std::string& source) {
+  const nlohmann::ordered_json json = {
+      {"generator", "relight record"},
+      {"source", source},
+      {"intrinsics", {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}, {"width", k.width}, {"height", k.height}}},
+      {"depth_scale", 5000.0}};
+  return json.dump(2) + "\n";
+}
+
+int run_record(const RecordOptions& options) {
+  InterruptGuard interrupt;
+  const bool to_oni = options.out.extension() == ".oni";
+  OpenNiOptions device_options;
+  device_options.uri = options.device;
+  OpenNiSource source(device_options);
+  if (to_oni && source.is_file()) throw Error("recording a .oni file into a .oni file: copy the file instead");
+
+  std::optional<TumWriter> tum;
+  const std::filesystem::path temporary = to_oni ? temporary_oni(options.out) : std::filesystem::path();
+  if (to_oni) {
+    if (!options.out.parent_path().empty()) std::filesystem::create_directories(options.out.parent_path());
+    // The streams run already (Recorder::attach needs started streams), so a frame that came in
+    // before the recorder started may be read below without being in the file: the check allows it.
+    source.start_recording(temporary);
+  } else {
+    tum.emplace(options.out);
+  }
+  if (!options.quiet) std::cerr << "relight record: " << source.describe() << " -> " << options.out.string() << "; Ctrl-C stops\n";
+
+  LiveStatus status("record", options.quiet);
+  const auto start = Clock::now();
+  std::int64_t frames = 0;
+  std::optional<PinholeIntrinsics> intrinsics;
+  std::string failure;
+  try {
+    while (!InterruptGuard::interrupted() && (options.frames == 0 || frames < options.frames)) {
+      auto frame = source.next();
+      if (!frame) break;  // end of a .oni being converted
+      intrinsics = frame->info.intrinsics;
+      if (tum) tum->add(frame->info.timestamp, frame->color, frame->depth, frame->info.camera_to_world);
+      ++frames;
+      status.update(frames, source.dropped());
+    }
+  } catch (const Error& e) {
+    failure = e.what();
+  }
+  status.finish();
+  const double seconds = seconds_since(start);
+  std::string held;
+  if (to_oni) {
+    source.stop_recording();
+    const OniRecordingSummary summary = inspect_oni(temporary);
+    // Every frame read after the recorder started must be in the file (all but possibly the first).
+    if (summary.depth_frames < frames - 1 || summary.color_frames < frames - 1) {
+      std::filesystem::remove(temporary);
+      throw Error(options.out.string() + ": the recording holds " + std::to_string(summary.depth_frames) + " depth and " +
+                  std::to_string(summary.color_frames) + " colour frames but " + std::to_string(frames) +
+                  " were delivered; frames were lost");
+    }
+    std::filesystem::rename(temporary, options.out);
+    held = "; the file holds " + std::to_string(summary.depth_frames) + " depth and " +
+           std::to_string(summary.color_frames) + " colour frames";
+  } else {
+    tum->finish();
+    // The folder's camera, for TumSequence (as `relight synth` writes it).
+    if (intrinsics) write_file_atomically(options.out / "scene.json", camera_json(*intrinsics, source.describe()));
+  }
+  if (!options.quiet) {
+    std::cerr << "relight record: " << frames << " frames in " << seconds << " s, " << source.dropped()
+              << " dropped by the reader" << held << (InterruptGuard::interrupted() ? ", interrupted" : "") << " -> "
+              << options.out.string() << "\n";
+  }
+  if (!failure.empty()) throw Error(failure);
+  return 0;
+}
+
+void add_live_compute_options(CLI::App& command, ReplayOptions& options) {
+  command.add_option("--backend", options.backend, "auto, cpu or vulkan (as in replay)")->capture_default_str();
+  command.add_flag_callback("--cpu", [&options] { options.backend = "cpu"; }, "Same as --backend cpu");
+  command.add_option("--vk-device", options.device, "Vulkan device (replay's --device)");
+  command.add_option("--geometry", options.geometry, "normal estimation: method1 or method2 (as in replay)")
+      ->check(CLI::IsMember({"method1", "method2"}))
+      ->capture_default_str();
+}
+
+}  // namespace
+
+void register_live(CLI::App& app, Runners& runners) {
+  CLI::App* devices = app.add_subcommand("devices", "List the RGB-D devices OpenNI2 sees (URI, vendor, name)");
+  runners[devices] = [] { return run_devices(); };
+
+  auto live_options = std::make_shared<LiveOptions>();
+  live_options->replay.markers = "none";
+  live_options->replay.out.clear();
+  CLI::App* live = app.add_subcommand("live", "Run the pipeline (as replay) on a live OpenNI2 device");
+  live->add_option("--device", live_options->device,
+                   "OpenNI2 device URI (relight devices lists them; relight://synthetic, relight://tum/<folder>); "
+                   "default: the first device");
+  live->add_option("--frames", live_options->frames, "Stop after N frames (default: until Ctrl-C)")
+      ->check(CLI::NonNegativeNumber);
+  live->add_option("--out", live_options->replay.out, "Output folder")->required();
+  live->add_flag("--quiet", live_options->replay.quiet, "No progress or summary on stderr");
+  live->add_flag("!--no-frames", live_options->replay.write_frames, "Do not write per-frame images");
+  live->add_option("--markers", live_options->replay.markers, "AprilTag layout JSON for the camera pose, or none")
+      ->capture_default_str();
+  add_live_compute_options(*live, live_options->replay);
+  runners[live] = [live_options] { return run_live(*live_options); };
+
+  auto record_options = std::make_shared<RecordOptions>();
+  CLI::App* record = app.add_subcommand("record", "Record an OpenNI2 device to a .oni file or a TUM RGB-D folder");
+  record->add_option("--device", record_options->device, "OpenNI2 device URI or .oni file (default: the first device)");
+  record->add_option("--frames", record_options->frames, "Stop after N frames (default: until Ctrl-C)")
+      ->check(CLI::NonNegativeNumber);
+  record->add_option("--out", record_options->out, "FILE.oni (openni::Recorder, lossless) or a folder (TUM RGB-D)")
+      ->required();
+  record->add_flag("--quiet", record_options->quiet, "No progress or summary on stderr");
+  runners[record] = [record_options] { return run_record(*record_options); };
+}
+
+}  // namespace relight::app
