@@ -69,7 +69,8 @@ class KMeansEngine {
   virtual void read_labels(std::vector<std::uint8_t>& labels) = 0;
 };
 
-/// The CPU engine: points split into chunks over threads, integer sums per chunk added up.
+/// The CPU engine: points split into chunks over threads, assigned in vectorised blocks of 256,
+/// integer sums per chunk added up.
 class KMeansCpu final : public KMeansEngine {
  public:
   explicit KMeansCpu(int threads = 0) : threads_(threads) {}
@@ -79,7 +80,8 @@ class KMeansCpu final : public KMeansEngine {
 
  private:
   int threads_;
-  std::vector<Float3> points_;
+  std::vector<float> xs_, ys_, zs_;           // points, structure of arrays
+  std::vector<std::uint32_t> qx_, qy_, qz_;  // their fixed-point values (brdf_shared.h)
   std::vector<std::uint8_t> labels_;
 };
 
