@@ -11,7 +11,9 @@
 //                          camera, for testing clients); 0 = never
 //   seed=0                 synth seed (handheld trajectory, noise)
 //   trajectory=orbit       static | orbit | handheld
-//   loop=540               synthetic trajectory length before it repeats (540 frames = one orbit)
+//   loop=540               synthetic trajectory length before it repeats (540 frames = one orbit);
+//                          a loop that fits in 256 MB (<= 213 frames at 640x480, 853 at
+//                          320x240) is rendered once and then served from memory at full rate
 //   noise=none             none | kinect1 (synth's Kinect v1 depth noise)
 //   size=640x480           default video mode of both streams (synthetic: 640x480 or 320x240)
 #include <cstdint>

@@ -7,8 +7,9 @@
 // producing is slower than the frame period (the synthetic renderer: ~170 ms per 640x480 frame
 // on two cores, ~45 ms at 320x240) the frames come late but none is skipped and the timestamps
 // stay on the device clock (k / fps apart); the anchor then moves so that a later faster phase
-// never sends a burst. Rendering ahead of time was rejected: a loop of pre-rendered frames costs
-// seconds at open and ~1.2 MB per frame, and repeats after a few frames.
+// never sends a burst. Pre-rendering a loop at open was rejected (seconds of blocking in
+// Device::open); instead a short synthetic loop (loop=N, up to 256 MB) is cached as it is first
+// rendered, so from the second pass on the device runs at its frame rate (frame_producer.cpp).
 //
 // Disconnect: with disconnect_after=N the thread stops after N frames and reports the device
 // disconnected (the OpenNI2 core then fires OpenNI::DeviceDisconnectedListener), as an unplugged

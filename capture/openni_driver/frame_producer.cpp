@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 #include "relight/capture/depth_millimetres.h"
 #include "relight/capture/tum_sequence.h"
@@ -62,6 +63,22 @@ class SyntheticProducer final : public FrameProducer {
   }
 
   ProducedFrame produce(std::int64_t index, Resolution size) const override {
+    const int loop_index = static_cast<int>(index % uri_.loop);
+    const bool cache = cacheable(size);
+    if (cache) {
+      if (const auto hit = cache_.find({loop_index, size.width}); hit != cache_.end()) {
+        ProducedFrame frame = hit->second;
+        frame.index = index;
+        frame.timestamp_us = timestamp_us(index);
+        return frame;
+      }
+    }
+    ProducedFrame frame = render(index, size);
+    if (cache) cache_.emplace(std::make_pair(loop_index, size.width), frame);
+    return frame;
+  }
+
+  ProducedFrame render(std::int64_t index, Resolution size) const {
     const PinholeIntrinsics k = intrinsics(size);
     const auto pose_index = static_cast<std::size_t>(index % uri_.loop);
     const synth::RenderedFrame rendered = synth::render_frame(scene_, k, poses_[pose_index]);
@@ -87,9 +104,19 @@ class SyntheticProducer final : public FrameProducer {
     return synth::synth_intrinsics(options);
   }
 
+  // A short loop is rendered once and then replayed from memory, so that after the first pass the
+  // device runs at its frame rate however slow the renderer is (1.2 MB a 640x480 frame).
+  bool cacheable(Resolution size) const {
+    constexpr std::size_t kCacheBytes = std::size_t{256} << 20;
+    const std::size_t frame_bytes = static_cast<std::size_t>(size.width) * static_cast<std::size_t>(size.height) * 5;
+    return static_cast<std::size_t>(uri_.loop) * frame_bytes <= kCacheBytes;
+  }
+
   DeviceUri uri_;
   synth::Scene scene_;
   std::vector<Pose> poses_;
+  // (loop index, width) -> frame; only the device's frame thread calls produce().
+  mutable std::map<std::pair<int, int>, ProducedFrame> cache_;
 };
 
 // A TUM RGB-D folder, looping. Timestamps are the folder's depth timestamps; each further pass

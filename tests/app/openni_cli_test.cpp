@@ -147,6 +147,19 @@ TEST(OpenNiCli, RecordReplayRoundTripKeepsDepthTimestampsAndFrameCount) {
   EXPECT_EQ(read_report(out)["frames"], summary.depth_frames);
 }
 
+TEST(OpenNiCli, RecordFinalisesTheFileOnCtrlC) {
+  TempDir dir;
+  const auto oni = dir.path() / "take.oni";
+  const auto result = run_command("{ " + kRelight + " record --device " + kDevice + " --out " + oni.string() +
+                                  " & pid=$!; sleep 2; kill -INT $pid; wait $pid; }");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.err.find("interrupted"), std::string::npos) << result.err;
+  EXPECT_GE(inspect_oni(oni).depth_frames, 1);
+  std::size_t files = 0;
+  for ([[maybe_unused]] const auto& entry : std::filesystem::directory_iterator(dir.path())) ++files;
+  EXPECT_EQ(files, 1u);  // no temporary file left behind
+}
+
 TEST(OpenNiCli, RecordToAFolderWritesATumSequence) {
   TempDir dir;
   const auto folder = dir.path() / "take";
