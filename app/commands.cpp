@@ -83,6 +83,7 @@ void register_commands(CLI::App& app) {
   register_graph(app);
   register_synth(app, registry().runners);
   register_lights(app, registry().runners);
+  register_render(app, registry().runners);
   register_live(app, registry().runners);
 }
 

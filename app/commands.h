@@ -12,6 +12,8 @@ void register_commands(CLI::App& app);
 using Runners = std::map<const CLI::App*, std::function<int()>>;
 void register_synth(CLI::App& app, Runners& runners);
 void register_lights(CLI::App& app, Runners& runners);
+/// `relight render-reference` and `relight models` (render_command.cpp).
+void register_render(CLI::App& app, Runners& runners);
 /// `relight devices`, `relight live` and `relight record` (OpenNI2 devices, live_command.cpp).
 void register_live(CLI::App& app, Runners& runners);
 

@@ -5,6 +5,8 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
+#include "relight/core/error.h"
+
 namespace relight {
 
 namespace {
@@ -61,6 +63,57 @@ std::string lights_to_json(const LightSet& set) {
   root["irradiance_up"] = vec(irradiance(set, Eigen::Vector3d::UnitZ()));
   root["lights"] = lights;
   return root.dump(2) + "\n";
+}
+
+namespace {
+
+Eigen::Vector3d read_vec3(const nlohmann::json& entry, const char* key, const std::string& where) {
+  if (!entry.contains(key) || !entry[key].is_array() || entry[key].size() != 3)
+    throw Error(where + ": '" + key + "' must be an array of 3 numbers");
+  Eigen::Vector3d v;
+  for (int i = 0; i < 3; ++i) {
+    const nlohmann::json& x = entry[key][static_cast<std::size_t>(i)];
+    if (!x.is_number() || !std::isfinite(x.get<double>())) throw Error(where + ": '" + key + "' must hold finite numbers");
+    v[i] = x.get<double>();
+  }
+  return v;
+}
+
+}  // namespace
+
+LightSet lights_from_json(const std::string& text, const std::string& source) {
+  const nlohmann::json root = nlohmann::json::parse(text, nullptr, false);
+  if (root.is_discarded()) throw Error(source + ": not valid JSON");
+  if (!root.is_object() || !root.contains("lights") || !root["lights"].is_array())
+    throw Error(source + ": expected an object with a \"lights\" array");
+  LightSet set;
+  for (std::size_t i = 0; i < root["lights"].size(); ++i) {
+    const nlohmann::json& entry = root["lights"][i];
+    const std::string where = source + ": light " + std::to_string(i);
+    if (!entry.is_object() || !entry.contains("type") || !entry["type"].is_string())
+      throw Error(where + ": needs a \"type\" of \"directional\" or \"point\"");
+    Light light;
+    const std::string type = entry["type"].get<std::string>();
+    if (type == "directional") {
+      light.kind = LightKind::Directional;
+      light.direction = read_vec3(entry, "direction", where);
+      if (light.direction.norm() < 1e-9) throw Error(where + ": the direction must not be zero");
+      light.direction.normalize();
+    } else if (type == "point") {
+      light.kind = LightKind::Point;
+      light.position = read_vec3(entry, "position", where);
+    } else {
+      throw Error(where + ": unknown type '" + type + "' (directional or point)");
+    }
+    light.power = read_vec3(entry, "power", where);
+    if (light.power.minCoeff() < 0.0) throw Error(where + ": the power must not be negative");
+    if (entry.contains("real")) {
+      if (!entry["real"].is_boolean()) throw Error(where + ": 'real' must be true or false");
+      light.real = entry["real"].get<bool>();
+    }
+    set.lights.push_back(light);
+  }
+  return set;
 }
 
 ColorImage light_preview(const RadianceImage& probe, const ProbeGeometry& geometry, const LightSet& set) {

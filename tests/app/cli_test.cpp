@@ -7,22 +7,17 @@
 
 #include "relight/core/atomic_file.h"
 #include "relight/core/image_io.h"
-#include "run_command.h"
+#include "cli.h"
 #include "temp_dir.h"
 
 namespace relight {
 namespace {
 
+using cli_test::expect_one_line_error;
+using cli_test::relight;
+
 const std::string kRelight = RELIGHT_BIN;
 const std::filesystem::path kSample = std::filesystem::path(RELIGHT_TEST_DATA) / "tum_fr1_rpy";
-
-CommandResult relight(const std::string& arguments) { return run_command(kRelight + " " + arguments); }
-
-void expect_one_line_error(const CommandResult& result, int exit_code) {
-  EXPECT_EQ(result.exit_code, exit_code) << result.err;
-  EXPECT_EQ(result.err.rfind("relight: error: ", 0), 0u) << result.err;
-  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
-}
 
 std::size_t temporary_files_under(const std::filesystem::path& folder) {
   std::size_t count = 0;

@@ -13,6 +13,11 @@ namespace relight {
 /// world +z). Directions are in the scene frame; units as light_set.h.
 [[nodiscard]] std::string lights_to_json(const LightSet& set);
 
+/// Reads what lights_to_json writes (only "lights" is needed; "real" defaults to true). Throws
+/// relight::Error naming `source` and the entry on malformed JSON, a missing field, an unknown
+/// type, a non-finite number or negative power.
+[[nodiscard]] LightSet lights_from_json(const std::string& text, const std::string& source);
+
 /// The probe tone-mapped to 8-bit sRGB (exposure puts the 99th percentile of luminance at 0.8,
 /// brighter values clip), each directional light marked by a ring whose radius grows with the
 /// square root of its share of the power; the strongest 10 % in red, the others in green.

@@ -1,0 +1,233 @@
+// `relight render-reference`: the differential path tracer's ground truth for one frame of a
+// sequence with a virtual object (render/path_tracer.h), and `relight models`: writes the
+// procedural virtual objects shipped in data/models/.
+#include <chrono>
+#include <cmath>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "relight/capture/tum_sequence.h"
+#include "relight/colormap/color_space.h"
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+#include "relight/core/image_io.h"
+#include "relight/core/progress.h"
+#include "relight/lights/light_output.h"
+#include "relight/render/composite.h"
+#include "relight/render/depth_mesh.h"
+#include "relight/render/model_io.h"
+#include "relight/render/procedural_models.h"
+#include "relight/render/scene_from_synth.h"
+#include "relight/render/scene_lights.h"
+
+namespace relight::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+using render::MrScene;
+
+struct RenderReferenceOptions {
+  fs::path sequence;
+  int frame = 0;
+  fs::path object;
+  std::string place;
+  fs::path lights;
+  int spp = 256;
+  double time_budget = 0.0;
+  int max_bounces = 4;
+  std::uint64_t seed = 1;
+  int downsample = 1;
+  float exposure = 1.f;
+  int threads = 0;
+  fs::path out;
+  bool quiet = false;
+};
+
+/// Where a virtual object goes when --place is not given on a synthetic sequence: on the table,
+/// to the right of the marker.
+constexpr const char* kDefaultSynthPlacement = "0.35,-0.2,0.75,30";
+
+bool is_synthetic(const fs::path& sequence) {
+  const fs::path scene = sequence / "scene.json";
+  if (!fs::is_regular_file(scene)) return false;
+  const nlohmann::json json = nlohmann::json::parse(read_text_file(scene), nullptr, false);
+  if (json.is_discarded()) throw Error(scene.string() + ": not valid JSON");
+  return json.value("generator", std::string()) == "relight synth";
+}
+
+/// The real part of the scene: the synthetic scene's exact geometry, or the frame's depth mesh
+/// with the lights of --lights.
+MrScene real_scene(const RenderReferenceOptions& command, const TumSequence& sequence, const RgbdFrame& frame) {
+  if (is_synthetic(command.sequence)) {
+    MrScene scene = render::scene_from_synth(synth::default_indoor_scene());
+    if (!command.lights.empty())
+      throw Error("--lights applies to recorded sequences; a synthetic sequence brings its own lights");
+    return scene;
+  }
+  if (command.lights.empty())
+    throw Error(command.sequence.string() + " is a recorded sequence: give its lights with --lights FILE (from `relight lights`)");
+  MrScene scene;
+  render::DepthMeshMaterials materials;
+  materials.material = scene.add_material({"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
+  scene.meshes.push_back(render::mesh_from_positions(render::positions_from_depth(frame.depth, sequence.intrinsics()),
+                                                     nullptr, *frame.info.camera_to_world, materials));
+  render::add_lights(scene, lights_from_json(read_text_file(command.lights), command.lights.string()));
+  return scene;
+}
+
+PinholeIntrinsics downsampled(const PinholeIntrinsics& k, int factor) {
+  const double f = factor;
+  // Pixel centres are integers: the new pixel 0 covers old pixels 0..factor-1.
+  return {k.fx / f, k.fy / f, (k.cx + 0.5) / f - 0.5, (k.cy + 0.5) / f - 0.5, k.width / factor, k.height / factor};
+}
+
+/// Box average in linear light (so edges do not darken).
+ColorImage downsample_color(const ColorImage& image, int factor) {
+  if (factor == 1) return image;
+  ColorImage out(image.width() / factor, image.height() / factor);
+  for (int row = 0; row < out.height(); ++row)
+    for (int col = 0; col < out.width(); ++col) {
+      Float3 sum;
+      for (int dy = 0; dy < factor; ++dy)
+        for (int dx = 0; dx < factor; ++dx) sum += colormap::decode_srgb8(image(row * factor + dy, col * factor + dx));
+      out(row, col) = colormap::encode_srgb8((1.f / static_cast<float>(factor * factor)) * sum);
+    }
+  return out;
+}
+
+fs::path sibling(const fs::path& out, const std::string& suffix) {
+  fs::path path = out;
+  path.replace_filename(out.stem().string() + suffix);
+  return path;
+}
+
+int run_render_reference(const RenderReferenceOptions& command) {
+  if (command.out.extension() != ".exr") throw Error("--out must name an .exr file (L_rv goes there)");
+  // Fail on an unwritable destination now, not after minutes of rendering.
+  if (const fs::path folder = command.out.parent_path(); !folder.empty()) {
+    std::error_code ec;
+    fs::create_directories(folder, ec);
+    if (ec) throw Error("cannot create " + folder.string() + ": " + ec.message());
+  }
+  const TumSequence sequence = TumSequence::open(command.sequence);
+  if (command.frame < 0 || static_cast<std::size_t>(command.frame) >= sequence.size())
+    throw Error("frame " + std::to_string(command.frame) + " is out of range: " + command.sequence.string() + " has " +
+                std::to_string(sequence.size()) + " frames");
+  const RgbdFrame frame = sequence.load(static_cast<std::size_t>(command.frame));
+  if (!frame.info.camera_to_world)
+    throw Error("frame " + std::to_string(command.frame) + " has no camera pose (groundtruth.txt)");
+  MrScene scene = real_scene(command, sequence, frame);
+  std::string placement_text;
+  if (!command.object.empty()) {
+    placement_text = command.place;
+    if (placement_text.empty()) {
+      if (!is_synthetic(command.sequence)) throw Error("--place x,y,z[,yaw[,scale]] is needed to put the object into a recorded scene");
+      placement_text = kDefaultSynthPlacement;
+    }
+    render::add_virtual_model(scene, render::load_model(command.object), render::Placement::parse(placement_text));
+  }
+  const render::MrCamera camera{downsampled(sequence.intrinsics(), command.downsample), *frame.info.camera_to_world};
+  render::PathTracerOptions options;
+  options.max_bounces = command.max_bounces;
+  options.seed = command.seed;
+  options.threads = command.threads;
+  render::DifferentialPathTracer tracer(scene, options);
+  tracer.reset(camera);
+
+  ProgressBar progress("render-reference spp", command.spp, command.quiet);
+  const auto start = std::chrono::steady_clock::now();
+  tracer.render(command.spp, std::chrono::duration<double>(command.time_budget), [&](int done, int) { progress.update(done); });
+  progress.finish();
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const render::DifferentialImages images = tracer.images();
+
+  const colormap::ToneMap tone_map{command.exposure};
+  const ColorImage composite = render::differential_composite(downsample_color(frame.color, command.downsample),
+                                                              images.real_virtual, images.real, images.virtual_coverage,
+                                                              tone_map);
+  write_radiance(command.out, images.real_virtual);
+  write_radiance(sibling(command.out, ".Lr.exr"), images.real);
+  write_color(sibling(command.out, ".composite.png"), composite);
+  const double mrays = static_cast<double>(tracer.rays_traced()) / 1e6 / seconds;
+  nlohmann::ordered_json summary = {
+      {"sequence", fs::absolute(command.sequence).string()},
+      {"frame", command.frame},
+      {"width", camera.intrinsics.width},
+      {"height", camera.intrinsics.height},
+      {"object", command.object.empty() ? "" : fs::absolute(command.object).string()},
+      {"placement", placement_text},
+      {"samples_per_pixel", images.samples_per_pixel},
+      {"max_bounces", command.max_bounces},
+      {"seed", command.seed},
+      {"seconds", seconds},
+      {"rays", tracer.rays_traced()},
+      {"mrays_per_s", mrays},
+      {"tone_map", {{"operator", "clamp(exposure * L, 0, 1)"}, {"exposure", command.exposure}}},
+      {"outputs", {{"L_rv", command.out.filename().string()}, {"L_r", sibling(command.out, ".Lr.exr").filename().string()},
+                   {"composite", sibling(command.out, ".composite.png").filename().string()}}}};
+  write_file_atomically(sibling(command.out, ".json"), summary.dump(2) + "\n");
+  if (!command.quiet)
+    std::cerr << "relight render-reference: " << images.samples_per_pixel << " spp at " << camera.intrinsics.width << "x"
+              << camera.intrinsics.height << " in " << seconds << " s (" << mrays << " Mrays/s) -> " << command.out.string()
+              << "\n";
+  return 0;
+}
+
+void register_render_reference(CLI::App& app, Runners& runners) {
+  auto options = std::make_shared<RenderReferenceOptions>();
+  CLI::App* command = app.add_subcommand(
+      "render-reference",
+      "Path-trace the ground truth of one frame with a virtual object: L_rv, L_r and the differential composite");
+  command->add_option("--sequence", options->sequence, "TUM RGB-D folder (synthetic from `relight synth`, or recorded)")
+      ->required();
+  command->add_option("--frame", options->frame, "Frame index")->capture_default_str();
+  command->add_option("--object", options->object, "Virtual object: .obj, .gltf or .glb");
+  command->add_option("--place", options->place,
+                      std::string("Object placement x,y,z[,yaw_degrees[,scale]] in the world frame (synthetic default ") +
+                          kDefaultSynthPlacement + ")");
+  command->add_option("--lights", options->lights, "Lights JSON (from `relight lights`), needed for recorded sequences");
+  command->add_option("--spp", options->spp, "Samples per pixel")->check(CLI::Range(1, 1 << 20))->capture_default_str();
+  command->add_option("--time-budget", options->time_budget, "Stop after this many seconds (0 = no limit)")
+      ->check(CLI::NonNegativeNumber);
+  command->add_option("--max-bounces", options->max_bounces, "Indirect bounces")->check(CLI::Range(0, 1000))->capture_default_str();
+  command->add_option("--seed", options->seed, "Random seed; same seed and spp, same image")->capture_default_str();
+  command->add_option("--downsample", options->downsample, "Render at 1/N of the camera resolution")
+      ->check(CLI::IsMember({1, 2, 4, 8}))
+      ->capture_default_str();
+  command->add_option("--exposure", options->exposure, "Tone-mapping exposure for the composite")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--threads", options->threads, "Render threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  command->add_option("--out", options->out,
+                      "L_rv as OUT.exr; beside it OUT.Lr.exr, OUT.composite.png and OUT.json (spp, time, Mrays/s)")
+      ->required();
+  command->add_flag("--quiet", options->quiet, "No progress or summary on stderr");
+  runners[command] = [options] { return run_render_reference(*options); };
+}
+
+void register_models(CLI::App& app, Runners& runners) {
+  auto out = std::make_shared<fs::path>();
+  CLI::App* command = app.add_subcommand("models", "Write the procedural virtual objects (as shipped in data/models/)");
+  command->add_option("--out", *out, "Output folder")->required();
+  runners[command] = [out] {
+    fs::create_directories(*out);
+    const render::VirtualModel pebble = render::make_glossy_pebble();
+    const render::VirtualModel box = render::make_matte_box();
+    render::save_gltf(*out / (pebble.name + ".gltf"), pebble);
+    render::save_obj(*out / (box.name + ".obj"), box);
+    std::cerr << "relight models: wrote " << pebble.name << ".gltf and " << box.name << ".obj/.mtl to " << out->string()
+              << "\n";
+    return 0;
+  };
+}
+
+}  // namespace
+
+void register_render(CLI::App& app, Runners& runners) {
+  register_render_reference(app, runners);
+  register_models(app, runners);
+}
+
+}  // namespace relight::app

@@ -1,0 +1,77 @@
+// `relight render-reference` and `relight models` as users run them.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "relight/core/atomic_file.h"
+#include "relight/core/image_io.h"
+#include "temp_dir.h"
+
+namespace relight {
+namespace {
+
+using cli_test::expect_one_line_error;
+using cli_test::relight;
+
+const std::filesystem::path kData = RELIGHT_TEST_DATA;
+
+/// A one-frame synthetic sequence, made once for the whole suite.
+const std::filesystem::path& synthetic_sequence() {
+  static TempDir dir;
+  static const std::filesystem::path sequence = [] {
+    const auto path = dir.path() / "seq";
+    const auto result = relight("synth --quiet --frames 1 --no-gt --noise none --out " + path.string());
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    return path;
+  }();
+  return sequence;
+}
+
+TEST(RenderReferenceCli, WritesLrvLrCompositeAndSummary) {
+  TempDir dir;
+  const auto out = dir.path() / "nested" / "ref.exr";
+  const auto result = relight("render-reference --quiet --sequence " + synthetic_sequence().string() + " --object " +
+                              (kData / "models" / "glossy_pebble.gltf").string() +
+                              " --spp 2 --downsample 8 --out " + out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const RadianceImage lrv = read_radiance(out);
+  const RadianceImage lr = read_radiance(dir.path() / "nested" / "ref.Lr.exr");
+  EXPECT_EQ(lrv.width(), 80);
+  EXPECT_EQ(lrv.height(), 60);
+  // The pebble on the table (default placement) changes some pixels, not most.
+  int changed = 0;
+  for (std::size_t i = 0; i < lrv.size(); ++i) changed += lrv.pixels()[i] == lr.pixels()[i] ? 0 : 1;
+  EXPECT_GT(changed, 10);
+  EXPECT_LT(changed, static_cast<int>(lrv.size()) / 2);
+  EXPECT_EQ(read_color(dir.path() / "nested" / "ref.composite.png").width(), 80);
+  const auto summary = nlohmann::json::parse(read_text_file(dir.path() / "nested" / "ref.json"));
+  EXPECT_EQ(summary["samples_per_pixel"], 2);
+  EXPECT_GT(summary["mrays_per_s"].get<double>(), 0.0);
+}
+
+TEST(RenderReferenceCli, BadInputGivesOneLineErrors) {
+  TempDir dir;
+  const std::string seq = " --sequence " + synthetic_sequence().string();
+  const std::string out = " --out " + (dir.path() / "ref.exr").string();
+  expect_one_line_error(relight("render-reference --sequence /no/such/folder" + out), 1);
+  expect_one_line_error(relight("render-reference" + seq + " --out " + (dir.path() / "ref.png").string()), 1);
+  expect_one_line_error(relight("render-reference" + seq + " --frame 7" + out), 1);
+  expect_one_line_error(relight("render-reference" + seq + " --object /no/such/model.glb" + out), 1);
+  expect_one_line_error(relight("render-reference" + seq + " --object " + (kData / "models" / "matte_box.obj").string() +
+                                " --place 1,2" + out),
+                        1);
+  // A recorded sequence has no lights of its own.
+  expect_one_line_error(relight("render-reference --sequence " + (kData / "tum_fr1_rpy").string() + out), 1);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "ref.exr"));
+}
+
+TEST(ModelsCli, RegeneratesTheShippedModelsByteForByte) {
+  TempDir dir;
+  ASSERT_EQ(relight("models --out " + dir.path().string()).exit_code, 0);
+  for (const char* file : {"glossy_pebble.gltf", "matte_box.obj", "matte_box.mtl"})
+    EXPECT_EQ(read_text_file(dir.path() / file), read_text_file(kData / "models" / file)) << file;
+}
+
+}  // namespace
+}  // namespace relight

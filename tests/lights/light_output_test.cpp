@@ -1,0 +1,44 @@
+#include "relight/lights/light_output.h"
+
+#include <gtest/gtest.h>
+
+#include "relight/core/error.h"
+
+namespace relight {
+namespace {
+
+TEST(LightOutput, JsonRoundTripKeepsEveryLight) {
+  LightSet set;
+  set.lights.push_back({LightKind::Directional, Eigen::Vector3d(0, 0.6, 0.8), {}, {1.5, 1.2, 0.9}, true});
+  set.lights.push_back({LightKind::Point, {}, {0.5, -0.2, 2.0}, {3, 3, 3}, false});
+  const LightSet back = lights_from_json(lights_to_json(set), "test");
+  ASSERT_EQ(back.lights.size(), 2u);
+  EXPECT_EQ(back.lights[0].kind, LightKind::Directional);
+  EXPECT_TRUE(back.lights[0].direction.isApprox(set.lights[0].direction, 1e-12));
+  EXPECT_TRUE(back.lights[0].power.isApprox(set.lights[0].power, 1e-12));
+  EXPECT_EQ(back.lights[1].kind, LightKind::Point);
+  EXPECT_TRUE(back.lights[1].position.isApprox(set.lights[1].position, 1e-12));
+  EXPECT_FALSE(back.lights[1].real);
+}
+
+TEST(LightOutput, MalformedJsonNamesTheSourceAndTheLight) {
+  const auto message = [](const std::string& text) {
+    try {
+      (void)lights_from_json(text, "lights.json");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message("{ nope").find("lights.json: not valid JSON"), std::string::npos);
+  EXPECT_NE(message("{}").find("\"lights\" array"), std::string::npos);
+  EXPECT_NE(message(R"({"lights": [{"type": "area"}]})").find("light 0: unknown type 'area'"), std::string::npos);
+  EXPECT_NE(message(R"({"lights": [{"type": "point", "position": [0, 0], "power": [1, 1, 1]}]})").find("'position'"),
+            std::string::npos);
+  EXPECT_NE(message(R"({"lights": [{"type": "directional", "direction": [0, 0, 1], "power": [1, -1, 1]}]})")
+                .find("negative"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace relight

@@ -1,0 +1,145 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+
+#include "relight/core/error.h"
+#include "relight/render/model_io.h"
+#include "relight/render/procedural_models.h"
+#include "temp_dir.h"
+
+namespace relight::render {
+namespace {
+
+void expect_same_geometry(const VirtualModel& a, const VirtualModel& b, float tolerance) {
+  ASSERT_EQ(a.meshes.size(), b.meshes.size());
+  for (std::size_t m = 0; m < a.meshes.size(); ++m) {
+    ASSERT_EQ(a.meshes[m].triangle_count(), b.meshes[m].triangle_count());
+    // Compare triangle corners (vertex numbering may differ between formats).
+    for (std::size_t t = 0; t < a.meshes[m].triangle_count(); t += 7)
+      for (int c = 0; c < 3; ++c) {
+        const auto ca = static_cast<std::size_t>(c);
+        EXPECT_LT((a.meshes[m].positions[a.meshes[m].triangles[t][ca]] - b.meshes[m].positions[b.meshes[m].triangles[t][ca]]).norm(),
+                  tolerance);
+        EXPECT_GT(a.meshes[m].normals[a.meshes[m].triangles[t][ca]].dot(b.meshes[m].normals[b.meshes[m].triangles[t][ca]]),
+                  0.999f);
+      }
+  }
+}
+
+void expect_same_material(const PhongMaterial& a, const PhongMaterial& b) {
+  EXPECT_TRUE(a.kd.isApprox(b.kd, 1e-5f)) << a.name;
+  EXPECT_NEAR(a.ks, b.ks, 1e-5f);
+  EXPECT_NEAR(a.n, b.n, 1e-3f);
+  EXPECT_TRUE(a.emission.isApprox(b.emission, 1e-5f) || (a.emission.isZero() && b.emission.isZero()));
+}
+
+TEST(ProceduralModels, PebbleIsClosedSmoothAndStandsOnItsBase) {
+  const VirtualModel pebble = make_glossy_pebble();
+  const Eigen::AlignedBox3f box = bounds(pebble);
+  EXPECT_NEAR(box.min().y(), 0.f, 1e-6f);
+  EXPECT_GT(box.max().y(), 0.08f);
+  EXPECT_LT(box.max().y(), 0.14f);
+  EXPECT_NEAR(box.center().x(), 0.f, 0.02f);
+  const TriangleMesh& mesh = pebble.meshes.front();
+  // Closed: every edge is shared by exactly two triangles (Euler characteristic 2).
+  const long long v = static_cast<long long>(mesh.positions.size());
+  const long long f = static_cast<long long>(mesh.triangle_count());
+  EXPECT_EQ(v - 3 * f / 2 + f, 2);
+  const Eigen::Vector3f centre = box.center();
+  for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+    EXPECT_GT((mesh.positions[i] - centre).normalized().dot(mesh.normals[i]), 0.5f) << "normals point outwards";
+}
+
+TEST(ModelIo, ObjAndGltfRoundTripGeometryAndPhongMaterials) {
+  const TempDir dir;
+  for (const VirtualModel& model : {make_glossy_pebble(24), make_matte_box()}) {
+    save_obj(dir.path() / (model.name + ".obj"), model);
+    save_gltf(dir.path() / (model.name + ".gltf"), model);
+    const VirtualModel from_obj = load_model(dir.path() / (model.name + ".obj"));
+    const VirtualModel from_gltf = load_model(dir.path() / (model.name + ".gltf"));
+    expect_same_geometry(model, from_obj, 1e-6f);
+    expect_same_geometry(model, from_gltf, 0.f + 1e-7f);
+    expect_same_material(model.materials[0], from_obj.materials[0]);
+    expect_same_material(model.materials[0], from_gltf.materials[0]);
+  }
+}
+
+TEST(ModelIo, EmissiveMaterialSurvivesGltf) {
+  const TempDir dir;
+  VirtualModel lamp = make_matte_box();
+  lamp.materials[0].emission = {4.f, 3.f, 2.f};
+  save_gltf(dir.path() / "lamp.gltf", lamp);
+  EXPECT_TRUE(load_model(dir.path() / "lamp.gltf").materials[0].emission.isApprox(Eigen::Vector3f(4, 3, 2), 1e-5f));
+}
+
+TEST(ModelIo, ShippedModelsAreTheProceduralOnes) {
+  const std::filesystem::path models = std::filesystem::path(RELIGHT_TEST_DATA) / "models";
+  const VirtualModel pebble = load_model(models / "glossy_pebble.gltf");
+  expect_same_geometry(make_glossy_pebble(), pebble, 1e-6f);
+  expect_same_material(make_glossy_pebble().materials[0], pebble.materials[0]);
+  const VirtualModel box = load_model(models / "matte_box.obj");
+  expect_same_geometry(make_matte_box(), box, 1e-6f);
+  expect_same_material(make_matte_box().materials[0], box.materials[0]);
+}
+
+TEST(ModelIo, BadFilesGiveOneLineErrorsNamingTheFile) {
+  const TempDir dir;
+  const auto expect_error = [](const std::filesystem::path& path) {
+    try {
+      (void)load_model(path);
+      ADD_FAILURE() << "no error for " << path;
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(path.filename().string()), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
+  };
+  expect_error(dir.path() / "missing.gltf");
+  std::ofstream(dir.path() / "garbage.gltf") << "{ not json";
+  expect_error(dir.path() / "garbage.gltf");
+  std::ofstream(dir.path() / "empty.obj") << "# nothing\n";
+  expect_error(dir.path() / "empty.obj");
+  std::ofstream(dir.path() / "model.ply") << "ply\n";
+  expect_error(dir.path() / "model.ply");
+  // A glTF whose accessor points past its buffer.
+  save_gltf(dir.path() / "box.gltf", make_matte_box());
+  std::string text;
+  {
+    std::ifstream in(dir.path() / "box.gltf");
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const auto count = text.find("\"count\": 24");
+  ASSERT_NE(count, std::string::npos);
+  text.replace(count, 11, "\"count\": 99999");
+  std::ofstream(dir.path() / "truncated.gltf") << text;
+  expect_error(dir.path() / "truncated.gltf");
+}
+
+TEST(Placement, ParsesAndTurnsYUpIntoZUp) {
+  const Placement p = Placement::parse("0.3,-0.2,0.75,90,2");
+  EXPECT_TRUE(p.position.isApprox(Eigen::Vector3d(0.3, -0.2, 0.75)));
+  // Model up (+y) becomes world up (+z); yaw 90 deg turns model +x into world +y.
+  const Eigen::Affine3d t = p.transform();
+  EXPECT_TRUE((t.linear() * Eigen::Vector3d::UnitY()).isApprox(Eigen::Vector3d(0, 0, 2), 1e-12));
+  EXPECT_TRUE((t.linear() * Eigen::Vector3d::UnitX()).isApprox(Eigen::Vector3d(0, 2, 0), 1e-12));
+  EXPECT_THROW((void)Placement::parse("1,2"), Error);
+  EXPECT_THROW((void)Placement::parse("1,2,x"), Error);
+  EXPECT_THROW((void)Placement::parse("1,2,3,0,-1"), Error);
+}
+
+TEST(Placement, AddsTheModelAsVirtualMeshesStandingAtThePoint) {
+  MrScene scene;
+  scene.add_material({});
+  add_virtual_model(scene, make_glossy_pebble(16), Placement::parse("0.3,-0.2,0.75"));
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  EXPECT_FALSE(scene.meshes[0].real);
+  EXPECT_EQ(scene.meshes[0].triangle_material[0], 1u);
+  float lowest = 10.f;
+  for (const Eigen::Vector3f& p : scene.meshes[0].positions) lowest = std::min(lowest, p.z());
+  EXPECT_NEAR(lowest, 0.75f, 1e-5f);
+  scene.validate();
+}
+
+}  // namespace
+}  // namespace relight::render
