@@ -135,6 +135,35 @@ void create_stream(Stream& stream, Device& device, openni::SensorType type, cons
   }
 }
 
+bool usable_pair(const openni::VideoMode& depth, const openni::VideoMode& color) {
+  return depth.getPixelFormat() == openni::PIXEL_FORMAT_DEPTH_1_MM && color.getPixelFormat() == openni::PIXEL_FORMAT_RGB888 &&
+         depth.getResolutionX() == color.getResolutionX() && depth.getResolutionY() == color.getResolutionY() &&
+         depth.getFps() == color.getFps();
+}
+
+// Keeps the device's default modes when they suit relight (1 mm depth and RGB888 colour of one
+// size, as the virtual device and a Kinect give), else picks the largest such pair it supports
+// (e.g. an Xtion, whose default depth is 320x240).
+void choose_modes(Device& device, openni::VideoStream& depth, openni::VideoStream& color) {
+  if (usable_pair(depth.getVideoMode(), color.getVideoMode())) return;
+  const auto& depth_modes = device.device.getSensorInfo(openni::SENSOR_DEPTH)->getSupportedVideoModes();
+  const auto& color_modes = device.device.getSensorInfo(openni::SENSOR_COLOR)->getSupportedVideoModes();
+  int best_depth = -1, best_color = -1, best_pixels = 0;
+  for (int d = 0; d < depth_modes.getSize(); ++d) {
+    for (int c = 0; c < color_modes.getSize(); ++c) {
+      const int pixels = depth_modes[d].getResolutionX() * depth_modes[d].getResolutionY();
+      if (usable_pair(depth_modes[d], color_modes[c]) && pixels > best_pixels) {
+        best_depth = d;
+        best_color = c;
+        best_pixels = pixels;
+      }
+    }
+  }
+  if (best_depth < 0) return;  // open() reports what is wrong with the defaults
+  depth.setVideoMode(depth_modes[best_depth]);
+  color.setVideoMode(color_modes[best_color]);
+}
+
 }  // namespace
 
 std::vector<OpenNiDeviceInfo> list_openni_devices() {
@@ -216,6 +245,7 @@ void OpenNiSource::Impl::open() {
     }
     device.device.setDepthColorSyncEnabled(true);  // best effort: pairing below works without it
   }
+  if (!file) choose_modes(device, depth.stream, color.stream);
   const openni::VideoMode depth_mode = depth.stream.getVideoMode(), color_mode = color.stream.getVideoMode();
   if (depth_mode.getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_1_MM) {
     throw Error(uri + ": depth stream is not in millimetres (pixel format " +
