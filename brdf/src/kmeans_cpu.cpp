@@ -179,35 +179,67 @@ KMeansResult lloyd(KMeansEngine& engine, std::vector<Eigen::Vector3f> initial, c
   return result;
 }
 
-std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> points, int clusters, std::mt19937_64& rng) {
+std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> all_points, int clusters, std::mt19937_64& rng,
+                                               int trials, std::size_t max_points) {
   check_clusters(static_cast<std::size_t>(clusters));
-  if (points.empty()) throw Error("brdf K-means: no points to seed from");
+  if (all_points.empty()) throw Error("brdf K-means: no points to seed from");
+  // Seeding on an even-stride subset: the D^2 distribution of a few ten thousand points is the
+  // same for seeding purposes and keeps the greedy trials cheap.
+  std::vector<Float3> subset;
+  std::span<const Float3> points = all_points;
+  if (max_points > 0 && all_points.size() > max_points) {
+    const std::size_t stride = (all_points.size() + max_points - 1) / max_points;
+    for (std::size_t i = 0; i < all_points.size(); i += stride) subset.push_back(all_points[i]);
+    points = subset;
+  }
+  const std::size_t n = points.size();
+  auto distance2 = [](const Float3& p, const Eigen::Vector3f& c) {
+    const float dx = p.x - c.x(), dy = p.y - c.y(), dz = p.z - c.z();
+    return dx * dx + dy * dy + dz * dz;
+  };
   std::vector<Eigen::Vector3f> centres;
-  std::uniform_int_distribution<std::size_t> pick(0, points.size() - 1);
+  std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
   const Float3 first = points[pick(rng)];
   centres.emplace_back(first.x, first.y, first.z);
-  std::vector<double> d2(points.size(), std::numeric_limits<double>::infinity());
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<float> d2(n), trial_d2(n), best_d2(n);
+  double potential = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    d2[i] = distance2(points[i], centres[0]);
+    potential += d2[i];
+  }
   while (static_cast<int>(centres.size()) < clusters) {
-    const Eigen::Vector3f& c = centres.back();
-    double total = 0.0;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      const double dx = points[i].x - c.x(), dy = points[i].y - c.y(), dz = points[i].z - c.z();
-      d2[i] = std::min(d2[i], dx * dx + dy * dy + dz * dz);
-      total += d2[i];
-    }
-    std::size_t chosen = pick(rng);
-    if (total > 0.0) {
-      double target = unit(rng) * total;
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        target -= d2[i];
-        if (target <= 0.0) {
-          chosen = i;
-          break;
+    // Greedy k-means++ (as cv::kmeans and scikit-learn): `trials` candidates drawn by D^2, the
+    // one that lowers the potential most wins.
+    double best_potential = std::numeric_limits<double>::infinity();
+    Eigen::Vector3f best_centre = centres.back();
+    for (int t = 0; t < std::max(1, trials); ++t) {
+      std::size_t chosen = pick(rng);
+      if (potential > 0.0) {
+        double target = unit(rng) * potential;
+        for (std::size_t i = 0; i < n; ++i) {
+          target -= d2[i];
+          if (target <= 0.0) {
+            chosen = i;
+            break;
+          }
         }
       }
+      const Eigen::Vector3f candidate(points[chosen].x, points[chosen].y, points[chosen].z);
+      double trial_potential = 0.0;
+      for (std::size_t i = 0; i < n; ++i) {
+        trial_d2[i] = std::min(d2[i], distance2(points[i], candidate));
+        trial_potential += trial_d2[i];
+      }
+      if (trial_potential < best_potential) {
+        best_potential = trial_potential;
+        best_centre = candidate;
+        best_d2.swap(trial_d2);
+      }
     }
-    centres.emplace_back(points[chosen].x, points[chosen].y, points[chosen].z);
+    centres.push_back(best_centre);
+    d2.swap(best_d2);
+    potential = best_potential;
   }
   return centres;
 }

@@ -89,9 +89,12 @@ class KMeansCpu final : public KMeansEngine {
 [[nodiscard]] KMeansResult lloyd(KMeansEngine& engine, std::vector<Eigen::Vector3f> initial,
                                  const KMeansOptions& options);
 
-/// k-means++ seeding (Arthur & Vassilvitskii): first centre uniform, then D^2 sampling.
+/// k-means++ seeding (Arthur & Vassilvitskii): first centre uniform, then D^2 sampling, greedy
+/// with `trials` candidates per centre (the lowest potential wins, as in cv::kmeans), on an
+/// even-stride subset of at most `max_points` points (0: all).
 [[nodiscard]] std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> points, int clusters,
-                                                             std::mt19937_64& rng);
+                                                             std::mt19937_64& rng, int trials = 3,
+                                                             std::size_t max_points = 32768);
 
 /// `attempts` runs from k-means++ seeds, the lowest compactness kept (cv::kmeans' setting).
 [[nodiscard]] KMeansResult kmeans(KMeansEngine& engine, std::span<const Float3> points, const KMeansOptions& options,
