@@ -7,6 +7,7 @@
 // finalised, then a one-line error, exit 1).
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -153,6 +154,29 @@ std::filesystem::path temporary_oni(const std::filesystem::path& out) {
   return out.parent_path() / (out.stem().string() + ".tmp-" + std::to_string(getpid()) + ".oni");
 }
 
+// Every frame read after the recorder started must be in the file, at its device time. Played
+// back, the file's timestamps count from its first frame, which may be one frame older than the
+// first we read (it can come in while the recorder starts): try both alignments.
+std::string check_recording(const OniRecordingSummary& summary, const std::vector<std::uint64_t>& delivered_us) {
+  if (summary.depth_frames != summary.color_frames) {
+    return "the recording holds " + std::to_string(summary.depth_frames) + " depth but " +
+           std::to_string(summary.color_frames) + " colour frames";
+  }
+  if (delivered_us.empty()) return "";
+  const auto& recorded = summary.depth_timestamps_us;
+  std::string first_missing;
+  for (std::size_t first = 0; first < std::min<std::size_t>(2, recorded.size()); ++first) {
+    const std::uint64_t offset = delivered_us.front() - recorded[first];
+    const auto missing = std::find_if(delivered_us.begin(), delivered_us.end(), [&](std::uint64_t t) {
+      return !std::binary_search(recorded.begin(), recorded.end(), t - offset);
+    });
+    if (missing == delivered_us.end()) return "";
+    if (first_missing.empty()) first_missing = std::to_string(missing - delivered_us.begin());
+  }
+  return "frame " + first_missing + " of the " + std::to_string(delivered_us.size()) +
+         " delivered is missing from the recording (" + std::to_string(recorded.size()) + " frames)";
+}
+
 std::string camera_json(const PinholeIntrinsics& k, const std::string& source) {
   const nlohmann::ordered_json json = {
       {"generator", "relight record"},
@@ -185,6 +209,7 @@ int run_record(const RecordOptions& options) {
   LiveStatus status("record", options.quiet);
   const auto start = Clock::now();
   std::int64_t frames = 0;
+  std::vector<std::uint64_t> delivered_us;  // device timestamps of the frames read
   std::optional<PinholeIntrinsics> intrinsics;
   std::string failure;
   try {
@@ -192,6 +217,7 @@ int run_record(const RecordOptions& options) {
       auto frame = source.next();
       if (!frame) break;  // end of a .oni being converted
       intrinsics = frame->info.intrinsics;
+      delivered_us.push_back(source.last_timestamp_us());
       if (tum) tum->add(frame->info.timestamp, frame->color, frame->depth, frame->info.camera_to_world);
       ++frames;
       status.update(frames, source.dropped());
@@ -205,12 +231,9 @@ int run_record(const RecordOptions& options) {
   if (to_oni) {
     source.stop_recording();
     const OniRecordingSummary summary = inspect_oni(temporary);
-    // Every frame read after the recorder started must be in the file (all but possibly the first).
-    if (summary.depth_frames < frames - 1 || summary.color_frames < frames - 1) {
+    if (const std::string lost = check_recording(summary, delivered_us); !lost.empty()) {
       std::filesystem::remove(temporary);
-      throw Error(options.out.string() + ": the recording holds " + std::to_string(summary.depth_frames) + " depth and " +
-                  std::to_string(summary.color_frames) + " colour frames but " + std::to_string(frames) +
-                  " were delivered; frames were lost");
+      throw Error(options.out.string() + ": " + lost);
     }
     std::filesystem::rename(temporary, options.out);
     held = "; the file holds " + std::to_string(summary.depth_frames) + " depth and " +

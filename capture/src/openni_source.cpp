@@ -185,13 +185,30 @@ OniRecordingSummary inspect_oni(const std::filesystem::path& file) {
   OniRecordingSummary summary;
   openni::PlaybackControl* playback = device.device.getPlaybackControl();
   if (playback == nullptr) throw Error(file.string() + " did not open as a recording");
-  if (device.device.hasSensor(openni::SENSOR_DEPTH)) {
-    create_stream(depth, device, openni::SENSOR_DEPTH, "depth", file.string());
-    summary.depth_frames = playback->getNumberOfFrames(depth.stream);
-  }
   if (device.device.hasSensor(openni::SENSOR_COLOR)) {
     create_stream(color, device, openni::SENSOR_COLOR, "colour", file.string());
     summary.color_frames = playback->getNumberOfFrames(color.stream);
+  }
+  if (!device.device.hasSensor(openni::SENSOR_DEPTH)) return summary;
+  create_stream(depth, device, openni::SENSOR_DEPTH, "depth", file.string());
+  summary.depth_frames = playback->getNumberOfFrames(depth.stream);
+  playback->setRepeatEnabled(false);
+  playback->setSpeed(-1.0f);
+  // Every stream of the file is read: at speed -1 the player waits for all of them.
+  std::vector<openni::VideoStream*> streams{&depth.stream};
+  if (color.stream.isValid()) streams.push_back(&color.stream);
+  for (openni::VideoStream* stream : streams) {
+    if (stream->start() != openni::STATUS_OK) throw Error(file.string() + ": cannot play it: " + extended_error());
+  }
+  while (static_cast<std::int64_t>(summary.depth_timestamps_us.size()) < summary.depth_frames) {
+    int ready = -1;
+    openni::VideoFrameRef frame;
+    if (openni::OpenNI::waitForAnyStream(streams.data(), static_cast<int>(streams.size()), &ready, 2000) != openni::STATUS_OK ||
+        streams[static_cast<std::size_t>(ready)]->readFrame(&frame) != openni::STATUS_OK) {
+      throw Error(file.string() + ": the recording ends after " + std::to_string(summary.depth_timestamps_us.size()) +
+                  " of " + std::to_string(summary.depth_frames) + " depth frames (truncated or corrupt file)");
+    }
+    if (ready == 0) summary.depth_timestamps_us.push_back(frame.getTimestamp());
   }
   return summary;
 }

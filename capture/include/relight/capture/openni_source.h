@@ -47,9 +47,12 @@ struct OpenNiDeviceInfo {
 struct OniRecordingSummary {
   std::int64_t depth_frames = 0;
   std::int64_t color_frames = 0;
+  /// Depth timestamps in file order, microseconds; OpenNI2 plays them back relative to the first.
+  std::vector<std::uint64_t> depth_timestamps_us;
 };
 
-/// Frames in a .oni file per stream (opens it through OpenNI2's file device). Throws on a bad file.
+/// Frames in a .oni file per stream and the depth timestamps (read sequentially through OpenNI2's
+/// file device). Throws on a bad file.
 [[nodiscard]] OniRecordingSummary inspect_oni(const std::filesystem::path& file);
 
 class OpenNiSource final : public FrameSource {
