@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <vector>
 
 #include "relight/brdf/specular_fit.h"
 #include "specular_model.h"
@@ -33,58 +34,127 @@ struct SampleResidual {
   }
 };
 
+/// Residual with the lights fixed (phase 1): one block (k_s, n).
+struct ShapeResidual {
+  const SpecularSample* sample;
+  const Eigen::Vector3f* kd;
+  const ShadingLights* lights;
+
+  template <class T>
+  bool operator()(const T* shape, T* residual) const {
+    T model[3];
+    detail::model_radiance<T>(*sample, *kd, *lights, shape[0], shape[1], nullptr, 0, model);
+    for (int c = 0; c < 3; ++c) residual[c] = T(double(sample->radiance[c])) - model[c];
+    return true;
+  }
+};
+
+ceres::Solver::Options solver_options(const SpecularOptions& options) {
+  ceres::Solver::Options so;
+  so.minimizer_type = ceres::TRUST_REGION;
+  so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
+  so.linear_solver_type = ceres::DENSE_QR;
+  so.max_num_iterations = options.max_iterations;
+  so.logging_type = ceres::SILENT;
+  so.minimizer_progress_to_stdout = false;
+  so.num_threads = 1;
+  return so;
+}
+
+void bound_shape(ceres::Problem& cp, double* shape, const SpecularOptions& options) {
+  cp.SetParameterLowerBound(shape, 0, 0.0);
+  cp.SetParameterUpperBound(shape, 0, options.ks_max);
+  cp.SetParameterLowerBound(shape, 1, options.n_min);
+  cp.SetParameterUpperBound(shape, 1, options.n_max);
+}
+
+constexpr std::size_t kLightSamples = 128;
+
+/// (k_s, n) with the lights fixed; returns F (Ceres minimises half of it).
+double solve_shape(const SpecularProblem& problem, const ShadingLights& lights, const SpecularOptions& options,
+                   const ceres::Solver::Options& so, double* shape, int& iterations) {
+  ceres::Problem cp;
+  for (const SpecularSample& s : problem.samples) {
+    cp.AddResidualBlock(new ceres::AutoDiffCostFunction<ShapeResidual, 3, 2>(new ShapeResidual{&s, &problem.kd, &lights}),
+                        nullptr, shape);
+  }
+  bound_shape(cp, shape, options);
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &cp, &summary);
+  iterations += static_cast<int>(summary.iterations.size());
+  return 2.0 * summary.final_cost;
+}
+
 class CeresSolver final : public SpecularSolver {
  public:
   [[nodiscard]] std::string name() const override { return "ceres"; }
 
+  // Phase 1 fits (k_s, n) with the lights fixed; like Nelder-Mead, the lights move (phase 2,
+  // every parameter, from phase 1's optimum) only when the residual stays above
+  // light_refine_rms and the cluster is not diffuse.
   [[nodiscard]] SpecularFit fit(const SpecularProblem& problem, const SpecularOptions& options) const override {
     const std::vector<int> moving_ids = moving_light_indices(problem.lights, options.moving_lights);
     const int moving = static_cast<int>(moving_ids.size());
     const ShadingLights ordered = detail::moving_first(problem.lights, moving_ids);
-    double shape[2] = {std::clamp<double>(options.ks_start, 0.0, options.ks_max),
-                       std::clamp<double>(options.n_start, options.n_min, options.n_max)};
-    double offsets[2][3] = {{0, 0, 0}, {0, 0, 0}};
-    ceres::Problem cp;
-    for (const SpecularSample& s : problem.samples) {
-      auto* cost = new ceres::AutoDiffCostFunction<SampleResidual, 3, 2, 3, 3>(
-          new SampleResidual{&s, &problem.kd, &ordered, moving});
-      cp.AddResidualBlock(cost, nullptr, shape, offsets[0], offsets[1]);
-    }
     SpecularFit fit;
     if (problem.samples.empty()) {
       detail::finish_fit(fit, problem, options);
       return fit;
     }
-    cp.SetParameterLowerBound(shape, 0, 0.0);
-    cp.SetParameterUpperBound(shape, 0, options.ks_max);
-    cp.SetParameterLowerBound(shape, 1, options.n_min);
-    cp.SetParameterUpperBound(shape, 1, options.n_max);
-    for (int l = 0; l < 2; ++l) {
-      if (l >= moving) {
-        cp.SetParameterBlockConstant(offsets[l]);
-        continue;
+    double shape[2] = {std::clamp<double>(options.ks_start, 0.0, options.ks_max),
+                       std::clamp<double>(options.n_start, options.n_min, options.n_max)};
+    double offsets[2][3] = {{0, 0, 0}, {0, 0, 0}};
+    const ceres::Solver::Options so = solver_options(options);
+    int iterations = 0;
+    double objective = solve_shape(problem, ordered, options, so, shape, iterations);
+    const double residuals = 3.0 * static_cast<double>(problem.samples.size());
+    const bool refine = moving > 0 && shape[0] >= options.min_ks &&
+                        std::sqrt(objective / residuals) > options.light_refine_rms;
+    if (refine) {
+      // Phase 2 on a strided subset (the offsets are few and smooth), phase 3: (k_s, n) on all
+      // samples with the moved lights; kept if F drops.
+      double shape2[2] = {shape[0], shape[1]};
+      double offsets2[2][3] = {{0, 0, 0}, {0, 0, 0}};
+      std::vector<SpecularSample> subset;
+      const std::size_t stride = problem.samples.size() / kLightSamples + 1;
+      for (std::size_t i = 0; i < problem.samples.size(); i += stride) subset.push_back(problem.samples[i]);
+      ceres::Problem cp;
+      for (const SpecularSample& s : subset) {
+        auto* cost = new ceres::AutoDiffCostFunction<SampleResidual, 3, 2, 3, 3>(
+            new SampleResidual{&s, &problem.kd, &ordered, moving});
+        cp.AddResidualBlock(cost, nullptr, shape2, offsets2[0], offsets2[1]);
       }
-      const double d = ordered.lights[static_cast<std::size_t>(l)].point ? options.point_offset_max
-                                                                        : options.direction_offset_max;
-      for (int c = 0; c < 3; ++c) {
-        cp.SetParameterLowerBound(offsets[l], c, -d);
-        cp.SetParameterUpperBound(offsets[l], c, d);
+      bound_shape(cp, shape2, options);
+      for (int l = 0; l < 2; ++l) {
+        if (l >= moving) {
+          cp.SetParameterBlockConstant(offsets2[l]);
+          continue;
+        }
+        const double d = ordered.lights[static_cast<std::size_t>(l)].point ? options.point_offset_max
+                                                                          : options.direction_offset_max;
+        for (int c = 0; c < 3; ++c) {
+          cp.SetParameterLowerBound(offsets2[l], c, -d);
+          cp.SetParameterUpperBound(offsets2[l], c, d);
+        }
+      }
+      ceres::Solver::Summary summary;
+      ceres::Solve(so, &cp, &summary);
+      iterations += static_cast<int>(summary.iterations.size());
+      ShadingLights moved = ordered;
+      for (int l = 0; l < moving; ++l) {
+        for (int c = 0; c < 3; ++c) moved.lights[static_cast<std::size_t>(l)].vector[c] += static_cast<float>(offsets2[l][c]);
+      }
+      const double objective3 = solve_shape(problem, moved, options, so, shape2, iterations);
+      if (objective3 < objective) {
+        objective = objective3;
+        std::copy(shape2, shape2 + 2, shape);
+        std::copy(&offsets2[0][0], &offsets2[0][0] + 6, &offsets[0][0]);
       }
     }
-    ceres::Solver::Options so;
-    so.minimizer_type = ceres::TRUST_REGION;
-    so.trust_region_strategy_type = ceres::LEVENBERG_MARQUARDT;
-    so.linear_solver_type = ceres::DENSE_QR;
-    so.max_num_iterations = options.max_iterations;
-    so.logging_type = ceres::SILENT;
-    so.minimizer_progress_to_stdout = false;
-    so.num_threads = 1;
-    ceres::Solver::Summary summary;
-    ceres::Solve(so, &cp, &summary);
     fit.ks = static_cast<float>(shape[0]);
     fit.n = static_cast<float>(shape[1]);
-    fit.objective = 2.0 * summary.final_cost;  // Ceres minimises half the sum of squares
-    fit.evaluations = static_cast<int>(summary.iterations.size());
+    fit.objective = objective;
+    fit.evaluations = iterations;
     for (int l = 0; l < moving; ++l) {
       fit.light_offsets.emplace_back(static_cast<float>(offsets[l][0]), static_cast<float>(offsets[l][1]),
                                      static_cast<float>(offsets[l][2]));

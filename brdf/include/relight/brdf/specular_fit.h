@@ -14,8 +14,10 @@
 //     sample and light), (B) if the residual is still above light_refine_rms and the cluster is
 //     not diffuse, every parameter on a subset of 256 samples, (C) k_s and log n again on all
 //     samples with the moved lights, kept if F drops;
-//   - Ceres: one ceres::AutoDiffCostFunction per sample (3 residuals; blocks (k_s, n) and one
-//     3-vector offset per moving light), parameter bounds on every block, Levenberg-Marquardt.
+//   - Ceres: one ceres::AutoDiffCostFunction per sample (3 residuals), parameter bounds on every
+//     block, Levenberg-Marquardt, in the same phases: (k_s, n) alone; under the same condition
+//     as phase B, blocks (k_s, n) and one 3-vector offset per moving light on the 128-sample
+//     subset; (k_s, n) again on all samples with the moved lights.
 // Ceres stays out of this header (compile time, shared/design/platform.md).
 //
 // When the fit's RMS residual stays above `max_rms`, or k_s comes out below `min_ks`, the cluster
@@ -59,7 +61,7 @@ struct SpecularOptions {
   /// Nelder-Mead moves the lights only when the fit with fixed lights leaves an RMS residual
   /// above this (about one 8-bit step at mid grey) and the cluster is not diffuse.
   float light_refine_rms = 0.004f;
-  int max_iterations = 100;            ///< Ceres iterations
+  int max_iterations = 30;             ///< Ceres iterations per solve
 };
 
 struct SpecularFit {
