@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "commands.h"
 #include "relight/capture/tum_sequence.h"
@@ -34,6 +35,7 @@ struct RenderReferenceOptions {
   fs::path object;
   std::string place;
   fs::path lights;
+  std::vector<std::string> virtual_lights;
   int spp = 256;
   double time_budget = 0.0;
   int max_bounces = 4;
@@ -75,6 +77,28 @@ MrScene real_scene(const RenderReferenceOptions& command, const TumSequence& seq
                                                      nullptr, *frame.info.camera_to_world, materials));
   render::add_lights(scene, lights_from_json(read_text_file(command.lights), command.lights.string()));
   return scene;
+}
+
+/// "x,y,z,intensity[,r,g,b]": a virtual point light of radiant intensity intensity * (r,g,b) W/sr.
+render::MrLight parse_virtual_light(const std::string& text) {
+  std::vector<float> v;
+  std::stringstream stream(text);
+  std::string field;
+  while (std::getline(stream, field, ',')) {
+    char* end = nullptr;
+    v.push_back(std::strtof(field.c_str(), &end));
+    if (field.empty() || *end != '\0' || !std::isfinite(v.back()))
+      throw Error("--virtual-light '" + text + "': '" + field + "' is not a number");
+  }
+  if (v.size() != 4 && v.size() != 7) throw Error("--virtual-light '" + text + "' needs x,y,z,intensity[,r,g,b]");
+  render::MrLight light;
+  light.kind = render::LightKind::Point;
+  light.position = {v[0], v[1], v[2]};
+  const Eigen::Vector3f colour = v.size() == 7 ? Eigen::Vector3f(v[4], v[5], v[6]) : Eigen::Vector3f::Ones();
+  if (v[3] < 0.f || colour.minCoeff() < 0.f) throw Error("--virtual-light '" + text + "': intensity and colour must not be negative");
+  light.intensity = v[3] * colour;
+  light.real = false;
+  return light;
 }
 
 PinholeIntrinsics downsampled(const PinholeIntrinsics& k, int factor) {
@@ -128,6 +152,7 @@ int run_render_reference(const RenderReferenceOptions& command) {
     }
     render::add_virtual_model(scene, render::load_model(command.object), render::Placement::parse(placement_text));
   }
+  for (const std::string& light : command.virtual_lights) scene.lights.push_back(parse_virtual_light(light));
   const render::MrCamera camera{downsampled(sequence.intrinsics(), command.downsample), *frame.info.camera_to_world};
   render::PathTracerOptions options;
   options.max_bounces = command.max_bounces;
@@ -188,6 +213,8 @@ void register_render_reference(CLI::App& app, Runners& runners) {
                       std::string("Object placement x,y,z[,yaw_degrees[,scale]] in the world frame (synthetic default ") +
                           kDefaultSynthPlacement + ")");
   command->add_option("--lights", options->lights, "Lights JSON (from `relight lights`), needed for recorded sequences");
+  command->add_option("--virtual-light", options->virtual_lights,
+                      "A virtual point light x,y,z,intensity[,r,g,b] (W/sr; repeat for more)");
   command->add_option("--spp", options->spp, "Samples per pixel")->check(CLI::Range(1, 1 << 20))->capture_default_str();
   command->add_option("--time-budget", options->time_budget, "Stop after this many seconds (0 = no limit)")
       ->check(CLI::NonNegativeNumber);

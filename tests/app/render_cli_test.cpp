@@ -1,6 +1,7 @@
 // `relight render-reference` and `relight models` as users run them.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
@@ -48,6 +49,21 @@ TEST(RenderReferenceCli, WritesLrvLrCompositeAndSummary) {
   const auto summary = nlohmann::json::parse(read_text_file(dir.path() / "nested" / "ref.json"));
   EXPECT_EQ(summary["samples_per_pixel"], 2);
   EXPECT_GT(summary["mrays_per_s"].get<double>(), 0.0);
+}
+
+TEST(RenderReferenceCli, VirtualLightBrightensOnlyLrv) {
+  TempDir dir;
+  const std::string common = "render-reference --quiet --sequence " + synthetic_sequence().string() + " --spp 1 --downsample 8";
+  ASSERT_EQ(relight(common + " --out " + (dir.path() / "dark.exr").string()).exit_code, 0);
+  const auto result = relight(common + " --virtual-light 0,0,1.5,2,1,0.5,0.2 --out " + (dir.path() / "lit.exr").string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const RadianceImage lit_lr = read_radiance(dir.path() / "lit.Lr.exr"), dark_lr = read_radiance(dir.path() / "dark.Lr.exr");
+  EXPECT_TRUE(std::equal(lit_lr.pixels().begin(), lit_lr.pixels().end(), dark_lr.pixels().begin())) << "L_r ignores virtual lights";
+  double dark = 0.0, lit = 0.0;
+  for (const Float3& p : read_radiance(dir.path() / "dark.exr").pixels()) dark += p.x;
+  for (const Float3& p : read_radiance(dir.path() / "lit.exr").pixels()) lit += p.x;
+  EXPECT_GT(lit, 1.1 * dark);
+  expect_one_line_error(relight(common + " --virtual-light 0,0,1.5 --out " + (dir.path() / "x.exr").string()), 1);
 }
 
 TEST(RenderReferenceCli, BadInputGivesOneLineErrors) {
