@@ -45,6 +45,8 @@ void register_replay(CLI::App& app) {
   replay->add_option("--intrinsics", options->intrinsics, "Override intrinsics: kinect, fr1, fr2, fr3");
   replay->add_flag("--quiet", options->quiet, "No progress or summary on stderr");
   replay->add_flag("!--no-frames", options->write_frames, "Do not write per-frame images");
+  replay->add_flag("--skip-bad-frames", options->skip_bad_frames,
+                   "A TUM frame that cannot be read is skipped with a warning naming it (default: an error)");
   replay->add_option("--markers", options->markers,
                      "AprilTag layout for the camera pose: auto (the sequence's scene.json if it has a tag), "
                      "none, or a layout JSON file; writes marker_trajectory.txt")

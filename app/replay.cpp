@@ -77,7 +77,13 @@ std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options) {
     oni.intrinsics = tum.intrinsics;
     return std::make_unique<RangeSource>(std::make_unique<OpenNiSource>(oni), range);
   }
-  return std::make_unique<TumSource>(TumSequence::open(folder, tum), range.first, range.last);
+  auto source = std::make_unique<TumSource>(TumSequence::open(folder, tum), range.first, range.last);
+  if (options.skip_bad_frames) {
+    source->on_bad_frame([](std::size_t index, const std::string& message) {
+      std::cerr << "relight: warning: frame " << index << " skipped: " << message << "\n";
+    });
+  }
+  return source;
 }
 
 ReplayPipeline::ReplayPipeline() = default;

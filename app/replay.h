@@ -27,6 +27,7 @@ struct ReplayOptions {
   /// AprilTag layout for the marker pose: "auto" (the sequence's scene.json when it has a tag),
   /// "none", or a layout/scene JSON file.
   std::string markers = "auto";
+  bool skip_bad_frames = false;  ///< TUM frames that cannot be read: warn and skip instead of failing
   std::string geometry = "method1";  ///< normals: method1 (NormalsRawDepth) | method2 (DepthWarpMerge + NormalsFromPositions)
 };
 

@@ -242,11 +242,18 @@ TumSource::TumSource(TumSequence sequence, std::size_t first, std::optional<std:
 }
 
 std::optional<RgbdFrame> TumSource::next() {
-  if (next_ >= last_) return std::nullopt;
-  RgbdFrame frame = sequence_.load(next_);
-  frame.info.index = static_cast<std::int64_t>(next_ - first_);
-  ++next_;
-  return frame;
+  for (; next_ < last_; ++next_) {
+    try {
+      RgbdFrame frame = sequence_.load(next_);
+      frame.info.index = static_cast<std::int64_t>(next_ - first_);
+      ++next_;
+      return frame;
+    } catch (const Error& e) {
+      if (!on_bad_frame_) throw;
+      on_bad_frame_(next_, e.what());
+    }
+  }
+  return std::nullopt;
 }
 
 std::string TumSource::describe() const {

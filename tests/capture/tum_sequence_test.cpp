@@ -145,6 +145,29 @@ TEST_F(DamagedSequence, MissingImage) {
   EXPECT_NE(message.find("1305031229.596617.png"), std::string::npos) << message;
 }
 
+TEST_F(DamagedSequence, MissingImageIsSkippedWhenAskedWithItsIndex) {
+  std::filesystem::remove(folder_ / "depth" / "1305031229.596617.png");
+  TumSource strict(TumSequence::open(folder_));
+  std::string error;
+  try {
+    while (strict.next()) {
+    }
+  } catch (const Error& e) {
+    error = e.what();
+  }
+  EXPECT_NE(error.find("1305031229.596617.png"), std::string::npos) << error;
+
+  TumSource lenient(TumSequence::open(folder_));
+  std::vector<std::pair<std::size_t, std::string>> skipped;
+  lenient.on_bad_frame([&](std::size_t index, const std::string& message) { skipped.emplace_back(index, message); });
+  std::vector<std::int64_t> read;
+  while (auto frame = lenient.next()) read.push_back(frame->info.index);
+  ASSERT_EQ(skipped.size(), 1u);
+  EXPECT_NE(skipped[0].second.find("1305031229.596617.png"), std::string::npos);
+  EXPECT_EQ(read.size() + 1, TumSequence::open(folder_).size());
+  EXPECT_EQ(std::count(read.begin(), read.end(), static_cast<std::int64_t>(skipped[0].first)), 0);
+}
+
 TEST_F(DamagedSequence, CorruptImage) {
   const auto file = folder_ / "rgb" / "1305031229.564425.png";
   const std::string bytes = read_text_file(file);

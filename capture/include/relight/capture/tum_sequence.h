@@ -14,6 +14,7 @@
 // Every problem (missing folder or list, malformed or unsorted line, missing/corrupt/8-bit image)
 // throws relight::Error naming the file and line.
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,8 +83,14 @@ class TumSource final : public FrameSource {
   [[nodiscard]] std::optional<RgbdFrame> next() override;
   [[nodiscard]] std::int64_t size_hint() const override { return static_cast<std::int64_t>(last_ - first_); }
   [[nodiscard]] std::string describe() const override;
+  /// With a handler, a frame that cannot be read (missing or corrupt image) is reported to it with
+  /// its index in the folder and skipped; without one (the default) it throws relight::Error.
+  void on_bad_frame(std::function<void(std::size_t index, const std::string& message)> handler) {
+    on_bad_frame_ = std::move(handler);
+  }
 
  private:
+  std::function<void(std::size_t, const std::string&)> on_bad_frame_;
   TumSequence sequence_;
   std::size_t first_;
   std::size_t last_;
