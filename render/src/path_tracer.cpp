@@ -8,66 +8,12 @@
 #include "relight/core/parallel.h"
 #include "relight/render/phong_brdf.h"
 #include "relight/render/sampler.h"
+#include "surface_shading.h"
 
 namespace relight::render {
 namespace {
 
-using Vec3 = Eigen::Vector3f;
-
-/// A surface point prepared for shading: both normals on the side the ray came from.
-struct Vertex {
-  Vec3 point;
-  Vec3 geometric_normal;
-  Vec3 shading_normal;
-  Vec3 wo;
-  const PhongMaterial* material = nullptr;
-};
-
-Vertex make_vertex(const SurfaceHit& hit, const Vec3& direction, const MrScene& scene) {
-  Vertex v;
-  v.point = hit.point;
-  v.wo = -direction;
-  v.geometric_normal = hit.geometric_normal.dot(v.wo) < 0.f ? Vec3(-hit.geometric_normal) : hit.geometric_normal;
-  v.shading_normal = hit.shading_normal.dot(v.geometric_normal) < 0.f ? Vec3(-hit.shading_normal) : hit.shading_normal;
-  // An interpolated normal can face away from a grazing viewer; shade with the true one there.
-  if (v.shading_normal.dot(v.wo) <= 0.f) v.shading_normal = v.geometric_normal;
-  v.material = &scene.materials[hit.material];
-  return v;
-}
-
-/// Ray origin just off the surface on the side `direction` leaves towards (avoids self-hits).
-Vec3 offset_origin(const Vertex& v, const Vec3& direction) {
-  const float scale = 1e-4f * (1.f + v.point.cwiseAbs().maxCoeff());
-  const float side = direction.dot(v.geometric_normal) >= 0.f ? 1.f : -1.f;
-  return v.point + side * scale * v.geometric_normal;
-}
-
-struct LightSample {
-  Vec3 wi;
-  float distance = 0.f;  ///< infinity for directional lights
-  Vec3 irradiance;       ///< at normal incidence
-};
-
-float spot_falloff(const MrLight& light, const Vec3& from_light) {
-  const float c = light.direction.normalized().dot(from_light);
-  if (c <= light.cos_outer) return 0.f;
-  if (c >= light.cos_inner) return 1.f;
-  const float x = (c - light.cos_outer) / (light.cos_inner - light.cos_outer);
-  return x * x * (3.f - 2.f * x);
-}
-
-std::optional<LightSample> sample_light(const MrLight& light, const Vec3& point) {
-  if (light.kind == LightKind::Directional)
-    return LightSample{light.direction.normalized(), std::numeric_limits<float>::infinity(), light.intensity};
-  const Vec3 to_light = light.position - point;
-  const float distance2 = to_light.squaredNorm();
-  if (!(distance2 > 0.f)) return std::nullopt;
-  const float distance = std::sqrt(distance2);
-  const Vec3 wi = to_light / distance;
-  const float falloff = light.kind == LightKind::Spot ? spot_falloff(light, -wi) : 1.f;
-  if (falloff <= 0.f) return std::nullopt;
-  return LightSample{wi, distance, light.intensity * (falloff / distance2)};
-}
+using namespace detail;
 
 class PathIntegrator {
  public:
@@ -85,8 +31,6 @@ class PathIntegrator {
                    Pcg32& rng, std::uint32_t& rays) const;
   std::optional<SurfaceHit> nearest(const Vec3& origin, const Vec3& direction, bool with_virtual,
                                     std::uint32_t& rays) const;
-  /// Next-event estimate of `light` at v (without visibility), or zero.
-  static Vec3 direct(const Vertex& v, const LightSample& sample);
   /// Samples the continuation; false when the path ends (bounce limit, absorption, roulette).
   bool continue_path(const Vertex& v, int bounce, Vec3& throughput, Vec3& origin, Vec3& direction, Pcg32& rng) const;
 
@@ -104,13 +48,6 @@ std::optional<SurfaceHit> PathIntegrator::nearest(const Vec3& origin, const Vec3
   std::optional<SurfaceHit> virtual_hit = tracer_.intersect(
       Layer::Virtual, origin, direction, hit ? hit->t : std::numeric_limits<float>::infinity());
   return virtual_hit ? virtual_hit : hit;
-}
-
-Vec3 PathIntegrator::direct(const Vertex& v, const LightSample& sample) {
-  if (sample.wi.dot(v.geometric_normal) <= 0.f) return Vec3::Zero();
-  const float cos_i = sample.wi.dot(v.shading_normal);
-  if (cos_i <= 0.f) return Vec3::Zero();
-  return phong_brdf(*v.material, v.shading_normal, sample.wi, v.wo).cwiseProduct(sample.irradiance) * cos_i;
 }
 
 bool PathIntegrator::continue_path(const Vertex& v, int bounce, Vec3& throughput, Vec3& origin, Vec3& direction,
@@ -145,7 +82,7 @@ void PathIntegrator::trace_layer(Vec3 origin, Vec3 direction, int bounce, bool w
       if (!with_virtual && !light.real) continue;
       const std::optional<LightSample> sample = sample_light(light, v.point);
       if (!sample) continue;
-      const Vec3 contribution = direct(v, *sample);
+      const Vec3 contribution = direct_light(v, *sample);
       if (contribution.isZero()) continue;
       const Vec3 from = offset_origin(v, sample->wi);
       const float reach = sample->distance * (1.f - 1e-4f);
@@ -196,7 +133,7 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
     for (const MrLight& light : scene_.lights) {
       const std::optional<LightSample> sample = sample_light(light, v.point);
       if (!sample) continue;
-      const Vec3 contribution = direct(v, *sample);
+      const Vec3 contribution = direct_light(v, *sample);
       if (contribution.isZero()) continue;
       const Vec3 from = offset_origin(v, sample->wi);
       const float reach = sample->distance * (1.f - 1e-4f);

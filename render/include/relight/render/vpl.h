@@ -1,0 +1,57 @@
+#pragma once
+// Virtual point lights (VPLs) for differential instant radiosity (Knecht et al., ISMAR 2010;
+// dissertation §5.2.3-5.2.6).
+//
+// A VPL is a point where light from a primary light (or from another VPL) is reflected. In
+// differential rendering every light path exists in up to two worlds: the real+virtual world
+// (L_rv) and the real-only world (L_r). A VPL records which:
+//   in_real_virtual  the path to it is valid with the virtual objects present,
+//   in_real          the path to it is valid without them (real light, real vertices only).
+// In Knecht's notation r(x̄)·r(VPL) = in_real and (1 - ir(VPL)) = in_real_virtual; a VPL with
+// in_real and not in_real_virtual is the "illuminate real only" VPL (VPL3 of Fig. 5.7): the
+// real surface behind a virtual object keeps its light in L_r, so that the difference removes
+// its colour bleeding from the camera image.
+//
+// Generation: each light sample is traced against the real layer and the virtual layer (the two
+// RSMs of a real spot light). If the real hit is nearer, one VPL holds both flags of its parent;
+// if a virtual object is in front, the virtual hit becomes a VPL of the real+virtual world and
+// the real hit a VPL of the real-only world. Multi-bounce VPLs continue from a VPL by importance
+// sampling its Phong BRDF (phong_brdf.h), and flags multiply along the path.
+//
+// Flux (W, RGB): a light of intensity I sampled with density p(omega) over N samples gives each
+// first-bounce VPL Phi = I(omega) / (p(omega) N), so that its contribution to a point x is
+//   Phi f_y(omega_in, y->x) f_x(y->x, omega_o) cos(theta_y) cos(theta_x) / |x - y|^2.
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "relight/render/mr_scene.h"
+#include "relight/render/ray_tracer.h"
+
+namespace relight::render {
+
+struct Vpl {
+  Eigen::Vector3f position;
+  Eigen::Vector3f normal;    ///< unit, on the side the light arrived from
+  Eigen::Vector3f incident;  ///< unit, from the VPL towards where its light came from
+  Eigen::Vector3f flux;
+  std::uint32_t material = 0;
+  bool on_real_surface = true;  ///< r(VPL)
+  bool in_real_virtual = true;
+  bool in_real = true;
+  int bounce = 1;  ///< 1 = lit directly by a primary light
+};
+
+enum class VplBudget { Equal, ByPower };
+
+struct VplOptions {
+  int count = 256;      ///< first-bounce light samples (each may yield two VPLs, see above)
+  int bounces = 1;      ///< 1 = one indirect bounce; 2 adds VPLs lit by VPLs
+  VplBudget budget = VplBudget::ByPower;
+  std::uint64_t seed = 1;
+};
+
+/// VPLs of the point and spot lights of `scene` (directional lights light directly only).
+[[nodiscard]] std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options);
+
+}  // namespace relight::render

@@ -1,0 +1,152 @@
+#include "relight/render/vpl.h"
+
+#include <cmath>
+#include <numbers>
+
+#include "relight/core/error.h"
+#include "relight/render/phong_brdf.h"
+#include "relight/render/sampler.h"
+#include "surface_shading.h"
+
+namespace relight::render {
+namespace {
+
+using Vec3 = Eigen::Vector3f;
+constexpr float kPi = std::numbers::pi_v<float>;
+
+float luminance(const Vec3& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
+
+/// Solid angle a light emits into (the spot's cone up to its outer edge).
+float emission_solid_angle(const MrLight& light) {
+  return light.kind == LightKind::Spot ? 2.f * kPi * (1.f - light.cos_outer) : 4.f * kPi;
+}
+
+bool emits_vpls(const MrLight& light) { return light.kind != LightKind::Directional; }
+
+struct LightSample {
+  Vec3 direction;
+  Vec3 intensity_over_pdf;
+};
+
+/// Uniform over the sphere (point light) or the spot's cone; u1 is stratified by the caller.
+LightSample sample_light_direction(const MrLight& light, float u1, float u2) {
+  const float phi = 2.f * kPi * u2;
+  if (light.kind == LightKind::Spot) {
+    const Vec3 axis = light.direction.normalized();
+    const float cos_theta = 1.f - u1 * (1.f - light.cos_outer);
+    const float sin_theta = std::sqrt(std::max(0.f, 1.f - cos_theta * cos_theta));
+    Vec3 t, b;
+    orthonormal_basis(axis, t, b);
+    const Vec3 direction = (sin_theta * std::cos(phi) * t + sin_theta * std::sin(phi) * b + cos_theta * axis).normalized();
+    return {direction, light.intensity * (detail::spot_falloff(light, direction) * emission_solid_angle(light))};
+  }
+  const float z = 1.f - 2.f * u1;
+  const float r = std::sqrt(std::max(0.f, 1.f - z * z));
+  return {Vec3(r * std::cos(phi), r * std::sin(phi), z), light.intensity * (4.f * kPi)};
+}
+
+class VplTracer {
+ public:
+  VplTracer(const MrScene& scene, const RayTracer& tracer, const VplOptions& options, std::vector<Vpl>& out)
+      : scene_(scene), tracer_(tracer), options_(options), out_(out) {}
+
+  /// Follows one light path segment and records the VPL(s) it ends in.
+  void emit(const Vec3& origin, const Vec3& direction, const Vec3& flux, bool in_real_virtual, bool in_real, int bounce,
+            Pcg32& rng) {
+    if (flux.maxCoeff() <= 0.f || (!in_real_virtual && !in_real)) return;
+    const std::optional<SurfaceHit> real = tracer_.intersect(Layer::Real, origin, direction);
+    const std::optional<SurfaceHit> virtual_hit =
+        tracer_.intersect(Layer::Virtual, origin, direction, real ? real->t : std::numeric_limits<float>::infinity());
+    if (virtual_hit) {
+      // The two worlds part here: the virtual surface is lit with the virtual objects present,
+      // the real surface behind it only without them.
+      add(*virtual_hit, direction, flux, in_real_virtual, false, bounce, rng);
+      if (real) add(*real, direction, flux, false, in_real, bounce, rng);
+    } else if (real) {
+      add(*real, direction, flux, in_real_virtual, in_real, bounce, rng);
+    }
+  }
+
+ private:
+  void add(const SurfaceHit& hit, const Vec3& direction, const Vec3& flux, bool in_real_virtual, bool in_real, int bounce,
+           Pcg32& rng) {
+    if (!in_real_virtual && !in_real) return;
+    Vpl vpl;
+    vpl.position = hit.point;
+    vpl.incident = -direction;
+    const Vec3 geometric = hit.geometric_normal.dot(vpl.incident) < 0.f ? Vec3(-hit.geometric_normal) : hit.geometric_normal;
+    vpl.normal = hit.shading_normal.dot(geometric) < 0.f ? Vec3(-hit.shading_normal) : hit.shading_normal;
+    if (vpl.normal.dot(vpl.incident) <= 0.f) vpl.normal = geometric;
+    vpl.flux = flux;
+    vpl.material = hit.material;
+    vpl.on_real_surface = hit.real;
+    vpl.in_real_virtual = in_real_virtual;
+    vpl.in_real = in_real;
+    vpl.bounce = bounce;
+    out_.push_back(vpl);
+    if (bounce >= options_.bounces) return;
+    // Continue the light path by sampling the VPL's BRDF (reciprocity: wo = where light came from).
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    const auto sample = sample_phong(scene_.materials[vpl.material], vpl.normal, vpl.incident, u1, u2);
+    if (!sample || sample->wi.dot(geometric) <= 0.f) return;
+    const float offset = 1e-4f * (1.f + vpl.position.cwiseAbs().maxCoeff());
+    emit(vpl.position + offset * geometric, sample->wi, flux.cwiseProduct(sample->weight), vpl.in_real_virtual,
+         vpl.in_real, bounce + 1, rng);
+  }
+
+  const MrScene& scene_;
+  const RayTracer& tracer_;
+  const VplOptions& options_;
+  std::vector<Vpl>& out_;
+};
+
+/// Light samples per light: equal shares, or shares by emitted power (luminance x solid angle).
+std::vector<int> light_budget(const MrScene& scene, const VplOptions& options) {
+  std::vector<double> weight;
+  double total = 0.0;
+  for (const MrLight& light : scene.lights) {
+    double w = 0.0;
+    if (emits_vpls(light))
+      w = options.budget == VplBudget::Equal ? 1.0 : std::max(0.f, luminance(light.intensity)) * emission_solid_angle(light);
+    weight.push_back(w);
+    total += w;
+  }
+  std::vector<int> count(scene.lights.size(), 0);
+  if (total <= 0.0) return count;
+  // Largest remainder, so that the shares add up to options.count exactly.
+  int given = 0;
+  std::vector<std::pair<double, std::size_t>> remainder;
+  for (std::size_t i = 0; i < weight.size(); ++i) {
+    const double exact = options.count * weight[i] / total;
+    count[i] = static_cast<int>(std::floor(exact));
+    given += count[i];
+    remainder.emplace_back(exact - count[i], i);
+  }
+  std::sort(remainder.begin(), remainder.end(), std::greater<>());
+  for (int i = 0; i < options.count - given; ++i) ++count[remainder[static_cast<std::size_t>(i) % remainder.size()].second];
+  return count;
+}
+
+}  // namespace
+
+std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options) {
+  if (options.count < 0) throw Error("the VPL count must not be negative");
+  if (options.bounces < 1) throw Error("VPLs need at least one bounce");
+  std::vector<Vpl> vpls;
+  VplTracer vpl_tracer(scene, tracer, options, vpls);
+  const std::vector<int> budget = light_budget(scene, options);
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    const MrLight& light = scene.lights[l];
+    const int n = budget[l];
+    for (int i = 0; i < n; ++i) {
+      Pcg32 rng = Pcg32::for_sample(options.seed, l, static_cast<std::uint64_t>(i));
+      const float u1 = (static_cast<float>(i) + rng.uniform()) / static_cast<float>(n);  // stratified
+      const LightSample sample = sample_light_direction(light, u1, rng.uniform());
+      vpl_tracer.emit(light.position, sample.direction, sample.intensity_over_pdf / static_cast<float>(n), true, light.real,
+                      1, rng);
+    }
+  }
+  return vpls;
+}
+
+}  // namespace relight::render

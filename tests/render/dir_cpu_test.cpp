@@ -1,0 +1,210 @@
+// Differential instant radiosity on the CPU: the four light interactions of Knecht's Fig. 5.7,
+// no double shadowing (Figs. 5.5/5.6), VPL generation, and agreement with the path tracer.
+#include "relight/render/dir_cpu.h"
+
+#include <gtest/gtest.h>
+
+#include <numbers>
+
+#include "relight/core/error.h"
+#include "test_scenes.h"
+
+namespace relight::render {
+namespace {
+
+using test::camera_at;
+using test::diffuse;
+using test::floor_scene;
+
+Eigen::Vector3d mean_over(const RadianceImage& image, const std::vector<std::pair<int, int>>& pixels) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const auto& [row, col] : pixels) sum += Eigen::Vector3d(image(row, col).x, image(row, col).y, image(row, col).z);
+  return sum / static_cast<double>(std::max<std::size_t>(1, pixels.size()));
+}
+
+/// Pixels whose centre ray first meets the real floor inside the box [lo, hi] (x, y).
+std::vector<std::pair<int, int>> floor_pixels(const MrScene& scene, const MrCamera& camera, const Eigen::Vector2f& lo,
+                                              const Eigen::Vector2f& hi) {
+  const RayTracer tracer(scene);
+  std::vector<std::pair<int, int>> pixels;
+  const Eigen::Vector3f origin = camera.camera_to_world.translation().cast<float>();
+  for (int row = 0; row < camera.intrinsics.height; ++row)
+    for (int col = 0; col < camera.intrinsics.width; ++col) {
+      const Eigen::Vector3f d = (camera.camera_to_world.linear() * camera.intrinsics.ray(col, row).normalized()).cast<float>();
+      const auto real = tracer.intersect(Layer::Real, origin, d);
+      if (!real || tracer.occluded(Layer::Virtual, origin, d, real->t)) continue;
+      const Eigen::Vector2f p = real->point.head<2>();
+      if (std::abs(real->point.z()) < 1e-4f && (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all())
+        pixels.emplace_back(row, col);
+    }
+  return pixels;
+}
+
+struct Rendered {
+  DifferentialImages images;
+  std::vector<Vpl> vpls;
+};
+
+Rendered render_dir(const MrScene& scene, const MrCamera& camera, int vpl_count, DirOptions options = {}) {
+  const RayTracer tracer(scene);
+  VplOptions vpl_options;
+  vpl_options.count = vpl_count;
+  Rendered out;
+  out.vpls = generate_vpls(scene, tracer, vpl_options);
+  out.images = shade_instant_radiosity(scene, tracer, camera, out.vpls, options);
+  return out;
+}
+
+/// A white floor, a real light to the right, and a red virtual cube on the floor.
+MrScene cube_scene() {
+  MrScene scene = floor_scene(Eigen::Vector3f::Constant(0.8f), {1.0f, 0.f, 1.5f}, 4.f);
+  test::add_virtual_box(scene, synth::Box{{-0.2, -0.2, 0.0}, {0.2, 0.2, 0.4}}, diffuse({0.9f, 0.1f, 0.1f}, "red cube"));
+  return scene;
+}
+
+TEST(DirCpu, VirtualCubeBleedsRedOntoTheRealFloorOnlyInLrv) {
+  const MrScene scene = cube_scene();
+  const MrCamera camera = camera_at({0.3, -1.6, 1.3}, {0.2, 0, 0}, 96, 72);
+  const Rendered r = render_dir(scene, camera, 512);
+  const auto pixels = floor_pixels(scene, camera, {0.25f, -0.15f}, {0.6f, 0.15f});
+  ASSERT_GT(pixels.size(), 40u);
+  const Eigen::Vector3d lr = mean_over(r.images.real, pixels);
+  const Eigen::Vector3d delta = mean_over(r.images.real_virtual, pixels) - lr;
+  EXPECT_NEAR(lr.x(), lr.y(), 1e-6 * lr.x()) << "white floor, white light: no colour in L_r";
+  EXPECT_GT(delta.x(), 0.02 * lr.x());
+  EXPECT_GT(delta.x(), 5.0 * std::abs(delta.y()));
+}
+
+TEST(DirCpu, VirtualShadowOnTheRealFloorRemovesExactlyTheDirectLight) {
+  const MrScene scene = cube_scene();
+  const MrCamera camera = camera_at({-1.2, -1.4, 1.4}, {-0.3, 0, 0}, 96, 72);
+  const Rendered r = render_dir(scene, camera, 256);
+  // The cube's umbra lies on the far side from the light (x < -0.2, |y| < 0.15 near the cube).
+  const auto pixels = floor_pixels(scene, camera, {-0.45f, -0.12f}, {-0.25f, 0.12f});
+  ASSERT_GT(pixels.size(), 20u);
+  for (const auto& [row, col] : pixels) {
+    const float lr = r.images.real(row, col).x, lrv = r.images.real_virtual(row, col).x;
+    EXPECT_LT(lrv, 0.05f * lr) << "only the (tiny) indirect light is left in the virtual shadow";
+  }
+}
+
+TEST(DirCpu, RealFloorBleedsOntoTheVirtualCubeInLrvAndLrIsZeroThere) {
+  const MrScene scene = cube_scene();
+  const MrCamera camera = camera_at({-1.4, -0.3, 0.6}, {0, 0, 0.2}, 64, 48);
+  DirOptions no_direct;
+  no_direct.direct = false;
+  const Rendered r = render_dir(scene, camera, 512, no_direct);
+  int cube_pixels = 0, lit = 0;
+  for (int row = 0; row < 48; ++row)
+    for (int col = 0; col < 64; ++col) {
+      if (r.images.virtual_coverage(row, col) == 0.f) continue;
+      ++cube_pixels;
+      EXPECT_EQ(r.images.real(row, col), Float3{}) << "r(p) = 0 on virtual surfaces";
+      lit += r.images.real_virtual(row, col).x > 0.f ? 1 : 0;
+    }
+  ASSERT_GT(cube_pixels, 100);
+  EXPECT_GT(lit, cube_pixels * 3 / 4) << "light from the floor's VPLs reaches the cube's shadowed side";
+}
+
+TEST(DirCpu, RealWallBehindAVirtualOccluderBleedsOnlyInLr) {
+  // The "illuminate real only" VPLs (VPL3 of Fig. 5.7): the virtual box shades part of a red real
+  // wall; in L_r that part still bleeds red onto the floor, so the difference removes red there.
+  MrScene scene = floor_scene(Eigen::Vector3f::Constant(0.8f), {0.f, 0.f, 1.0f}, 4.f);
+  const std::uint32_t red = scene.add_material(diffuse({0.9f, 0.05f, 0.05f}, "red wall"));
+  TriangleMesh wall = tessellate(synth::Box{{1.0, -1.0, 0.0}, {1.05, 1.0, 1.2}}, red);
+  scene.meshes.push_back(wall);
+  test::add_virtual_box(scene, synth::Box{{0.5, -0.5, 0.65}, {0.7, 0.5, 1.4}}, diffuse(Eigen::Vector3f::Constant(0.5f)));
+  const MrCamera camera = camera_at({-0.6, -1.5, 1.2}, {0.8, 0, 0.2}, 96, 72);
+  const Rendered r = render_dir(scene, camera, 1024);
+  int real_only = 0;
+  for (const Vpl& vpl : r.vpls) {
+    if (vpl.in_real && !vpl.in_real_virtual) {
+      ++real_only;
+      EXPECT_TRUE(vpl.on_real_surface);
+      EXPECT_NEAR(vpl.position.x(), 1.0f, 1e-3f) << "on the wall the box hides from the light";
+    }
+    if (!vpl.on_real_surface) {
+      EXPECT_FALSE(vpl.in_real);
+    }
+  }
+  EXPECT_GT(real_only, 20);
+  const auto pixels = floor_pixels(scene, camera, {0.8f, -0.2f}, {0.95f, 0.2f});
+  ASSERT_GT(pixels.size(), 20u);
+  const Eigen::Vector3d delta = mean_over(r.images.real_virtual, pixels) - mean_over(r.images.real, pixels);
+  EXPECT_LT(delta.x(), 0.0);
+  EXPECT_GT(-delta.x(), 5.0 * std::abs(delta.y()));
+}
+
+TEST(DirCpu, RealBlockerBehindAVirtualOneDoesNotShadowTwice) {
+  MrScene scene = floor_scene(Eigen::Vector3f::Constant(0.8f), {0.f, 0.f, 2.0f}, 4.f);
+  const std::uint32_t grey = scene.add_material(diffuse(Eigen::Vector3f::Constant(0.5f)));
+  scene.meshes.push_back(tessellate(synth::Box{{-0.2, -0.2, 0.5}, {0.2, 0.2, 0.6}}, grey));  // real blocker
+  test::add_virtual_box(scene, synth::Box{{-0.25, -0.25, 1.0}, {0.25, 0.25, 1.1}}, diffuse(Eigen::Vector3f::Constant(0.5f)));
+  const MrCamera camera = camera_at({0.0, -1.6, 1.2}, {0, 0, 0}, 64, 48);
+  DirOptions direct_only;
+  direct_only.indirect = false;
+  const Rendered r = render_dir(scene, camera, 0, direct_only);
+  // Under both blockers the floor is dark in both worlds: the difference is zero there, not a
+  // second shadow.
+  const auto pixels = floor_pixels(scene, camera, {-0.15f, -0.15f}, {0.15f, 0.15f});
+  ASSERT_GT(pixels.size(), 10u);
+  for (const auto& [row, col] : pixels) {
+    EXPECT_EQ(r.images.real_virtual(row, col), r.images.real(row, col));
+    EXPECT_EQ(r.images.real(row, col).x, 0.f);
+  }
+}
+
+TEST(Vpls, FirstBounceFluxAddsUpToTheLightsPowerAndFollowsTheBudget) {
+  // A point light inside a closed box: every light sample ends on a surface.
+  MrScene scene;
+  const std::uint32_t white = scene.add_material(diffuse(Eigen::Vector3f::Constant(0.5f)));
+  scene.meshes.push_back(tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
+  MrLight strong, weak;
+  strong.position = {0.2f, 0.f, 0.f};
+  strong.intensity = Eigen::Vector3f::Constant(3.f);
+  weak.position = {-0.2f, 0.f, 0.f};
+  weak.intensity = Eigen::Vector3f::Constant(1.f);
+  scene.lights = {strong, weak};
+  const RayTracer tracer(scene);
+  VplOptions options;
+  options.count = 400;
+  const std::vector<Vpl> vpls = generate_vpls(scene, tracer, options);
+  ASSERT_EQ(vpls.size(), 400u);
+  Eigen::Vector3d flux = Eigen::Vector3d::Zero();
+  for (const Vpl& vpl : vpls) {
+    flux += vpl.flux.cast<double>();
+    EXPECT_TRUE(vpl.in_real && vpl.in_real_virtual);
+    EXPECT_GT(vpl.normal.dot(vpl.incident), 0.f);
+  }
+  EXPECT_NEAR(flux.x(), 4.0 * 4.0 * std::numbers::pi, 1e-3);  // (3 + 1) W/sr over the sphere
+  options.bounces = 2;
+  const std::vector<Vpl> two = generate_vpls(scene, tracer, options);
+  EXPECT_GT(two.size(), 700u);  // nearly every first-bounce VPL continues in a closed box
+  EXPECT_THROW((void)generate_vpls(scene, tracer, VplOptions{-1}), Error);
+}
+
+TEST(DirCpu, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions) {
+  // One indirect bounce in both; no sky, so both estimate the same light transport.
+  const MrScene scene = cube_scene();
+  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 48, 36);
+  PathTracerOptions pt_options;
+  pt_options.max_bounces = 1;
+  pt_options.roulette_from = 10;
+  const DifferentialImages pt = render_reference(scene, camera, 256, pt_options);
+  DirOptions options;
+  options.min_distance = 0.02f;
+  // Few VPLs land on the small cube face that causes the bleeding; 8192 light samples put ~40 there.
+  const Rendered dir = render_dir(scene, camera, 8192, options);
+  const auto compare = [&](const Eigen::Vector2f& lo, const Eigen::Vector2f& hi) {
+    const auto pixels = floor_pixels(scene, camera, lo, hi);
+    EXPECT_GT(pixels.size(), 8u);
+    const Eigen::Vector3d d_pt = mean_over(pt.real_virtual, pixels) - mean_over(pt.real, pixels);
+    const Eigen::Vector3d d_dir = mean_over(dir.images.real_virtual, pixels) - mean_over(dir.images.real, pixels);
+    return (d_dir - d_pt).norm() / d_pt.norm();
+  };
+  EXPECT_LT(compare({-0.45f, -0.12f}, {-0.25f, 0.12f}), 0.15) << "shadow region";
+  EXPECT_LT(compare({0.22f, -0.15f}, {0.45f, 0.15f}), 0.15) << "bleeding region";
+}
+
+}  // namespace
+}  // namespace relight::render
