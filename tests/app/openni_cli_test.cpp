@@ -54,6 +54,11 @@ std::vector<std::uint16_t> ground_truth_mm(std::int64_t k) {
   return to_mm(rendered.depth);
 }
 
+// Shell loop waiting (at most 30 s) until a file matching `pattern` exists.
+std::string wait_for(const std::filesystem::path& pattern) {
+  return "for i in $(seq 300); do ls " + pattern.string() + " >/dev/null 2>&1 && break; sleep 0.1; done";
+}
+
 std::uint64_t device_timestamp_us(std::int64_t k) { return static_cast<std::uint64_t>(std::llround(1e6 * (1.0 + k / 30.0))); }
 
 TEST(OpenNiCli, DevicesListsTheSyntheticDevice) {
@@ -79,9 +84,11 @@ TEST(OpenNiCli, LiveRunsTheReplayGraphForNFrames) {
 
 TEST(OpenNiCli, LiveStopsCleanlyOnCtrlC) {
   TempDir dir;
-  // No --frames: only SIGINT ends it. `wait` returns relight's exit status.
-  const auto result = run_command("{ " + kRelight + " live --device " + kDevice + " --no-frames --out " +
-                                  dir.path().string() + " & pid=$!; sleep 1.5; kill -INT $pid; wait $pid; }");
+  // SIGINT once the graph runs (graph.dot is written after the device opened and the handler is
+  // in place); --frames only bounds the run should the signal get lost.
+  const auto result = run_command("{ " + kRelight + " live --device " + kDevice + " --frames 3000 --no-frames --out " +
+                                  dir.path().string() + " & pid=$!; " + wait_for(dir.path() / "graph.dot") +
+                                  "; sleep 1; kill -INT $pid; wait $pid; }");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.err.find("interrupted"), std::string::npos) << result.err;
   const auto report = read_report(dir.path());
@@ -150,8 +157,10 @@ TEST(OpenNiCli, RecordReplayRoundTripKeepsDepthTimestampsAndFrameCount) {
 TEST(OpenNiCli, RecordFinalisesTheFileOnCtrlC) {
   TempDir dir;
   const auto oni = dir.path() / "take.oni";
-  const auto result = run_command("{ " + kRelight + " record --device " + kDevice + " --out " + oni.string() +
-                                  " & pid=$!; sleep 1.5; kill -INT $pid; wait $pid; }");
+  // The temporary .oni appears once the recorder runs (after the handler is in place).
+  const auto result = run_command("{ " + kRelight + " record --device " + kDevice + " --frames 3000 --out " +
+                                  oni.string() + " & pid=$!; " + wait_for(dir.path() / "take.tmp-*.oni") +
+                                  "; sleep 1; kill -INT $pid; wait $pid; }");
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.err.find("interrupted"), std::string::npos) << result.err;
   EXPECT_GE(inspect_oni(oni).depth_frames, 1);
