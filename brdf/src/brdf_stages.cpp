@@ -28,6 +28,8 @@ void gather_points(const RadianceImage& kd, const Mask& valid, std::vector<Float
   if (!kd.same_shape(valid)) throw Error("brdf K-means: k_d and its validity mask differ in size");
   points.clear();
   pixels.clear();
+  points.reserve(kd.size());
+  pixels.reserve(kd.size());
   for (std::size_t i = 0; i < kd.size(); ++i) {
     if (!valid.pixels()[i]) continue;
     points.push_back(kmeans_feature(kd.pixels()[i]));

@@ -10,12 +10,12 @@
 namespace relight::brdf {
 
 bool is_highlight(Rgb8 color, const HighlightOptions& options) {
+  // I >= I_min and S <= S_max without divisions: sum >= 765 I_min and 3 min >= (1 - S_max) sum.
   const int sum = color.r + color.g + color.b;
   if (sum == 0) return false;
-  const float intensity = static_cast<float>(sum) / (3.f * 255.f);
   const int lowest = std::min({color.r, color.g, color.b});
-  const float saturation = 1.f - static_cast<float>(3 * lowest) / static_cast<float>(sum);
-  return intensity >= options.intensity_min && saturation <= options.saturation_max;
+  return static_cast<float>(sum) >= options.intensity_min * 765.f &&
+         static_cast<float>(3 * lowest) >= (1.f - options.saturation_max) * static_cast<float>(sum);
 }
 
 void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
@@ -28,9 +28,24 @@ void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
   // Per row, the horizontal distance to the nearest set pixel (capped at radius + 1); a pixel is
   // set in the output when some row dy away holds a set pixel within sqrt(r^2 - dy^2) columns.
   const int far = radius + 1;
+  // Rows without a set pixel within `radius` rows stay empty: highlights are rare, so most of
+  // the image is skipped.
+  std::vector<std::uint8_t> row_set(static_cast<std::size_t>(h), 0), row_near(static_cast<std::size_t>(h), 0);
+  parallel_for_each_row(h, threads, [&](int r) {
+    const auto row = input.row(r);
+    row_set[static_cast<std::size_t>(r)] = std::any_of(row.begin(), row.end(), [](std::uint8_t v) { return v != 0; });
+  });
+  for (int r = 0; r < h; ++r) {
+    if (!row_set[static_cast<std::size_t>(r)]) continue;
+    for (int rr = std::max(0, r - radius); rr <= std::min(h - 1, r + radius); ++rr) row_near[static_cast<std::size_t>(rr)] = 1;
+  }
   std::vector<std::uint8_t> distance(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
   parallel_for_each_row(h, threads, [&](int r) {
     std::uint8_t* d = distance.data() + static_cast<std::size_t>(r) * static_cast<std::size_t>(w);
+    if (!row_set[static_cast<std::size_t>(r)]) {
+      std::fill(d, d + w, static_cast<std::uint8_t>(far));
+      return;
+    }
     int last = -far - 1;
     for (int c = 0; c < w; ++c) {
       if (input(r, c)) last = c;
@@ -47,6 +62,11 @@ void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
     reach[static_cast<std::size_t>(dy)] = static_cast<int>(std::floor(std::sqrt(static_cast<double>(radius * radius - dy * dy))));
   }
   parallel_for_each_row(h, threads, [&](int r) {
+    if (!row_near[static_cast<std::size_t>(r)]) {
+      const auto row = output.row(r);
+      std::fill(row.begin(), row.end(), std::uint8_t{0});
+      return;
+    }
     for (int c = 0; c < w; ++c) {
       std::uint8_t on = 0;
       for (int dy = -radius; dy <= radius && !on; ++dy) {
