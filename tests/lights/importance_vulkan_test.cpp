@@ -23,8 +23,11 @@ class ImportanceVulkan : public test::VulkanTest {
     for (std::size_t i = 0; i < cpu_samples.size(); ++i) {
       same_pixel += gpu_samples[i].pixel == cpu_samples[i].pixel ? 1 : 0;
       EXPECT_EQ(gpu_samples[i].pixel, cpu_samples[i].pixel) << "sample " << i;
-      EXPECT_NEAR(gpu_samples[i].u, cpu_samples[i].u, 1e-5) << "sample " << i;
-      EXPECT_NEAR(gpu_samples[i].v, cpu_samples[i].v, 1e-5) << "sample " << i;
+      // Within the pixel the warp divides by the pixel's probability; a GPU that contracts to FMA
+      // (NVIDIA does, lavapipe does not) moves the point inside its pixel by up to ~4e-4 of a pixel
+      // (measured on an H200).
+      EXPECT_NEAR(gpu_samples[i].u, cpu_samples[i].u, 1e-3) << "sample " << i;
+      EXPECT_NEAR(gpu_samples[i].v, cpu_samples[i].v, 1e-3) << "sample " << i;
       EXPECT_LT(test::angle_between(gpu.lights[i].direction, cpu.lights[i].direction), 1e-4) << "sample " << i;
       EXPECT_NEAR(luminance(gpu.lights[i].power) / luminance(cpu.lights[i].power), 1.0, 1e-4) << "sample " << i;
     }
