@@ -330,7 +330,8 @@ OpenNiSource::~OpenNiSource() {
 std::optional<RgbdFrame> OpenNiSource::next() {
   Impl& s = *impl_;
   openni::VideoStream* streams[] = {&s.depth.stream, &s.color.stream};
-  const auto timeout = static_cast<int>(s.options.timeout.count());
+  const auto timeout = static_cast<int>(s.file ? std::min<std::int64_t>(s.options.timeout.count(), 2000)
+                                                : s.options.timeout.count());
   while (true) {
     if (s.file && s.total > 0 && s.delivered >= s.total) return std::nullopt;  // all frames read
     if (s.pending_depth && s.pending_color) {

@@ -26,9 +26,10 @@ namespace relight {
 struct OpenNiOptions {
   /// Device URI (as `relight devices` lists), a .oni file, or empty for the first device found.
   std::string uri;
-  /// Longest wait for a frame before a live device counts as stalled (an error); a .oni file ends
-  /// when no frame comes within this time.
-  std::chrono::milliseconds timeout{3000};
+  /// Longest wait for a frame before a live device counts as stalled (an error; generous because
+  /// relight's synthetic device renders a 640x480 frame in up to ~1 s on two busy cores). A .oni
+  /// file, whose frames are there at once, ends when none comes within min(timeout, 2 s).
+  std::chrono::milliseconds timeout{10000};
   /// Intrinsics of the registered images; default: from the depth stream's field of view with the
   /// principal point at the image centre.
   std::optional<PinholeIntrinsics> intrinsics;
