@@ -101,7 +101,12 @@ class NelderMeadSolver final : public SpecularSolver {
       steps[1] = 0.1;
       for (std::size_t i = 2; i < x.size(); ++i) steps[i] = 0.5 * bounds.upper[i];
       double fx = f(x);
-      restarts(f, clamp, x, fx, steps, evaluations + options.light_evaluations, evaluations);
+      // A short probe first: when moving the lights buys less than 10 % of F, the misfit has
+      // another cause (shadows, mixed materials) and the rest of the budget is not spent.
+      const double f_start = fx;
+      const int budget_end = evaluations + options.light_evaluations;
+      restarts(f, clamp, x, fx, steps, std::min(budget_end, evaluations + kLightProbe), evaluations);
+      if (fx < 0.9 * f_start) restarts(f, clamp, x, fx, steps, budget_end, evaluations);
       // Phase C: (k_s, log n) again on all samples with the moved lights; kept if F drops.
       std::vector<double> moved(x.begin() + 2, x.end());
       std::vector<double> shape_c(x.begin(), x.begin() + 2);
@@ -128,6 +133,7 @@ class NelderMeadSolver final : public SpecularSolver {
 
  private:
   static constexpr std::size_t kLightSamples = 256;
+  static constexpr int kLightProbe = 150;
 
   /// Restarted Nelder-Mead: fresh simplices of halving size from the best vertex until a restart
   /// no longer improves F.

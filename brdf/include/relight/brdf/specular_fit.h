@@ -12,7 +12,8 @@
 //     from the best vertex with a fresh simplex until a restart no longer improves F; in phases:
 //     (A) k_s and log n with the lights fixed (precomputed per-sample terms: one exp per lit
 //     sample and light), (B) if the residual is still above light_refine_rms and the cluster is
-//     not diffuse, every parameter on a subset of 256 samples, (C) k_s and log n again on all
+//     not diffuse, every parameter on a subset of 256 samples (stopped after a 150-evaluation
+//     probe when that lowers F by less than 10 %), (C) k_s and log n again on all
 //     samples with the moved lights, kept if F drops;
 //   - Ceres: one ceres::AutoDiffCostFunction per sample (3 residuals), parameter bounds on every
 //     block, Levenberg-Marquardt, in the same phases: (k_s, n) alone; under the same condition
