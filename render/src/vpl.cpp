@@ -1,5 +1,6 @@
 #include "relight/render/vpl.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <numbers>
 
@@ -43,6 +44,55 @@ LightSample sample_light_direction(const MrLight& light, float u1, float u2) {
   const float z = 1.f - 2.f * u1;
   const float r = std::sqrt(std::max(0.f, 1.f - z * z));
   return {Vec3(r * std::cos(phi), r * std::sin(phi), z), light.intensity * (4.f * kPi)};
+}
+
+/// The cone from a light position that holds the virtual objects' bounding sphere.
+struct Cone {
+  Vec3 axis;
+  float cos_half = 1.f;
+  float solid_angle = 0.f;
+
+  [[nodiscard]] bool contains(const Vec3& direction) const { return direction.dot(axis) > cos_half; }
+  [[nodiscard]] Vec3 sample(float u1, float u2) const {
+    const float cos_theta = 1.f - u1 * (1.f - cos_half);
+    const float sin_theta = std::sqrt(std::max(0.f, 1.f - cos_theta * cos_theta));
+    Vec3 t, b;
+    orthonormal_basis(axis, t, b);
+    const float phi = 2.f * kPi * u2;
+    return (sin_theta * std::cos(phi) * t + sin_theta * std::sin(phi) * b + cos_theta * axis).normalized();
+  }
+};
+
+struct BoundingSphere {
+  Vec3 centre = Vec3::Zero();
+  float radius = -1.f;  ///< negative: no virtual geometry
+};
+
+BoundingSphere virtual_bounds(const MrScene& scene) {
+  Eigen::AlignedBox3f box;
+  for (const TriangleMesh& mesh : scene.meshes)
+    if (!mesh.real)
+      for (const Vec3& p : mesh.positions) box.extend(p);
+  BoundingSphere sphere;
+  if (box.isEmpty()) return sphere;
+  sphere.centre = box.center();
+  for (const TriangleMesh& mesh : scene.meshes)
+    if (!mesh.real)
+      for (const Vec3& p : mesh.positions) sphere.radius = std::max(sphere.radius, (p - sphere.centre).norm());
+  return sphere;
+}
+
+std::optional<Cone> cone_towards(const BoundingSphere& sphere, const Vec3& from) {
+  if (sphere.radius < 0.f) return std::nullopt;
+  const Vec3 offset = sphere.centre - from;
+  const float distance = offset.norm();
+  if (distance <= 1.001f * sphere.radius) return std::nullopt;  // the light is among the virtual objects
+  Cone cone;
+  cone.axis = offset / distance;
+  const float sin_half = sphere.radius / distance;
+  cone.cos_half = std::sqrt(std::max(0.f, 1.f - sin_half * sin_half));
+  cone.solid_angle = 2.f * kPi * (1.f - cone.cos_half);
+  return cone;
 }
 
 class VplTracer {
@@ -134,16 +184,31 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
   if (options.bounces < 1) throw Error("VPLs need at least one bounce");
   std::vector<Vpl> vpls;
   VplTracer vpl_tracer(scene, tracer, options, vpls);
+  if (options.virtual_share < 0.f || options.virtual_share >= 1.f) throw Error("the virtual VPL share must be in [0, 1)");
   const std::vector<int> budget = light_budget(scene, options);
+  const BoundingSphere virtual_sphere = virtual_bounds(scene);
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     const MrLight& light = scene.lights[l];
+    const std::optional<Cone> cone = options.virtual_share > 0.f ? cone_towards(virtual_sphere, light.position) : std::nullopt;
     const int n = budget[l];
+    const int n_cone = cone && n >= 2 ? std::max(1, static_cast<int>(std::lround(options.virtual_share * n))) : 0;
+    const int n_rest = n - n_cone;
     for (int i = 0; i < n; ++i) {
       Pcg32 rng = Pcg32::for_sample(options.seed, l, static_cast<std::uint64_t>(i));
-      const float u1 = (static_cast<float>(i) + rng.uniform()) / static_cast<float>(n);  // stratified
+      if (i < n_cone) {
+        const float u1 = (static_cast<float>(i) + rng.uniform()) / static_cast<float>(n_cone);  // stratified
+        const Vec3 direction = cone->sample(u1, rng.uniform());
+        const float falloff = light.kind == LightKind::Spot ? detail::spot_falloff(light, direction) : 1.f;
+        vpl_tracer.emit(light.position, direction, light.intensity * (falloff * cone->solid_angle / static_cast<float>(n_cone)),
+                        true, light.real, 1, rng);
+        continue;
+      }
+      const int j = i - n_cone;
+      const float u1 = (static_cast<float>(j) + rng.uniform()) / static_cast<float>(n_rest);  // stratified
       const LightSample sample = sample_light_direction(light, u1, rng.uniform());
-      vpl_tracer.emit(light.position, sample.direction, sample.intensity_over_pdf / static_cast<float>(n), true, light.real,
-                      1, rng);
+      if (cone && n_cone > 0 && cone->contains(sample.direction)) continue;  // the other stratum covers it
+      vpl_tracer.emit(light.position, sample.direction, sample.intensity_over_pdf / static_cast<float>(n_rest), true,
+                      light.real, 1, rng);
     }
   }
   return vpls;

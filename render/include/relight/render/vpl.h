@@ -18,6 +18,13 @@
 // the real hit a VPL of the real-only world. Multi-bounce VPLs continue from a VPL by importance
 // sampling its Phong BRDF (phong_brdf.h), and flags multiply along the path.
 //
+// Virtual focus: the differential image lives where virtual objects reflect or block light, and
+// they are small, so uniformly spread light samples put few VPLs on them. A share of each light's
+// samples (`virtual_share`) is therefore drawn uniformly inside the cone that the virtual objects'
+// bounding sphere subtends from the light (flux I Omega_cone / n_cone each); the other samples
+// are drawn over the light's whole emission and dropped when they fall into that cone (flux
+// I Omega_light / n_rest each). The two strata cover every direction once: unbiased.
+//
 // Flux (W, RGB): a light of intensity I sampled with density p(omega) over N samples gives each
 // first-bounce VPL Phi = I(omega) / (p(omega) N), so that its contribution to a point x is
 //   Phi f_y(omega_in, y->x) f_x(y->x, omega_o) cos(theta_y) cos(theta_x) / |x - y|^2.
@@ -48,6 +55,7 @@ struct VplOptions {
   int count = 256;      ///< first-bounce light samples (each may yield two VPLs, see above)
   int bounces = 1;      ///< 1 = one indirect bounce; 2 adds VPLs lit by VPLs
   VplBudget budget = VplBudget::ByPower;
+  float virtual_share = 0.5f;  ///< of each light's samples aimed at the virtual objects (0 = off)
   std::uint64_t seed = 1;
 };
 
