@@ -1,8 +1,5 @@
 #include "relight/vk/compute_pipeline.h"
 
-#include <algorithm>
-#include <vector>
-
 #include "relight/core/error.h"
 #include "relight/vk/buffer.h"
 #include "relight/vk/check.h"
@@ -11,31 +8,18 @@
 namespace relight::vk {
 
 ComputePipeline::ComputePipeline(const VulkanContext& context, const ComputePipelineInfo& info)
-    : device_(context.device()), storage_buffers_(info.storage_buffers), push_constant_bytes_(info.push_constant_bytes) {
+    : device_(context.device()),
+      storage_buffers_(info.storage_buffers),
+      push_constant_bytes_(info.push_constant_bytes),
+      sets_(context.device(), info.storage_buffers, VK_SHADER_STAGE_COMPUTE_BIT, info.max_descriptor_sets) {
   if (info.spirv.empty()) throw LogicError("ComputePipeline: no SPIR-V given");
   if (push_constant_bytes_ % 4 != 0 || push_constant_bytes_ > context.properties().limits.maxPushConstantsSize) {
     throw LogicError("ComputePipeline: push constants must be a multiple of 4 bytes within the device limit");
   }
 
-  VkShaderModuleCreateInfo shader_info{};
-  shader_info.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-  shader_info.codeSize = info.spirv.size_bytes();
-  shader_info.pCode = info.spirv.data();
-  VkShaderModule shader = VK_NULL_HANDLE;
-  RELIGHT_VK_CHECK(vkCreateShaderModule(device_, &shader_info, nullptr, &shader));
-  shader_ = UniqueShaderModule(device_, shader);
-
-  std::vector<VkDescriptorSetLayoutBinding> bindings(storage_buffers_);
-  for (std::uint32_t i = 0; i < storage_buffers_; ++i) {
-    bindings[i] = {i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
-  }
-  VkDescriptorSetLayoutCreateInfo set_info{};
-  set_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-  set_info.bindingCount = storage_buffers_;
-  set_info.pBindings = bindings.data();
-  VkDescriptorSetLayout set_layout = VK_NULL_HANDLE;
-  RELIGHT_VK_CHECK(vkCreateDescriptorSetLayout(device_, &set_info, nullptr, &set_layout));
-  set_layout_ = UniqueDescriptorSetLayout(device_, set_layout);
+  shader_ = create_shader_module(device_, info.spirv);
+  const VkShaderModule shader = shader_.get();
+  const VkDescriptorSetLayout set_layout = sets_.layout();
 
   const VkPushConstantRange push_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_constant_bytes_};
   VkPipelineLayoutCreateInfo layout_info{};
@@ -58,46 +42,10 @@ ComputePipeline::ComputePipeline(const VulkanContext& context, const ComputePipe
   VkPipeline pipeline = VK_NULL_HANDLE;
   RELIGHT_VK_CHECK(vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline));
   pipeline_ = UniquePipeline(device_, pipeline);
-
-  const VkDescriptorPoolSize pool_size{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                       std::max(1u, storage_buffers_) * info.max_descriptor_sets};
-  VkDescriptorPoolCreateInfo pool_info{};
-  pool_info.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-  pool_info.flags = VK_DESCRIPTOR_POOL_CREATE_FREE_DESCRIPTOR_SET_BIT;  // sets are freed one by one (RAII)
-  pool_info.maxSets = info.max_descriptor_sets;
-  pool_info.poolSizeCount = 1;
-  pool_info.pPoolSizes = &pool_size;
-  VkDescriptorPool pool = VK_NULL_HANDLE;
-  RELIGHT_VK_CHECK(vkCreateDescriptorPool(device_, &pool_info, nullptr, &pool));
-  pool_ = UniqueDescriptorPool(device_, pool);
 }
 
 UniqueDescriptorSet ComputePipeline::bind(std::initializer_list<const VulkanBuffer*> buffers) {
-  if (buffers.size() != storage_buffers_) throw LogicError("ComputePipeline::bind: wrong number of buffers");
-  const VkDescriptorSetLayout set_layout = set_layout_.get();
-  VkDescriptorSetAllocateInfo allocate{};
-  allocate.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  allocate.descriptorPool = pool_.get();
-  allocate.descriptorSetCount = 1;
-  allocate.pSetLayouts = &set_layout;
-  VkDescriptorSet raw = VK_NULL_HANDLE;
-  RELIGHT_VK_CHECK(vkAllocateDescriptorSets(device_, &allocate, &raw));
-  UniqueDescriptorSet set(device_, pool_.get(), raw);
-
-  std::vector<VkDescriptorBufferInfo> infos;
-  infos.reserve(buffers.size());
-  for (const VulkanBuffer* buffer : buffers) infos.push_back({buffer->handle(), 0, VK_WHOLE_SIZE});
-  std::vector<VkWriteDescriptorSet> writes(infos.size());
-  for (std::uint32_t i = 0; i < writes.size(); ++i) {
-    writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-    writes[i].dstSet = raw;
-    writes[i].dstBinding = i;
-    writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[i].pBufferInfo = &infos[i];
-  }
-  vkUpdateDescriptorSets(device_, static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
-  return set;
+  return sets_.bind(buffers);
 }
 
 void ComputePipeline::dispatch(VkCommandBuffer cmd, const UniqueDescriptorSet& set,

@@ -16,6 +16,7 @@
 #include <span>
 
 #include "relight/vk/handles.h"
+#include "relight/vk/storage_buffer_sets.h"
 
 namespace relight::vk {
 
@@ -55,11 +56,10 @@ class ComputePipeline {
   VkDevice device_ = VK_NULL_HANDLE;
   std::uint32_t storage_buffers_ = 0;
   std::uint32_t push_constant_bytes_ = 0;
+  StorageBufferSets sets_;
   UniqueShaderModule shader_;
-  UniqueDescriptorSetLayout set_layout_;
   UniquePipelineLayout layout_;
   UniquePipeline pipeline_;
-  UniqueDescriptorPool pool_;
 };
 
 }  // namespace relight::vk
