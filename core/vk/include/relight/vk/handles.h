@@ -57,6 +57,8 @@ using UniqueCommandPool = DeviceObject<VkCommandPool, vkDestroyCommandPool>;
 using UniqueFence = DeviceObject<VkFence, vkDestroyFence>;
 using UniqueSemaphore = DeviceObject<VkSemaphore, vkDestroySemaphore>;
 using UniqueQueryPool = DeviceObject<VkQueryPool, vkDestroyQueryPool>;
+using UniqueRenderPass = DeviceObject<VkRenderPass, vkDestroyRenderPass>;
+using UniqueFramebuffer = DeviceObject<VkFramebuffer, vkDestroyFramebuffer>;
 
 /// Owner of a handle allocated from a pool (command buffers, descriptor sets) and given back with
 /// `vkFreeX(device, pool, 1, &handle)`. Descriptor pools must have

@@ -1,0 +1,27 @@
+#version 450
+// G-buffer pass: target 0 = (world position, signed distance), the sign holding r(p) as in
+// Knecht et al. (positive: real surface, negative: virtual); target 1 = (normal facing the
+// camera, material index). Every corner carries its triangle's material and flag (a flat
+// attribute: gl_PrimitiveID would need the geometry-shader feature).
+layout(location = 0) in vec3 world_position;
+layout(location = 1) in vec3 world_normal;
+layout(location = 2) flat in uint triangle_info;  // bits 0-30: material index; bit 31: virtual
+
+layout(push_constant) uniform Camera {
+  mat4 world_to_clip;
+  vec4 centre;
+} camera;
+
+layout(location = 0) out vec4 out_position;
+layout(location = 1) out vec4 out_normal;
+
+void main() {
+  const uint info = triangle_info;
+  const bool is_virtual = (info >> 31) != 0u;
+  const vec3 to_camera = camera.centre.xyz - world_position;
+  const float distance = length(to_camera);
+  vec3 n = normalize(world_normal);
+  if (dot(n, to_camera) < 0.0) n = -n;
+  out_position = vec4(world_position, is_virtual ? -distance : distance);
+  out_normal = vec4(n, float(info & 0x7fffffffu));
+}

@@ -1,0 +1,73 @@
+// The rasterised G-buffer against the ray-cast reference on the synthetic scene with the
+// shipped pebble: same surface, flag and material at every pixel away from triangle edges.
+#include "relight/render/gbuffer_vk.h"
+
+#include <gtest/gtest.h>
+
+#include "../reconstruct/vulkan_test_env.h"
+#include "relight/core/error.h"
+#include "relight/render/procedural_models.h"
+#include "relight/render/scene_from_synth.h"
+#include "relight/synth/trajectory.h"
+#include "relight/vk/context.h"
+#include "test_scenes.h"
+
+namespace relight::render {
+namespace {
+
+class GBufferVkTest : public relight::test::VulkanTest {};
+
+MrScene scene_with_pebble() {
+  MrScene scene = scene_from_synth(synth::default_indoor_scene(), {48});
+  add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
+  return scene;
+}
+
+TEST_F(GBufferVkTest, MatchesTheRayCastGBuffer) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const MrScene scene = scene_with_pebble();
+  const MrCamera camera = test::camera_at({1.3, -1.1, 1.4}, {0.2, -0.1, 0.75}, 160, 120);
+  GBufferVk renderer(context, 160, 120);
+  renderer.set_scene(scene);
+  const GBuffer gpu = renderer.render(camera);
+  const GBuffer cpu = gbuffer_cpu(scene, RayTracer(scene), camera);
+  int both = 0, same_surface = 0, virtual_pixels = 0, coverage_mismatch = 0;
+  for (int row = 0; row < 120; ++row)
+    for (int col = 0; col < 160; ++col) {
+      const bool seen_gpu = gpu.material(row, col) != 0, seen_cpu = cpu.material(row, col) != 0;
+      if (seen_gpu != seen_cpu) {
+        ++coverage_mismatch;
+        continue;
+      }
+      if (!seen_gpu) continue;
+      ++both;
+      virtual_pixels += cpu.virtual_surface(row, col);
+      if (gpu.material(row, col) != cpu.material(row, col) || gpu.virtual_surface(row, col) != cpu.virtual_surface(row, col))
+        continue;  // an edge between two objects
+      ++same_surface;
+      EXPECT_NEAR(gpu.distance(row, col), cpu.distance(row, col), 1e-3f * cpu.distance(row, col) + 1e-4f) << row << "," << col;
+      EXPECT_GT(dot(gpu.normal(row, col), cpu.normal(row, col)), 0.999f) << row << "," << col;
+      EXPECT_LT(length(gpu.position(row, col) - cpu.position(row, col)), 2e-3f * cpu.distance(row, col)) << row << "," << col;
+    }
+  EXPECT_GT(both, 160 * 120 * 9 / 10);
+  EXPECT_GT(virtual_pixels, 30) << "the pebble is in view";
+  EXPECT_GT(same_surface, both * 99 / 100);
+  EXPECT_LT(coverage_mismatch, 160 * 120 / 100);
+  if (context.timestamps_supported()) {
+    EXPECT_GT(renderer.last_gpu_ms(), 0.0);
+  }
+}
+
+TEST_F(GBufferVkTest, RejectsAWrongCameraSizeAndRenderBeforeScene) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  GBufferVk renderer(context, 32, 24);
+  const MrCamera camera = test::camera_at({0, -2, 1}, {0, 0, 0}, 32, 24);
+  EXPECT_THROW((void)renderer.render(camera), LogicError);
+  renderer.set_scene(test::floor_scene(Eigen::Vector3f::Constant(0.5f), {0, 0, 2}, 1.f));
+  EXPECT_THROW((void)renderer.render(test::camera_at({0, -2, 1}, {0, 0, 0}, 64, 48)), Error);
+  const GBuffer g = renderer.render(camera);
+  EXPECT_NE(g.material(12, 16), 0);
+}
+
+}  // namespace
+}  // namespace relight::render
