@@ -3,8 +3,7 @@
 
 namespace relight::render {
 
-GBuffer gbuffer_cpu(const MrScene& scene, const RayTracer& tracer, const MrCamera& camera, int threads) {
-  (void)scene;
+GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads) {
   const PinholeIntrinsics& k = camera.intrinsics;
   GBuffer out{PositionMap(k.width, k.height), NormalMap(k.width, k.height), LabelImage(k.width, k.height),
               Mask(k.width, k.height), DepthMap(k.width, k.height)};

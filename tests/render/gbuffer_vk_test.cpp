@@ -30,7 +30,7 @@ TEST_F(GBufferVkTest, MatchesTheRayCastGBuffer) {
   GBufferVk renderer(context, 160, 120);
   renderer.set_scene(scene);
   const GBuffer gpu = renderer.render(camera);
-  const GBuffer cpu = gbuffer_cpu(scene, RayTracer(scene), camera);
+  const GBuffer cpu = gbuffer_cpu(RayTracer(scene), camera);
   int both = 0, same_surface = 0, virtual_pixels = 0, coverage_mismatch = 0;
   for (int row = 0; row < 120; ++row)
     for (int col = 0; col < 160; ++col) {

@@ -18,6 +18,6 @@ struct GBuffer {
   DepthMap distance;     ///< from the camera centre, metres; 0 where nothing is seen
 };
 
-[[nodiscard]] GBuffer gbuffer_cpu(const MrScene& scene, const RayTracer& tracer, const MrCamera& camera, int threads = 0);
+[[nodiscard]] GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads = 0);
 
 }  // namespace relight::render
