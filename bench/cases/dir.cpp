@@ -8,15 +8,18 @@
 // TM(L_r)), and the path tracer's composite RMSE when it gets DIR's wall time (equal time).
 // The renderer measured here is DIR's CPU reference with exact visibility; the Vulkan renderer
 // will report into the same fields.
+// dir/gbuffer_640x480: the first Vulkan stage of DIR against its ray-cast reference.
 #include <chrono>
 #include <cmath>
 
 #include "bench.h"
 #include "relight/render/dir_cpu.h"
+#include "relight/render/gbuffer_vk.h"
 #include "relight/render/path_tracer.h"
 #include "relight/render/procedural_models.h"
 #include "relight/render/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
+#include "relight/vk/context.h"
 
 namespace {
 
@@ -113,6 +116,28 @@ bench::Json vs_reference(const bench::Options&) {
           {"by_vpl_count", curve}};
 }
 
+/// dir/gbuffer_640x480: the rasterised G-buffer of the synthetic scene with the pebble (about
+/// 12k triangles) against the ray-cast one (Embree, all threads): wall time including the read
+/// back, and the draw's GPU time.
+bench::Json gbuffer_640x480(const bench::Options& options) {
+  auto context = vk::try_create_vulkan();
+  if (!context) return {{"skipped", "no Vulkan device"}};
+  render::MrScene scene = bench_scene();
+  render::MrCamera camera = bench_camera();
+  camera.intrinsics = PinholeIntrinsics{};  // Kinect v1, 640x480
+  render::GBufferVk renderer(*context, 640, 480);
+  renderer.set_scene(scene);
+  const render::RayTracer tracer(scene);
+  const bench::Comparison c = bench::compare_interleaved([&] { (void)renderer.render(camera); },
+                                                         [&] { (void)render::gbuffer_cpu(tracer, camera); },
+                                                         options.repetitions);
+  bench::Json json = bench::comparison_json(c, "embree_ray_cast");
+  json["gpu_ms"] = renderer.last_gpu_ms();
+  json["device"] = context->device_info().name;
+  return json;
+}
+
 }  // namespace
 
 RELIGHT_BENCH_CASE("dir/vs_reference", vs_reference);
+RELIGHT_BENCH_CASE("dir/gbuffer_640x480", gbuffer_640x480);
