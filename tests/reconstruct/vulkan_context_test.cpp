@@ -13,6 +13,7 @@
 #include "relight/vk/buffer.h"
 #include "relight/vk/check.h"
 #include "relight/vk/compute_pipeline.h"
+#include "relight/vk/image.h"
 #include "relight/vk/timer.h"
 #include "relight/vk/transfer.h"
 #include "relight/shaders/add_constant_test_comp.h"
@@ -182,38 +183,9 @@ TEST(VulkanRaii, EveryWrapperReleasesItsObject) {
     const auto set = pipeline.bind({&a, &moved});
     GpuTimer timer(context);
 
-    VkImageCreateInfo image_info{};
-    image_info.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
-    image_info.imageType = VK_IMAGE_TYPE_2D;
-    image_info.format = VK_FORMAT_R32_SFLOAT;
-    image_info.extent = {8, 8, 1};
-    image_info.mipLevels = 1;
-    image_info.arrayLayers = 1;
-    image_info.samples = VK_SAMPLE_COUNT_1_BIT;
-    image_info.tiling = VK_IMAGE_TILING_OPTIMAL;
-    image_info.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
-    VkImage raw_image = VK_NULL_HANDLE;
-    RELIGHT_VK_CHECK(vkCreateImage(device, &image_info, nullptr, &raw_image));
-    UniqueImage image(device, raw_image);
-    VkMemoryRequirements requirements{};
-    vkGetImageMemoryRequirements(device, raw_image, &requirements);
-    VkMemoryAllocateInfo allocate{};
-    allocate.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
-    allocate.allocationSize = requirements.size;
-    allocate.memoryTypeIndex = context.find_memory_type(requirements.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    VkDeviceMemory raw_memory = VK_NULL_HANDLE;
-    RELIGHT_VK_CHECK(vkAllocateMemory(device, &allocate, nullptr, &raw_memory));
-    UniqueMemory memory(device, raw_memory);
-    RELIGHT_VK_CHECK(vkBindImageMemory(device, raw_image, raw_memory, 0));
-    VkImageViewCreateInfo view_info{};
-    view_info.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
-    view_info.image = raw_image;
-    view_info.viewType = VK_IMAGE_VIEW_TYPE_2D;
-    view_info.format = VK_FORMAT_R32_SFLOAT;
-    view_info.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-    VkImageView raw_view = VK_NULL_HANDLE;
-    RELIGHT_VK_CHECK(vkCreateImageView(device, &view_info, nullptr, &raw_view));
-    UniqueImageView view(device, raw_view);
+    // Owns a VkImage, its VkDeviceMemory and a VkImageView (UniqueImage/UniqueMemory/UniqueImageView).
+    const VulkanImage image(context, 8, 8, VK_FORMAT_R32_SFLOAT, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT);
+    EXPECT_NE(image.view(), VK_NULL_HANDLE);
 
     VkSemaphoreCreateInfo semaphore_info{};
     semaphore_info.sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO;
