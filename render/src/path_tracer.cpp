@@ -155,7 +155,7 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
 }  // namespace
 
 DifferentialPathTracer::DifferentialPathTracer(const MrScene& scene, PathTracerOptions options)
-    : scene_(scene), options_(options), tracer_(scene_) {
+    : options_(options), tracer_(scene) {
   if (options_.max_bounces < 0) throw Error("max bounces must not be negative");
   if (options_.roulette_from < 1) throw Error("Russian roulette must start at bounce 1 or later");
 }
@@ -180,7 +180,7 @@ DifferentialPathTracer::Sample DifferentialPathTracer::trace_pixel(double u, dou
   const Eigen::Vector3d camera_direction((jitter_u - k.cx) / k.fx, (jitter_v - k.cy) / k.fy, 1.0);
   const Vec3 direction = (camera_.camera_to_world.linear() * camera_direction.normalized()).cast<float>();
   const Vec3 origin = camera_.camera_to_world.translation().cast<float>();
-  const PathIntegrator integrator(scene_, tracer_, options_);
+  const PathIntegrator integrator(tracer_.scene(), tracer_, options_);
   Sample out = integrator.trace(origin, direction.normalized(), rng);
   if (!out.real_virtual.allFinite() || !out.real.allFinite()) {
     out.real_virtual.setZero();

@@ -109,6 +109,8 @@ RayTracer::RayTracer(const MrScene& scene) : impl_(std::make_unique<Impl>()) {
 
 RayTracer::~RayTracer() = default;
 
+const MrScene& RayTracer::scene() const { return impl_->scene; }
+
 bool RayTracer::has_virtual_geometry() const { return !impl_->virtual_objects.meshes.empty(); }
 
 std::optional<SurfaceHit> RayTracer::intersect(Layer which, const Eigen::Vector3f& origin,

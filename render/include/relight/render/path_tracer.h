@@ -86,9 +86,8 @@ class DifferentialPathTracer {
   [[nodiscard]] Sample trace_pixel(double u, double v, std::uint64_t pixel, std::uint64_t sample) const;
 
  private:
-  MrScene scene_;
   PathTracerOptions options_;
-  RayTracer tracer_;
+  RayTracer tracer_;  // holds the scene
   MrCamera camera_;
   std::vector<double> sum_rv_, sum_r_;
   std::vector<std::uint32_t> virtual_hits_;

@@ -42,6 +42,8 @@ class RayTracer {
                               float t_max) const;
 
   [[nodiscard]] bool has_virtual_geometry() const;
+  /// The tracer's own copy of the scene (hits index its meshes and materials).
+  [[nodiscard]] const MrScene& scene() const;
 
  private:
   struct Impl;
