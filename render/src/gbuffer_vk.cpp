@@ -106,8 +106,8 @@ struct GBufferVk::Impl {
   vk::UniquePipeline pipeline;
   vk::VulkanBuffer readback;
   vk::GpuTimer timer;
-  std::unique_ptr<vk::VulkanBuffer> vertices, indices;
-  std::uint32_t index_count = 0;
+  std::unique_ptr<vk::VulkanBuffer> vertices;
+  std::uint32_t vertex_count = 0;
   double gpu_ms = 0.0;
 };
 
@@ -234,7 +234,6 @@ double GBufferVk::last_gpu_ms() const { return impl_->gpu_ms; }
 void GBufferVk::set_scene(const MrScene& scene) {
   scene.validate();
   std::vector<Vertex> vertices;
-  std::vector<std::uint32_t> indices;
   for (const TriangleMesh& mesh : scene.meshes) {
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       const std::uint32_t info = mesh.triangle_material[t] | (mesh.real ? 0u : 0x80000000u);
@@ -245,7 +244,6 @@ void GBufferVk::set_scene(const MrScene& scene) {
       for (std::uint32_t v : tri) {
         const Eigen::Vector3f& p = mesh.positions[v];
         const Eigen::Vector3f n = mesh.normals.empty() ? flat : mesh.normals[v];
-        indices.push_back(static_cast<std::uint32_t>(vertices.size()));
         vertices.push_back({{p.x(), p.y(), p.z()}, {n.x(), n.y(), n.z()}, info});
       }
     }
@@ -258,8 +256,7 @@ void GBufferVk::set_scene(const MrScene& scene) {
     return buffer;
   };
   impl_->vertices = upload(vertices, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  impl_->indices = upload(indices, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
-  impl_->index_count = static_cast<std::uint32_t>(indices.size());
+  impl_->vertex_count = static_cast<std::uint32_t>(vertices.size());
 }
 
 GBuffer GBufferVk::render(const MrCamera& camera) {
@@ -287,15 +284,14 @@ GBuffer GBufferVk::render(const MrCamera& camera) {
     begin.pClearValues = clear.data();
     g.timer.start(cmd);
     vkCmdBeginRenderPass(cmd, &begin, VK_SUBPASS_CONTENTS_INLINE);
-    if (g.index_count > 0) {
+    if (g.vertex_count > 0) {
       vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, g.pipeline.get());
       vkCmdPushConstants(cmd, g.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                          sizeof constants, &constants);
       const VkBuffer vertex_buffer = g.vertices->handle();
       const VkDeviceSize offset = 0;
       vkCmdBindVertexBuffers(cmd, 0, 1, &vertex_buffer, &offset);
-      vkCmdBindIndexBuffer(cmd, g.indices->handle(), 0, VK_INDEX_TYPE_UINT32);
-      vkCmdDrawIndexed(cmd, g.index_count, 1, 0, 0, 0);
+      vkCmdDraw(cmd, g.vertex_count, 1, 0, 0);
     }
     vkCmdEndRenderPass(cmd);
     g.timer.stop(cmd);

@@ -1,5 +1,5 @@
 #pragma once
-// The rasterised G-buffer on Vulkan (Knecht's dissertation §5.2.2): one indexed draw of every
+// The rasterised G-buffer on Vulkan (Knecht's dissertation §5.2.2): one draw of every
 // real and virtual triangle of an MrScene from the camera, into two RGBA32F targets
 // (position + signed distance, normal + material) and a depth buffer; the CPU reference is
 // gbuffer_cpu() (gbuffer.h), and the two agree pixel for pixel up to triangle edges.
