@@ -61,8 +61,9 @@ bool is_synthetic(const fs::path& sequence) {
 
 /// The real part of the scene: the synthetic scene's exact geometry, or the frame's depth mesh
 /// with the lights of --lights.
-MrScene real_scene(const RenderReferenceOptions& command, const TumSequence& sequence, const RgbdFrame& frame) {
-  if (is_synthetic(command.sequence)) {
+MrScene real_scene(const RenderReferenceOptions& command, bool synthetic, const TumSequence& sequence,
+                   const RgbdFrame& frame) {
+  if (synthetic) {
     MrScene scene = render::scene_from_synth(synth::default_indoor_scene());
     if (!command.lights.empty())
       throw Error("--lights applies to recorded sequences; a synthetic sequence brings its own lights");
@@ -142,12 +143,13 @@ int run_render_reference(const RenderReferenceOptions& command) {
   const RgbdFrame frame = sequence.load(static_cast<std::size_t>(command.frame));
   if (!frame.info.camera_to_world)
     throw Error("frame " + std::to_string(command.frame) + " has no camera pose (groundtruth.txt)");
-  MrScene scene = real_scene(command, sequence, frame);
+  const bool synthetic = is_synthetic(command.sequence);
+  MrScene scene = real_scene(command, synthetic, sequence, frame);
   std::string placement_text;
   if (!command.object.empty()) {
     placement_text = command.place;
     if (placement_text.empty()) {
-      if (!is_synthetic(command.sequence)) throw Error("--place x,y,z[,yaw[,scale]] is needed to put the object into a recorded scene");
+      if (!synthetic) throw Error("--place x,y,z[,yaw[,scale]] is needed to put the object into a recorded scene");
       placement_text = kDefaultSynthPlacement;
     }
     render::add_virtual_model(scene, render::load_model(command.object), render::Placement::parse(placement_text));
