@@ -7,12 +7,17 @@
 // Reads: the MrScene (set_scene, uploaded once), an MrCamera per render. Writes: GBuffer.
 // Pixel centres sit at integer (u, v) as everywhere in relight (cx = 319.5 is the middle of a
 // 640-pixel row), so the projection shifts by half a pixel into Vulkan's framebuffer convention.
+#include <vulkan/vulkan.h>
+
+#include <cstddef>
 #include <memory>
+#include <span>
 
 #include "relight/render/gbuffer.h"
 
 namespace relight::vk {
 class VulkanContext;
+class VulkanBuffer;
 }
 
 namespace relight::render {
@@ -30,6 +35,13 @@ class GBufferVk {
   /// Renders the camera's view and reads the G-buffer back. The camera's intrinsics must have
   /// this renderer's size.
   [[nodiscard]] GBuffer render(const MrCamera& camera);
+  /// Records the draw and a copy of both targets into `destination` (packed_bytes(): first every
+  /// pixel's position.xyz + signed distance, then every pixel's normal.xyz + material index), for
+  /// a renderer that goes on shading on the GPU.
+  void record(VkCommandBuffer cmd, const MrCamera& camera, const vk::VulkanBuffer& destination);
+  [[nodiscard]] static std::size_t packed_bytes(int width, int height);
+  /// The GBuffer of a packed copy (distance 0 = nothing drawn).
+  [[nodiscard]] static GBuffer unpack(std::span<const float> packed, int width, int height);
   /// GPU time of the last render's draw, milliseconds (0 without timestamp support).
   [[nodiscard]] double last_gpu_ms() const;
 
