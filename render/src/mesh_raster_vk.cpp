@@ -10,10 +10,11 @@
 
 namespace relight::render::detail {
 
-SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene) {
+SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers) {
   scene.validate();
   std::vector<RasterVertex> vertices;
   for (const TriangleMesh& mesh : scene.meshes) {
+    if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       const std::uint32_t info = mesh.triangle_material[t] | (mesh.real ? 0u : 0x80000000u);
       const auto& tri = mesh.triangles[t];
@@ -130,7 +131,7 @@ MeshPipeline create_mesh_pipeline(VkDevice device, const MeshPipelineInfo& info)
   vertex_input.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
   vertex_input.vertexBindingDescriptionCount = 1;
   vertex_input.pVertexBindingDescriptions = &binding;
-  vertex_input.vertexAttributeDescriptionCount = static_cast<std::uint32_t>(attributes.size());
+  vertex_input.vertexAttributeDescriptionCount = info.position_only ? 1u : static_cast<std::uint32_t>(attributes.size());
   vertex_input.pVertexAttributeDescriptions = attributes.data();
   VkPipelineInputAssemblyStateCreateInfo assembly{};
   assembly.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;

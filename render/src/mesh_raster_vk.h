@@ -33,8 +33,11 @@ struct SceneVertices {
   std::uint32_t count = 0;
 };
 
-/// Every triangle of `scene`; meshes without vertex normals get their face normal.
-[[nodiscard]] SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene);
+enum class MeshLayers { All, Real, Virtual };
+
+/// The triangles of `scene` in `layers`; meshes without vertex normals get their face normal.
+[[nodiscard]] SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene,
+                                                  MeshLayers layers = MeshLayers::All);
 
 /// Colour targets cleared and left in TRANSFER_SRC_OPTIMAL for a copy to a buffer; depth cleared
 /// and discarded.
@@ -57,6 +60,7 @@ struct MeshPipelineInfo {
   std::span<const std::uint32_t> fragment_spirv;
   std::uint32_t colour_targets = 1;
   std::uint32_t push_constant_bytes = 0;  ///< visible to both stages
+  bool position_only = false;             ///< the vertex shader reads location 0 only
 };
 
 /// Triangles with RasterVertex input, depth test LESS, no culling (reconstructed meshes and open

@@ -1,0 +1,77 @@
+#pragma once
+// Differential instant radiosity on Vulkan (Knecht et al., ISMAR 2010; dissertation chapter 5):
+// per frame, in one command buffer,
+//   1. the G-buffer of the camera (gbuffer_vk.h), r(p) in the sign of the distance;
+//   2. the shadow-map atlas of the primary lights, real and virtual layer (shadow_maps.h);
+//   3. the imperfect shadow maps of the VPLs, real and virtual layer (ism.h);
+//   4. one shading dispatch that writes L_rv and L_r together (dir_shade.comp, eqs. 5.1-5.8).
+// Reads an MrScene (set_scene), an MrCamera and the VPLs of vpl.h; writes DifferentialImages.
+//
+// The CPU mirror of step 4 is shade_dir_from_maps(): the same arithmetic on the same G-buffer and
+// atlases, so that a test can hold the GPU to it; the exact-visibility reference of the whole
+// method is shade_instant_radiosity() (dir_cpu.h).
+//
+// One pass vs two: `output` lets the same renderer produce only L_rv or only L_r, which is what
+// a renderer without the differential formulation has to do twice (bench dir/one_vs_two_pass).
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "relight/render/dir_cpu.h"
+#include "relight/render/gbuffer.h"
+#include "relight/render/ism.h"
+#include "relight/render/shadow_maps.h"
+
+namespace relight::vk {
+class VulkanContext;
+}
+
+namespace relight::render {
+
+enum class DirOutput { Both, RealVirtualOnly, RealOnly };
+
+struct DirVkOptions {
+  DirOptions shading{};      ///< min_distance, direct, indirect (threads: unused)
+  int shadow_tile = 512;     ///< texels per side of a primary light's shadow-map view
+  IsmOptions ism{};
+  DirOutput output = DirOutput::Both;
+};
+
+/// GPU milliseconds per step of the last render (0 without timestamp support).
+struct DirVkTimings {
+  double gbuffer_ms = 0, shadow_maps_ms = 0, ism_ms = 0, shading_ms = 0, total_ms = 0;
+};
+
+class DirRendererVk {
+ public:
+  /// Throws relight::Error when the device cannot rasterise and compute on one queue.
+  DirRendererVk(vk::VulkanContext& context, int width, int height);
+  ~DirRendererVk();
+  DirRendererVk(const DirRendererVk&) = delete;
+  DirRendererVk& operator=(const DirRendererVk&) = delete;
+
+  /// Geometry, materials, lights and the ISM point pools (options.ism's counts and seed).
+  void set_scene(const MrScene& scene, const DirVkOptions& options = {});
+  [[nodiscard]] DifferentialImages render(const MrCamera& camera, std::span<const Vpl> vpls,
+                                          const DirVkOptions& options = {});
+  [[nodiscard]] const DirVkTimings& last_timings() const;
+
+  // The intermediate results of the last render, read back (for tests and debugging views).
+  [[nodiscard]] GBuffer last_gbuffer() const;
+  [[nodiscard]] std::vector<float> last_shadow_atlas() const;
+  [[nodiscard]] std::vector<float> last_ism_atlas() const;
+  [[nodiscard]] const ShadowLayout& shadow_layout() const;
+  [[nodiscard]] const IsmPointPools& ism_points() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The shading pass on the CPU, from the same inputs as the GPU's.
+[[nodiscard]] DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene,
+                                                     const Eigen::Vector3f& camera_centre, const ShadowLayout& layout,
+                                                     std::span<const float> shadow_atlas, std::span<const Vpl> vpls,
+                                                     std::span<const float> ism_atlas, const DirVkOptions& options);
+
+}  // namespace relight::render

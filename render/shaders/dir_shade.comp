@@ -1,0 +1,189 @@
+#version 450
+// Differential instant radiosity, shading pass (render/dir_vk.h; Knecht et al. 2010, eqs.
+// 5.1-5.8): one invocation per G-buffer pixel computes L_rv and L_r together from the same
+// primary lights and VPLs. The CPU mirror is shade_dir_from_maps() (dir_vk.h).
+//   direct    L_rv += L_o min(V_r, V_v)              L_r += L_o r(light) r(p) V_r
+//   indirect  L_rv += L_o (1 - ir(VPL)) min(V_r, V_v)  L_r += L_o r(x̄) r(VPL) r(p) V_r
+// V_r / V_v come from the shadow-map atlas (primary lights) and the ISM atlas (VPLs).
+#include "dir_common.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+struct Material {
+  vec4 kd_ks;        // k_d, k_s
+  vec4 emission_n;   // emission, Phong exponent n
+};
+struct Light {
+  vec4 position_kind;      // w: 0 point, 1 spot, 2 directional (bits)
+  vec4 direction_real;     // unit; w: r(light)
+  vec4 intensity_inner;    // w: cos_inner
+  vec4 outer_views;        // x: cos_outer, y: first view (bits), z: view count (bits)
+};
+struct ShadowView {
+  mat4 world_to_clip;
+  vec4 eye;
+  vec4 texel_size;
+};
+
+layout(std430, set = 0, binding = 0) readonly buffer GBuffer { vec4 gbuffer[]; };  // positions, then normals
+layout(std430, set = 0, binding = 1) readonly buffer Materials { Material materials[]; };
+layout(std430, set = 0, binding = 2) readonly buffer Lights { Light lights[]; };
+layout(std430, set = 0, binding = 3) readonly buffer Views { ShadowView views[]; };
+layout(std430, set = 0, binding = 4) readonly buffer ShadowAtlas { float shadow_atlas[]; };
+layout(std430, set = 0, binding = 5) readonly buffer Vpls { Vpl vpls[]; };
+layout(std430, set = 0, binding = 6) readonly buffer IsmAtlas { float ism_atlas[]; };
+layout(std430, set = 0, binding = 7) writeonly buffer Radiance { vec4 radiance[]; };  // per pixel: L_rv + coverage, L_r
+
+layout(push_constant) uniform Params {
+  uint width;
+  uint height;
+  uint light_count;
+  uint vpl_count;
+  int shadow_tile;
+  int shadow_columns;
+  int shadow_rows;
+  int ism_tile;
+  float min_distance;
+  uint flags;  // bit 0 direct, bit 1 indirect, bit 2 write L_rv, bit 3 write L_r
+  uint pad0, pad1;
+  vec4 camera_centre;
+  vec4 environment;
+} params;
+
+// phong_brdf() (phong_brdf.h).
+vec3 phong(Material m, vec3 n, vec3 wi, vec3 wo) {
+  if (dot(n, wi) <= 0.0 || dot(n, wo) <= 0.0) return vec3(0.0);
+  vec3 f = m.kd_ks.xyz / PI;
+  if (m.kd_ks.w > 0.0) {
+    const float cos_alpha = max(0.0, dot(2.0 * dot(n, wi) * n - wi, wo));
+    f += m.kd_ks.w * (m.emission_n.w + 2.0) / (2.0 * PI) * pow(cos_alpha, m.emission_n.w);
+  }
+  return f;
+}
+
+// shadow_visibility() (shadow_maps.h).
+float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
+  const uint first = floatBitsToUint(light.outer_views.y), count = floatBitsToUint(light.outer_views.z);
+  if (count == 0u) return 1.0;
+  const vec4 any_eye = views[first].eye;
+  const bool positional = any_eye.w > 0.5;
+  const vec3 towards_light = positional ? any_eye.xyz - point : any_eye.xyz;
+  uint index = first;
+  if (count == 6u) {
+    const vec3 d = point - any_eye.xyz, a = abs(d);
+    const int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
+    index += uint(2 * axis + (d[axis] < 0.0 ? 1 : 0));
+  }
+  const ShadowView view = views[index];
+  const float texel = positional ? view.texel_size.x * length(towards_light) : view.texel_size.x;
+  const vec3 facing = dot(normal, towards_light) < 0.0 ? -normal : normal;
+  const vec3 receiver = point + 1.5 * texel * facing;
+  const vec4 clip = view.world_to_clip * vec4(receiver, 1.0);
+  if (clip.w <= 0.0) return 1.0;
+  const vec2 ndc = clip.xy / clip.w;
+  if (abs(ndc.x) > 1.0 || abs(ndc.y) > 1.0) return 1.0;
+  const int tile = params.shadow_tile;
+  const ivec2 texel_xy = clamp(ivec2(floor((ndc * 0.5 + 0.5) * float(tile))), ivec2(0), ivec2(tile - 1));
+  const int rows = max(params.shadow_rows, 1);
+  const ivec2 origin = ivec2((int(index) % params.shadow_columns) * tile, (layer * rows + int(index) / params.shadow_columns) * tile);
+  const float stored = shadow_atlas[(origin.y + texel_xy.y) * params.shadow_columns * tile + origin.x + texel_xy.x];
+  const float depth = positional ? length(receiver - view.eye.xyz) : -dot(receiver, view.eye.xyz);
+  return depth <= stored + texel ? 1.0 : 0.0;
+}
+
+// ism_visibility() (ism.h).
+float ism_visibility(uint index, int layer, Vpl vpl, vec3 point) {
+  vec3 t, b;
+  const vec3 n = vpl.normal_flags.xyz;
+  orthonormal_basis(n, t, b);
+  const vec3 q = point - vpl.position_material.xyz;
+  const float distance = length(q);
+  if (!(distance > 0.0)) return 1.0;
+  const int tile = params.ism_tile;
+  const vec2 texel = paraboloid_texel(vec3(dot(q, t), dot(q, b), dot(q, n)) / distance, tile);
+  const ivec2 xy = clamp(ivec2(floor(texel)), ivec2(0), ivec2(tile - 1));
+  const uint tile_index = uint(layer) * params.vpl_count + index;
+  const float stored = ism_atlas[(tile_index * uint(tile) + uint(xy.y)) * uint(tile) + uint(xy.x)];
+  const float bias = 0.02 + distance * 8.0 / float(tile);
+  return distance <= stored + bias ? 1.0 : 0.0;
+}
+
+void main() {
+  const uvec2 pixel = gl_GlobalInvocationID.xy;
+  if (pixel.x >= params.width || pixel.y >= params.height) return;
+  const uint pixels = params.width * params.height;
+  const uint i = pixel.y * params.width + pixel.x;
+  const vec4 position = gbuffer[i];
+  if (position.w == 0.0) {
+    radiance[2u * i] = vec4(params.environment.xyz, 0.0);
+    radiance[2u * i + 1u] = vec4(params.environment.xyz, 0.0);
+    return;
+  }
+  const vec4 normal_material = gbuffer[pixels + i];
+  const vec3 point = position.xyz, n = normal_material.xyz;
+  const float real_pixel = position.w > 0.0 ? 1.0 : 0.0;  // r(p)
+  const vec3 wo = normalize(params.camera_centre.xyz - point);
+  const Material m = materials[uint(normal_material.w)];
+  vec3 rv = m.emission_n.xyz;
+  vec3 r = real_pixel * m.emission_n.xyz;
+  const bool want_rv = (params.flags & 4u) != 0u, want_r = (params.flags & 8u) != 0u;
+
+  if ((params.flags & 1u) != 0u) {
+    for (uint l = 0u; l < params.light_count; ++l) {
+      const Light light = lights[l];
+      const uint kind = floatBitsToUint(light.position_kind.w);
+      vec3 wi, irradiance;
+      if (kind == 2u) {
+        wi = light.direction_real.xyz;
+        irradiance = light.intensity_inner.xyz;
+      } else {
+        const vec3 to_light = light.position_kind.xyz - point;
+        const float d2 = dot(to_light, to_light);
+        if (!(d2 > 0.0)) continue;
+        wi = to_light / sqrt(d2);
+        float falloff = 1.0;
+        if (kind == 1u) {
+          const float c = dot(light.direction_real.xyz, -wi);
+          const float inner = light.intensity_inner.w, outer = light.outer_views.x;
+          const float x = clamp((c - outer) / (inner - outer), 0.0, 1.0);
+          falloff = c <= outer ? 0.0 : (c >= inner ? 1.0 : x * x * (3.0 - 2.0 * x));
+        }
+        if (falloff <= 0.0) continue;
+        irradiance = light.intensity_inner.xyz * (falloff / d2);
+      }
+      const float cos_i = dot(wi, n);
+      if (cos_i <= 0.0) continue;
+      const vec3 contribution = phong(m, n, wi, wo) * irradiance * cos_i;
+      const float v_r = shadow_visibility(light, 0, point, n);
+      if (v_r == 0.0) continue;
+      if (want_rv) rv += contribution * shadow_visibility(light, 1, point, n);
+      r += contribution * (light.direction_real.w * real_pixel);
+    }
+  }
+
+  if ((params.flags & 2u) != 0u) {
+    const float min_d2 = params.min_distance * params.min_distance;
+    for (uint j = 0u; j < params.vpl_count; ++j) {
+      const Vpl vpl = vpls[j];
+      const uint flags = floatBitsToUint(vpl.normal_flags.w);
+      const bool in_rv = want_rv && (flags & 2u) != 0u;
+      const bool in_r = want_r && (flags & 4u) != 0u && real_pixel > 0.0;
+      if (!in_rv && !in_r) continue;
+      const vec3 to_vpl = vpl.position_material.xyz - point;
+      const float d2 = dot(to_vpl, to_vpl);
+      if (!(d2 > 0.0)) continue;
+      const vec3 wi = to_vpl / sqrt(d2);
+      const float cos_x = dot(wi, n), cos_y = -dot(wi, vpl.normal_flags.xyz);
+      if (cos_x <= 0.0 || cos_y <= 0.0) continue;
+      const Material mv = materials[floatBitsToUint(vpl.position_material.w)];
+      const vec3 contribution = vpl.flux.xyz * phong(mv, vpl.normal_flags.xyz, vpl.incident.xyz, -wi) *
+                                phong(m, n, wi, wo) * (cos_x * cos_y / max(d2, min_d2));
+      const float v_r = ism_visibility(j, 0, vpl, point);
+      if (v_r == 0.0) continue;
+      if (in_rv) rv += contribution * ism_visibility(j, 1, vpl, point);
+      if (in_r) r += contribution;
+    }
+  }
+  radiance[2u * i] = vec4(rv, 1.0 - real_pixel);
+  radiance[2u * i + 1u] = vec4(r, 0.0);
+}

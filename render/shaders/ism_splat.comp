@@ -1,0 +1,80 @@
+#version 450
+// Imperfect shadow maps, splat pass (render/ism.h): one invocation per (point slot, VPL, layer)
+// maps the point's normal-aligned square into the VPL's paraboloid tile and keeps the minimum
+// distance per texel (atomicMin on the float's bits: non-negative floats order like uints).
+#include "dir_common.glsl"
+
+layout(local_size_x = 64) in;
+
+struct Point {
+  vec4 position_half_size;
+  vec4 normal;
+};
+
+layout(std430, set = 0, binding = 0) readonly buffer Points { Point points[]; };  // real pool, then virtual
+layout(std430, set = 0, binding = 1) readonly buffer Vpls { Vpl vpls[]; };
+layout(std430, set = 0, binding = 2) buffer Atlas { uint atlas[]; };
+
+layout(push_constant) uniform Params {
+  int tile;
+  uint points_per_vpl;
+  uint vpl_count;
+  uint real_pool;
+  uint virtual_pool;
+} params;
+
+const int MAX_SPLAT = 16;  // kMaxSplat
+
+float edge_function(vec2 a, vec2 b, vec2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }
+
+void main() {
+  const uint slot = gl_GlobalInvocationID.x, vpl_index = gl_GlobalInvocationID.y, layer = gl_GlobalInvocationID.z;
+  if (slot >= params.points_per_vpl || vpl_index >= params.vpl_count) return;
+  const uint pool = layer == 0u ? params.real_pool : params.virtual_pool;
+  if (pool == 0u) return;
+  const Point point = points[(layer == 0u ? 0u : params.real_pool) + ism_point_index(vpl_index, slot, pool)];
+  const Vpl vpl = vpls[vpl_index];
+  vec3 t, b;
+  const vec3 n = vpl.normal_flags.xyz;
+  orthonormal_basis(n, t, b);
+  const vec3 origin = vpl.position_material.xyz;
+  const vec3 q = point.position_half_size.xyz - origin;
+  const float distance = length(q);
+  if (!(distance > 1e-4)) return;
+  const vec3 centre_dir = vec3(dot(q, t), dot(q, b), dot(q, n)) / distance;
+  if (centre_dir.z <= 0.0) return;
+  const int tile = params.tile;
+  const vec2 centre = paraboloid_texel(centre_dir, tile);
+  vec3 tp, bp;
+  orthonormal_basis(point.normal.xyz, tp, bp);
+  const float h = point.position_half_size.w;
+  const vec2 signs[4] = vec2[4](vec2(1, 1), vec2(-1, 1), vec2(-1, -1), vec2(1, -1));
+  vec2 corners[4];
+  vec2 low = centre, high = centre;
+  for (int k = 0; k < 4; ++k) {
+    const vec3 c = point.position_half_size.xyz + h * (signs[k].x * tp + signs[k].y * bp) - origin;
+    const float cd = length(c);
+    corners[k] = cd > 1e-4 ? paraboloid_texel(vec3(dot(c, t), dot(c, b), dot(c, n)) / cd, tile) : centre;
+    low = min(low, corners[k]);
+    high = max(high, corners[k]);
+  }
+  const uint base = (layer * params.vpl_count + vpl_index) * uint(tile * tile);
+  const uint bits = floatBitsToUint(distance);
+  const int cx = clamp(int(floor(centre.x)), 0, tile - 1), cy = clamp(int(floor(centre.y)), 0, tile - 1);
+  const int x0 = max(max(0, int(floor(low.x))), cx - MAX_SPLAT / 2);
+  const int y0 = max(max(0, int(floor(low.y))), cy - MAX_SPLAT / 2);
+  const int x1 = min(min(tile - 1, int(floor(high.x))), x0 + MAX_SPLAT - 1);
+  const int y1 = min(min(tile - 1, int(floor(high.y))), y0 + MAX_SPLAT - 1);
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const vec2 p = vec2(x, y) + 0.5;
+      bool positive = true, negative = true;
+      for (int k = 0; k < 4; ++k) {
+        const float e = edge_function(corners[k], corners[(k + 1) % 4], p);
+        positive = positive && e >= 0.0;
+        negative = negative && e <= 0.0;
+      }
+      if (positive || negative) atomicMin(atlas[base + uint(y * tile + x)], bits);
+    }
+  atomicMin(atlas[base + uint(cy * tile + cx)], bits);
+}

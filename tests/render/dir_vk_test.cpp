@@ -1,0 +1,244 @@
+// Differential instant radiosity on Vulkan: every GPU step against its CPU reference (shadow
+// maps by ray casting, ISMs by the same splats, shading by shade_dir_from_maps), then the whole
+// method against the exact-visibility CPU DIR and the path tracer.
+#include "relight/render/dir_vk.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "../reconstruct/vulkan_test_env.h"
+#include "relight/core/error.h"
+#include "relight/render/procedural_models.h"
+#include "relight/render/scene_from_synth.h"
+#include "relight/synth/scene.h"
+#include "relight/vk/context.h"
+#include "test_scenes.h"
+
+namespace relight::render {
+namespace {
+
+using test::camera_at;
+using test::diffuse;
+
+class DirVkTest : public relight::test::VulkanTest {};
+
+/// A white floor and a back wall, a real point light, and a red virtual cube on the floor.
+MrScene cube_scene() {
+  MrScene scene = test::floor_scene(Eigen::Vector3f::Constant(0.8f), {1.0f, 0.f, 1.5f}, 4.f);
+  TriangleMesh wall = tessellate(synth::Rect{{0, 2, 1}, {0, -1, 0}, {1, 0, 0}, {0, 0, 1}, 2, 1},
+                                 scene.add_material(diffuse({0.3f, 0.6f, 0.3f}, "green wall")));
+  scene.meshes.push_back(wall);
+  test::add_virtual_box(scene, synth::Box{{-0.2, -0.2, 0.0}, {0.2, 0.2, 0.4}}, diffuse({0.9f, 0.1f, 0.1f}, "red cube"));
+  return scene;
+}
+
+MrScene indoor_with_pebble() {
+  MrScene scene = scene_from_synth(synth::default_indoor_scene(), {48});
+  add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
+  return scene;
+}
+
+DirVkOptions test_options() {
+  DirVkOptions options;
+  options.shadow_tile = 256;
+  options.ism.tile = 32;
+  options.ism.points_per_vpl = 512;
+  options.ism.pull_push_levels = 2;
+  options.shading.min_distance = 0.05f;
+  return options;
+}
+
+std::vector<Vpl> make_vpls(const MrScene& scene, int count) {
+  VplOptions options;
+  options.count = count;
+  return generate_vpls(scene, RayTracer(scene), options);
+}
+
+float luminance(const Float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+TEST_F(DirVkTest, ShadowAtlasMatchesTheRayCastReference) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  MrScene scene = indoor_with_pebble();
+  MrLight spot;
+  spot.kind = LightKind::Spot;
+  spot.position = {0.8f, -0.9f, 2.0f};
+  spot.direction = Eigen::Vector3f(-0.3f, 0.5f, -1.f).normalized();
+  spot.real = false;
+  scene.lights.push_back(spot);
+  MrLight sun;
+  sun.kind = LightKind::Directional;
+  sun.direction = Eigen::Vector3f(0.3f, -0.4f, 1.f).normalized();
+  scene.lights.push_back(sun);
+  DirVkOptions options = test_options();
+  options.shadow_tile = 128;
+  DirRendererVk renderer(context, 32, 24);
+  renderer.set_scene(scene, options);
+  (void)renderer.render(camera_at({1.3, -1.1, 1.4}, {0.2, -0.1, 0.75}, 32, 24), {}, options);
+  const ShadowLayout& layout = renderer.shadow_layout();
+  ASSERT_EQ(layout.light_views.size(), scene.lights.size());
+  EXPECT_EQ(layout.light_views.back()[1], 1u) << "directional: one orthographic view";
+  EXPECT_EQ(layout.light_views[layout.light_views.size() - 2][1], 1u) << "narrow spot: one perspective view";
+  const std::vector<float> gpu = renderer.last_shadow_atlas();
+  const std::vector<float> cpu = shadow_atlas_cpu(RayTracer(scene), layout);
+  ASSERT_EQ(gpu.size(), cpu.size());
+  std::size_t both = 0, agree = 0, coverage_mismatch = 0, virtual_texels = 0;
+  const int virtual_top = layout.atlas_height() / 2;
+  for (std::size_t i = 0; i < cpu.size(); ++i) {
+    const bool seen_gpu = gpu[i] < kShadowEmpty, seen_cpu = cpu[i] < kShadowEmpty;
+    if (seen_gpu != seen_cpu) {
+      ++coverage_mismatch;
+      continue;
+    }
+    if (!seen_cpu) continue;
+    ++both;
+    if (static_cast<int>(i / static_cast<std::size_t>(layout.atlas_width())) >= virtual_top) ++virtual_texels;
+    if (std::abs(gpu[i] - cpu[i]) <= 0.01f * std::abs(cpu[i]) + 0.005f) ++agree;
+  }
+  EXPECT_GT(both, cpu.size() / 4) << "the real layer (half the atlas) is mostly covered";
+  EXPECT_GT(virtual_texels, 50u) << "the pebble is in the lights' views";
+  EXPECT_GT(agree, both * 98 / 100);
+  EXPECT_LT(coverage_mismatch, cpu.size() / 100);
+}
+
+TEST_F(DirVkTest, IsmAtlasMatchesTheCpuSplatsAndPullPush) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const MrScene scene = cube_scene();
+  const DirVkOptions options = test_options();
+  const std::vector<Vpl> vpls = make_vpls(scene, 48);
+  DirRendererVk renderer(context, 32, 24);
+  renderer.set_scene(scene, options);
+  (void)renderer.render(camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 32, 24), vpls, options);
+  const std::vector<float> gpu = renderer.last_ism_atlas();
+  const std::vector<float> cpu = ism_atlas_cpu(renderer.ism_points(), vpls, options.ism);
+  ASSERT_EQ(gpu.size(), cpu.size());
+  std::size_t seen = 0, agree = 0, virtual_seen = 0;
+  const std::size_t half = cpu.size() / 2;
+  for (std::size_t i = 0; i < cpu.size(); ++i) {
+    if (cpu[i] < kShadowEmpty) {
+      ++seen;
+      if (i >= half) ++virtual_seen;
+    }
+    const bool same_state = (gpu[i] < kShadowEmpty) == (cpu[i] < kShadowEmpty);
+    if (same_state && (cpu[i] >= kShadowEmpty || std::abs(gpu[i] - cpu[i]) <= 1e-4f * cpu[i])) ++agree;
+  }
+  EXPECT_GT(seen, half / 2) << "the real layer covers most of every VPL's hemisphere";
+  EXPECT_GT(virtual_seen, 100u) << "the cube is seen by the VPLs";
+  EXPECT_GT(agree, cpu.size() * 995 / 1000);
+}
+
+TEST_F(DirVkTest, ShadingMatchesTheCpuMirrorOnTheSameMaps) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const MrScene scene = cube_scene();
+  const DirVkOptions options = test_options();
+  const std::vector<Vpl> vpls = make_vpls(scene, 64);
+  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 64, 48);
+  DirRendererVk renderer(context, 64, 48);
+  renderer.set_scene(scene, options);
+  const DifferentialImages gpu = renderer.render(camera, vpls, options);
+  const DifferentialImages cpu =
+      shade_dir_from_maps(renderer.last_gbuffer(), scene, camera.camera_to_world.translation().cast<float>(),
+                          renderer.shadow_layout(), renderer.last_shadow_atlas(), vpls, renderer.last_ism_atlas(), options);
+  int close = 0, virtual_pixels = 0;
+  const int pixels = 64 * 48;
+  for (int i = 0; i < pixels; ++i) {
+    const float tolerance_rv = 1e-3f * luminance(cpu.real_virtual.pixels()[i]) + 1e-5f;
+    const float tolerance_r = 1e-3f * luminance(cpu.real.pixels()[i]) + 1e-5f;
+    const bool rv = length(gpu.real_virtual.pixels()[i] - cpu.real_virtual.pixels()[i]) <= tolerance_rv;
+    const bool r = length(gpu.real.pixels()[i] - cpu.real.pixels()[i]) <= tolerance_r;
+    if (rv && r) ++close;
+    EXPECT_EQ(gpu.virtual_coverage.pixels()[i], cpu.virtual_coverage.pixels()[i]);
+    virtual_pixels += gpu.virtual_coverage.pixels()[i] > 0.5f;
+  }
+  EXPECT_GT(virtual_pixels, 50);
+  // A handful of pixels may sit exactly on a visibility edge where the GPU's fused arithmetic
+  // rounds the other way.
+  EXPECT_GT(close, pixels * 99 / 100);
+}
+
+/// The floor + red virtual cube of dir_cpu_test.cpp (no wall): the path tracer's scene.
+MrScene open_cube_scene() {
+  MrScene scene = test::floor_scene(Eigen::Vector3f::Constant(0.8f), {1.0f, 0.f, 1.5f}, 4.f);
+  test::add_virtual_box(scene, synth::Box{{-0.2, -0.2, 0.0}, {0.2, 0.2, 0.4}}, diffuse({0.9f, 0.1f, 0.1f}, "red cube"));
+  return scene;
+}
+
+TEST_F(DirVkTest, VirtualCubeShadowsAndBleedsOnlyWhereFig57Says) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const MrScene scene = open_cube_scene();
+  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 48, 36);
+  DirVkOptions options = test_options();
+  DirRendererVk renderer(context, 48, 36);
+  renderer.set_scene(scene, options);
+  const DifferentialImages images = renderer.render(camera, make_vpls(scene, 256), options);
+  const auto shadow = test::floor_pixels(scene, camera, {-0.45f, -0.12f}, {-0.25f, 0.12f});
+  const auto bleeding = test::floor_pixels(scene, camera, {0.22f, -0.15f}, {0.45f, 0.15f});
+  const auto far_floor = test::floor_pixels(scene, camera, {1.2f, -0.6f}, {1.8f, 0.6f});
+  ASSERT_GT(shadow.size(), 8u);
+  ASSERT_GT(bleeding.size(), 8u);
+  ASSERT_GT(far_floor.size(), 8u);
+  // The virtual shadow: direct light is gone from L_rv but present in L_r.
+  const Eigen::Vector3d shadow_rv = test::mean_over(images.real_virtual, shadow);
+  const Eigen::Vector3d shadow_r = test::mean_over(images.real, shadow);
+  EXPECT_LT(shadow_rv.sum(), 0.5 * shadow_r.sum());
+  // Red bleeding from the virtual cube onto the real floor exists only in L_rv.
+  const Eigen::Vector3d bleed = test::mean_over(images.real_virtual, bleeding) - test::mean_over(images.real, bleeding);
+  EXPECT_GT(bleed.x(), 0.0);
+  EXPECT_GT(bleed.x(), 3.0 * std::abs(bleed.z()));
+  // Far from the cube the two worlds agree.
+  const Eigen::Vector3d far = test::mean_over(images.real_virtual, far_floor) - test::mean_over(images.real, far_floor);
+  EXPECT_LT(far.norm(), 0.02 * test::mean_over(images.real, far_floor).norm());
+  // The cube's own pixels: r(p) = 0, so L_r is zero there and L_rv holds the lit red cube.
+  int cube_pixels = 0;
+  for (std::size_t i = 0; i < images.real.pixels().size(); ++i) {
+    if (images.virtual_coverage.pixels()[i] < 0.5f) continue;
+    ++cube_pixels;
+    EXPECT_EQ(images.real.pixels()[i], (Float3{0.f, 0.f, 0.f}));
+  }
+  EXPECT_GT(cube_pixels, 20);
+}
+
+TEST_F(DirVkTest, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const MrScene scene = open_cube_scene();
+  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 48, 36);
+  PathTracerOptions pt_options;
+  pt_options.max_bounces = 1;
+  pt_options.roulette_from = 10;
+  const DifferentialImages pt = render_reference(scene, camera, 256, pt_options);
+  DirVkOptions options;
+  options.shading.min_distance = 0.02f;
+  options.shadow_tile = 512;
+  DirRendererVk renderer(context, 48, 36);
+  renderer.set_scene(scene, options);
+  const DifferentialImages dir = renderer.render(camera, make_vpls(scene, 1024), options);
+  const auto relative_error = [&](const Eigen::Vector2f& lo, const Eigen::Vector2f& hi) {
+    const auto pixels = test::floor_pixels(scene, camera, lo, hi);
+    EXPECT_GT(pixels.size(), 8u);
+    const Eigen::Vector3d d_pt = test::mean_over(pt.real_virtual, pixels) - test::mean_over(pt.real, pixels);
+    const Eigen::Vector3d d_dir = test::mean_over(dir.real_virtual, pixels) - test::mean_over(dir.real, pixels);
+    return (d_dir - d_pt).norm() / d_pt.norm();
+  };
+  EXPECT_LT(relative_error({-0.45f, -0.12f}, {-0.25f, 0.12f}), 0.15) << "shadow region";
+  EXPECT_LT(relative_error({0.22f, -0.15f}, {0.45f, 0.15f}), 0.15) << "bleeding region";
+}
+
+TEST_F(DirVkTest, RejectsMisuse) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  EXPECT_THROW(DirRendererVk(context, 0, 10), Error);
+  DirRendererVk renderer(context, 16, 12);
+  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 16, 12);
+  EXPECT_THROW((void)renderer.render(camera, {}), LogicError);
+  DirVkOptions options = test_options();
+  renderer.set_scene(open_cube_scene(), options);
+  DirVkOptions other = options;
+  other.shadow_tile = 128;
+  EXPECT_THROW((void)renderer.render(camera, {}, other), Error);
+  EXPECT_THROW((void)renderer.render(camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 32, 24), {}, options), Error);
+  IsmOptions too_many;
+  too_many.points_per_vpl = 8192;
+  EXPECT_THROW((void)sample_ism_points(open_cube_scene(), too_many), Error);
+}
+
+}  // namespace
+}  // namespace relight::render
