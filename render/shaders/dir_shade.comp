@@ -5,6 +5,15 @@
 //   direct    L_rv += L_o min(V_r, V_v)              L_r += L_o r(light) r(p) V_r
 //   indirect  L_rv += L_o (1 - ir(VPL)) min(V_r, V_v)  L_r += L_o r(x̄) r(VPL) r(p) V_r
 // V_r / V_v come from the shadow-map atlas (primary lights) and the ISM atlas (VPLs).
+//
+// Interleaved sampling (Segovia et al. 2006): with interleave n > 1, pixel (x, y) is lit by the
+// VPLs j = s, s + n^2, ... of its subset s = (x mod n) + n (y mod n), scaled by n^2; dir_merge.comp
+// then averages the indirect light over n x n neighbours. The dispatch is laid out as n x n
+// sub-buffers (invocation block (sx, sy) shades the pixels of subset (sx, sy)), so neighbouring
+// invocations read the same VPLs.
+//
+// Output per pixel (4 vec4): direct L_rv + emission (w: virtual coverage), direct L_r,
+// indirect L_rv, indirect L_r.
 #include "dir_common.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -32,7 +41,7 @@ layout(std430, set = 0, binding = 3) readonly buffer Views { ShadowView views[];
 layout(std430, set = 0, binding = 4) readonly buffer ShadowAtlas { float shadow_atlas[]; };
 layout(std430, set = 0, binding = 5) readonly buffer Vpls { Vpl vpls[]; };
 layout(std430, set = 0, binding = 6) readonly buffer IsmAtlas { float ism_atlas[]; };
-layout(std430, set = 0, binding = 7) writeonly buffer Radiance { vec4 radiance[]; };  // per pixel: L_rv + coverage, L_r
+layout(std430, set = 0, binding = 7) writeonly buffer Radiance { vec4 radiance[]; };
 
 layout(push_constant) uniform Params {
   uint width;
@@ -45,7 +54,8 @@ layout(push_constant) uniform Params {
   int ism_tile;
   float min_distance;
   uint flags;  // bit 0 direct, bit 1 indirect, bit 2 write L_rv, bit 3 write L_r
-  uint pad0, pad1;
+  uint interleave;
+  uint pad;
   vec4 camera_centre;
   vec4 environment;
 } params;
@@ -109,14 +119,19 @@ float ism_visibility(uint index, int layer, Vpl vpl, vec3 point) {
 }
 
 void main() {
-  const uvec2 pixel = gl_GlobalInvocationID.xy;
-  if (pixel.x >= params.width || pixel.y >= params.height) return;
+  const uint interleave = params.interleave;
+  const uvec2 sub_size = (uvec2(params.width, params.height) + interleave - 1u) / interleave;
+  const uvec2 id = gl_GlobalInvocationID.xy;
+  const uvec2 pixel = (id % sub_size) * interleave + id / sub_size;
+  if (id.x >= sub_size.x * interleave || id.y >= sub_size.y * interleave || pixel.x >= params.width || pixel.y >= params.height) return;
   const uint pixels = params.width * params.height;
   const uint i = pixel.y * params.width + pixel.x;
   const vec4 position = gbuffer[i];
   if (position.w == 0.0) {
-    radiance[2u * i] = vec4(params.environment.xyz, 0.0);
-    radiance[2u * i + 1u] = vec4(params.environment.xyz, 0.0);
+    radiance[4u * i] = vec4(params.environment.xyz, 0.0);
+    radiance[4u * i + 1u] = vec4(params.environment.xyz, 0.0);
+    radiance[4u * i + 2u] = vec4(0.0);
+    radiance[4u * i + 3u] = vec4(0.0);
     return;
   }
   const vec4 normal_material = gbuffer[pixels + i];
@@ -161,9 +176,11 @@ void main() {
     }
   }
 
+  vec3 indirect_rv = vec3(0.0), indirect_r = vec3(0.0);
   if ((params.flags & 2u) != 0u) {
     const float min_d2 = params.min_distance * params.min_distance;
-    for (uint j = 0u; j < params.vpl_count; ++j) {
+    const uint subset = (pixel.x % interleave) + interleave * (pixel.y % interleave);
+    for (uint j = subset; j < params.vpl_count; j += interleave * interleave) {
       const Vpl vpl = vpls[j];
       const uint flags = floatBitsToUint(vpl.normal_flags.w);
       const bool in_rv = want_rv && (flags & 2u) != 0u;
@@ -180,10 +197,13 @@ void main() {
                                 phong(m, n, wi, wo) * (cos_x * cos_y / max(d2, min_d2));
       const float v_r = ism_visibility(j, 0, vpl, point);
       if (v_r == 0.0) continue;
-      if (in_rv) rv += contribution * ism_visibility(j, 1, vpl, point);
-      if (in_r) r += contribution;
+      if (in_rv) indirect_rv += contribution * ism_visibility(j, 1, vpl, point);
+      if (in_r) indirect_r += contribution;
     }
   }
-  radiance[2u * i] = vec4(rv, 1.0 - real_pixel);
-  radiance[2u * i + 1u] = vec4(r, 0.0);
+  const float scale = float(interleave * interleave);
+  radiance[4u * i] = vec4(rv, 1.0 - real_pixel);
+  radiance[4u * i + 1u] = vec4(r, 0.0);
+  radiance[4u * i + 2u] = vec4(indirect_rv * scale, 0.0);
+  radiance[4u * i + 3u] = vec4(indirect_r * scale, 0.0);
 }

@@ -13,8 +13,10 @@ namespace {
 using Vec3 = Eigen::Vector3f;
 
 struct Radiance {
-  Vec3 real_virtual = Vec3::Zero();
+  Vec3 real_virtual = Vec3::Zero();  ///< direct + emission
   Vec3 real = Vec3::Zero();
+  Vec3 indirect_real_virtual = Vec3::Zero();  ///< this pixel's VPL subset, scaled by n^2
+  Vec3 indirect_real = Vec3::Zero();
 };
 
 class MapShader {
@@ -24,12 +26,12 @@ class MapShader {
       : scene_(scene), layout_(layout), shadow_atlas_(shadow_atlas), vpls_(vpls), ism_atlas_(ism_atlas), options_(options) {}
 
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
-                               float real_pixel) const {
+                               float real_pixel, std::uint32_t subset) const {
     Radiance out;
     out.real_virtual = m.emission;
     out.real = real_pixel * m.emission;
     if (options_.shading.direct) add_direct(point, normal, wo, m, real_pixel, out);
-    if (options_.shading.indirect) add_indirect(point, normal, wo, m, real_pixel, out);
+    if (options_.shading.indirect) add_indirect(point, normal, wo, m, real_pixel, subset, out);
     return out;
   }
 
@@ -54,10 +56,12 @@ class MapShader {
   }
 
   void add_indirect(const Vec3& point, const Vec3& n, const Vec3& wo, const PhongMaterial& m, float real_pixel,
-                    Radiance& out) const {
+                    std::uint32_t subset, Radiance& out) const {
     const float min_distance2 = options_.shading.min_distance * options_.shading.min_distance;
     const auto count = static_cast<std::uint32_t>(vpls_.size());
-    for (std::uint32_t j = 0; j < count; ++j) {
+    const auto subsets = static_cast<std::uint32_t>(options_.interleave * options_.interleave);
+    Vec3 rv = Vec3::Zero(), r = Vec3::Zero();
+    for (std::uint32_t j = subset; j < count; j += subsets) {
       const Vpl& vpl = vpls_[j];
       const bool in_rv = want_rv() && vpl.in_real_virtual;
       const bool in_r = want_r() && vpl.in_real && real_pixel > 0.f;
@@ -72,9 +76,11 @@ class MapShader {
                                     .cwiseProduct(phong_brdf(m, n, wi, wo)) *
                                 (cos_x * cos_y / std::max(distance2, min_distance2));
       if (ism_visibility(ism_atlas_, options_.ism, count, j, 0, vpl, point) == 0.f) continue;
-      if (in_rv) out.real_virtual += contribution * ism_visibility(ism_atlas_, options_.ism, count, j, 1, vpl, point);
-      if (in_r) out.real += contribution;
+      if (in_rv) rv += contribution * ism_visibility(ism_atlas_, options_.ism, count, j, 1, vpl, point);
+      if (in_r) r += contribution;
     }
+    out.indirect_real_virtual = rv * static_cast<float>(subsets);
+    out.indirect_real = r * static_cast<float>(subsets);
   }
 
   const MrScene& scene_;
@@ -84,6 +90,35 @@ class MapShader {
   std::span<const float> ism_atlas_;
   const DirVkOptions& options_;
 };
+
+/// merge_interleaved: dir_merge.comp's geometry-aware average of the indirect light over the
+/// n x n window, direct light added unblurred.
+Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, int y, int n) {
+  const Radiance& own = shaded(y, x);
+  Vec3 sum_rv = own.indirect_real_virtual, sum_r = own.indirect_real;
+  float weight = 1.f;
+  const float distance = g.distance(y, x);
+  if (n > 1 && distance != 0.f) {
+    const Float3 normal = g.normal(y, x);
+    const bool is_virtual = g.virtual_surface(y, x) != 0;
+    for (int dy = -n / 2; dy < n - n / 2; ++dy)
+      for (int dx = -n / 2; dx < n - n / 2; ++dx) {
+        const int qx = x + dx, qy = y + dy;
+        if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= g.distance.width() || qy >= g.distance.height()) continue;
+        const float dq = g.distance(qy, qx);
+        if (dq == 0.f || (g.virtual_surface(qy, qx) != 0) != is_virtual) continue;
+        if (std::abs(dq - distance) > 0.05f * distance) continue;
+        if (dot(g.normal(qy, qx), normal) < 0.9f) continue;
+        sum_rv += shaded(qy, qx).indirect_real_virtual;
+        sum_r += shaded(qy, qx).indirect_real;
+        weight += 1.f;
+      }
+  }
+  Radiance out;
+  out.real_virtual = own.real_virtual + sum_rv / weight;
+  out.real = own.real + sum_r / weight;
+  return out;
+}
 
 }  // namespace
 
@@ -96,27 +131,37 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
     throw Error("shade_dir_from_maps: the shadow atlas is smaller than its layout");
   const std::size_t ism_texels = 2 * vpls.size() * static_cast<std::size_t>(options.ism.tile) * static_cast<std::size_t>(options.ism.tile);
   if (ism_atlas.size() < ism_texels) throw Error("shade_dir_from_maps: the ISM atlas is smaller than its VPLs need");
-  DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1};
+  if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
   const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, options);
   const Vec3 environment = scene.environment.radiance;
+  const int n = options.interleave;
+  Image<Radiance> shaded(width, height);
   parallel_rows(height, options.shading.threads, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
       for (int x = 0; x < width; ++x) {
         if (gbuffer.distance(y, x) == 0.f) {
-          out.real_virtual(y, x) = out.real(y, x) = {environment.x(), environment.y(), environment.z()};
+          shaded(y, x).real_virtual = shaded(y, x).real = environment;
           continue;
         }
         const auto& p = gbuffer.position(y, x);
         const auto& nn = gbuffer.normal(y, x);
         const Vec3 point(p.x, p.y, p.z), normal(nn.x, nn.y, nn.z);
         const float real_pixel = gbuffer.virtual_surface(y, x) ? 0.f : 1.f;
-        const Radiance r = shader.shade(point, normal, (camera_centre - point).normalized(),
-                                        scene.materials[gbuffer.material(y, x) - 1u], real_pixel);
-        out.real_virtual(y, x) = {r.real_virtual.x(), r.real_virtual.y(), r.real_virtual.z()};
-        out.real(y, x) = {r.real.x(), r.real.y(), r.real.z()};
-        out.virtual_coverage(y, x) = 1.f - real_pixel;
+        const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));
+        shaded(y, x) = shader.shade(point, normal, (camera_centre - point).normalized(),
+                                    scene.materials[gbuffer.material(y, x) - 1u], real_pixel, subset);
       }
   }, 4);
+  DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1};
+  parallel_rows(height, options.shading.threads, [&](int begin, int end) {
+    for (int y = begin; y < end; ++y)
+      for (int x = 0; x < width; ++x) {
+        const Radiance r = merged_pixel(gbuffer, shaded, x, y, n);
+        out.real_virtual(y, x) = {r.real_virtual.x(), r.real_virtual.y(), r.real_virtual.z()};
+        out.real(y, x) = {r.real.x(), r.real.y(), r.real.z()};
+        out.virtual_coverage(y, x) = gbuffer.distance(y, x) != 0.f && gbuffer.virtual_surface(y, x) ? 1.f : 0.f;
+      }
+  }, 8);
   return out;
 }
 

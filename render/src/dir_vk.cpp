@@ -1,12 +1,14 @@
 #include "relight/render/dir_vk.h"
 
 #include <bit>
+#include <chrono>
 #include <cstring>
 #include <optional>
 
 #include "ism_vk.h"
 #include "relight/core/error.h"
 #include "relight/render/gbuffer_vk.h"
+#include "relight/shaders/dir_merge_comp.h"
 #include "relight/shaders/dir_shade_comp.h"
 #include "relight/vk/barrier.h"
 #include "relight/vk/buffer.h"
@@ -17,17 +19,28 @@
 #include "shadow_maps_vk.h"
 
 namespace relight::render {
-namespace {
+namespace detail {
 
 struct ShadeParams {
   std::uint32_t width, height, light_count, vpl_count;
   std::int32_t shadow_tile, shadow_columns, shadow_rows, ism_tile;
   float min_distance;
-  std::uint32_t flags, pad0 = 0, pad1 = 0;
+  std::uint32_t flags, interleave, pad = 0;
   float camera_centre[4];
   float environment[4];
 };
 static_assert(sizeof(ShadeParams) <= 128);
+
+struct MergeParams {
+  std::uint32_t width, height, interleave;
+};
+
+}  // namespace detail
+
+namespace {
+
+using detail::MergeParams;
+using detail::ShadeParams;
 
 float bits(std::uint32_t value) { return std::bit_cast<float>(value); }
 
@@ -89,10 +102,14 @@ struct DirRendererVk::Impl {
         ism(context),
         shade(context, {.spirv = shaders::dir_shade_comp, .storage_buffers = 8,
                         .push_constant_bytes = sizeof(ShadeParams), .max_descriptor_sets = 2}),
+        merge(context, {.spirv = shaders::dir_merge_comp, .storage_buffers = 3,
+                        .push_constant_bytes = sizeof(MergeParams), .max_descriptor_sets = 2}),
         gbuffer_buffer(context, GBufferVk::packed_bytes(width, height)),
+        shaded(context, 16 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
         output(context, 8 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
+        merge_set(merge.bind({&gbuffer_buffer, &shaded, &output})),
         timers{vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context),
-               vk::GpuTimer(context)} {}
+               vk::GpuTimer(context), vk::GpuTimer(context)} {}
 
   /// `slot` holds at least `data` (grown, never shrunk) with `data` uploaded.
   void upload(std::unique_ptr<vk::VulkanBuffer>& slot, const std::vector<float>& data) {
@@ -106,16 +123,18 @@ struct DirRendererVk::Impl {
   GBufferVk gbuffer;
   detail::ShadowMapsVk shadow_maps;
   detail::IsmVk ism;
-  vk::ComputePipeline shade;
-  vk::VulkanBuffer gbuffer_buffer, output;
+  vk::ComputePipeline shade, merge;
+  vk::VulkanBuffer gbuffer_buffer, shaded, output;
+  vk::UniqueDescriptorSet merge_set;
   std::unique_ptr<vk::VulkanBuffer> materials, lights, views, vpls;
   vk::UniqueDescriptorSet shade_set;
-  std::array<vk::GpuTimer, 5> timers;
+  std::array<vk::GpuTimer, 6> timers;
   std::optional<MrScene> scene;
   ShadowLayout layout;
   IsmPointPools points;
   DirVkTimings timings;
   std::uint32_t vpl_count = 0;
+  std::vector<float> cpu_ism_atlas;  // of the last render when it shaded on the CPU
 };
 
 DirRendererVk::DirRendererVk(vk::VulkanContext& context, int width, int height) {
@@ -144,6 +163,7 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
   if (!d.scene) throw LogicError("DirRendererVk::set_scene must come before render");
   if (options.shadow_tile != d.layout.tile) throw Error("DirRendererVk: the shadow tile differs from set_scene's");
   if (!(options.shading.min_distance > 0.f)) throw Error("the VPL clamp distance must be positive");
+  if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
   d.upload(d.vpls, pack_vpls(vpls));
   d.vpl_count = static_cast<std::uint32_t>(vpls.size());
 
@@ -152,32 +172,25 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
   const ShadeParams params{static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
                            static_cast<std::uint32_t>(d.scene->lights.size()), d.vpl_count, d.layout.tile,
                            d.layout.columns, d.layout.rows(), options.ism.tile, options.shading.min_distance,
-                           shade_flags(options), 0, 0, {centre.x(), centre.y(), centre.z(), 1.f},
+                           shade_flags(options), static_cast<std::uint32_t>(options.interleave), 0,
+                           {centre.x(), centre.y(), centre.z(), 1.f},
                            {environment.x(), environment.y(), environment.z(), 0.f}};
+  const bool cpu_shading =
+      options.backend == DirBackend::Cpu || (options.backend == DirBackend::Auto && d.context.is_cpu_device());
   d.context.submit([&](VkCommandBuffer cmd) {
-    d.timers[4].start(cmd);
+    d.timers[5].start(cmd);
     d.timers[0].start(cmd);
     d.gbuffer.record(cmd, camera, d.gbuffer_buffer);
     d.timers[0].stop(cmd);
     d.timers[1].start(cmd);
     d.shadow_maps.record(cmd, d.layout);
     d.timers[1].stop(cmd);
-    d.timers[2].start(cmd);
-    d.ism.record(cmd, *d.vpls, d.vpl_count, options.ism);
-    d.timers[2].stop(cmd);
-    vk::compute_barrier(cmd);
-    d.shade_set = {};
-    d.shade_set = d.shade.bind({&d.gbuffer_buffer, d.materials.get(), d.lights.get(), d.views.get(),
-                                &d.shadow_maps.atlas(), d.vpls.get(), &d.ism.atlas(), &d.output});
-    d.timers[3].start(cmd);
-    d.shade.dispatch(cmd, d.shade_set, params, vk::ComputePipeline::group_count(params.width, 8),
-                     vk::ComputePipeline::group_count(params.height, 8));
-    d.timers[3].stop(cmd);
-    d.timers[4].stop(cmd);
+    if (!cpu_shading) record_shading(cmd, params, options);
+    d.timers[5].stop(cmd);
   });
-  d.timings = {d.timers[0].elapsed_ms().value_or(0.0), d.timers[1].elapsed_ms().value_or(0.0),
-               d.timers[2].elapsed_ms().value_or(0.0), d.timers[3].elapsed_ms().value_or(0.0),
-               d.timers[4].elapsed_ms().value_or(0.0)};
+  const auto ms = [&](std::size_t k) { return d.timers[k].elapsed_ms().value_or(0.0); };
+  d.timings = {ms(0), ms(1), ms(2), ms(3), ms(4), ms(5), cpu_shading};
+  if (cpu_shading) return shade_on_cpu(camera, vpls, options);
 
   std::vector<float> radiance(static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) * 8);
   d.context.transfer().download(d.output, std::as_writable_bytes(std::span(radiance)));
@@ -188,6 +201,43 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
     out.virtual_coverage.pixels()[i] = p[3];
     out.real.pixels()[i] = {p[4], p[5], p[6]};
   }
+  return out;
+}
+
+void DirRendererVk::record_shading(VkCommandBuffer cmd, const detail::ShadeParams& params, const DirVkOptions& options) {
+  Impl& d = *impl_;
+  d.timers[2].start(cmd);
+  d.ism.record(cmd, *d.vpls, d.vpl_count, options.ism);
+  d.timers[2].stop(cmd);
+  vk::compute_barrier(cmd);
+  d.shade_set = {};
+  d.shade_set = d.shade.bind({&d.gbuffer_buffer, d.materials.get(), d.lights.get(), d.views.get(),
+                              &d.shadow_maps.atlas(), d.vpls.get(), &d.ism.atlas(), &d.shaded});
+  const auto n = static_cast<std::uint32_t>(options.interleave);
+  d.timers[3].start(cmd);
+  d.shade.dispatch(cmd, d.shade_set, params, vk::ComputePipeline::group_count((params.width + n - 1) / n * n, 8),
+                   vk::ComputePipeline::group_count((params.height + n - 1) / n * n, 8));
+  d.timers[3].stop(cmd);
+  vk::compute_barrier(cmd);
+  d.timers[4].start(cmd);
+  d.merge.dispatch(cmd, d.merge_set, detail::MergeParams{params.width, params.height, n},
+                   vk::ComputePipeline::group_count(params.width, 8), vk::ComputePipeline::group_count(params.height, 8));
+  d.timers[4].stop(cmd);
+}
+
+DifferentialImages DirRendererVk::shade_on_cpu(const MrCamera& camera, std::span<const Vpl> vpls,
+                                               const DirVkOptions& options) {
+  Impl& d = *impl_;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  d.cpu_ism_atlas = ism_atlas_cpu(d.points, vpls, options.ism);
+  const auto ism_done = Clock::now();
+  DifferentialImages out = shade_dir_from_maps(last_gbuffer(), *d.scene, camera.camera_to_world.translation().cast<float>(),
+                                               d.layout, last_shadow_atlas(), vpls, d.cpu_ism_atlas, options);
+  const auto done = Clock::now();
+  d.timings.ism_ms = std::chrono::duration<double, std::milli>(ism_done - start).count();
+  d.timings.shading_ms = std::chrono::duration<double, std::milli>(done - ism_done).count();
+  d.timings.total_ms += std::chrono::duration<double, std::milli>(done - start).count();
   return out;
 }
 
@@ -209,6 +259,7 @@ std::vector<float> DirRendererVk::last_shadow_atlas() const {
 }
 
 std::vector<float> DirRendererVk::last_ism_atlas() const {
+  if (impl_->timings.cpu_shading) return impl_->cpu_ism_atlas;
   std::vector<float> data(impl_->ism.atlas().size_bytes() / sizeof(float));
   impl_->context.transfer().download(impl_->ism.atlas(), std::as_writable_bytes(std::span(data)));
   return data;

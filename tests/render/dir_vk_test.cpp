@@ -46,6 +46,7 @@ DirVkOptions test_options() {
   options.ism.points_per_vpl = 512;
   options.ism.pull_push_levels = 2;
   options.shading.min_distance = 0.05f;
+  options.backend = DirBackend::Gpu;  // these tests hold the Vulkan steps to their references
   return options;
 }
 
@@ -209,6 +210,7 @@ TEST_F(DirVkTest, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions)
   DirVkOptions options;
   options.shading.min_distance = 0.02f;
   options.shadow_tile = 512;
+  options.backend = DirBackend::Gpu;
   DirRendererVk renderer(context, 48, 36);
   renderer.set_scene(scene, options);
   const DifferentialImages dir = renderer.render(camera, make_vpls(scene, 1024), options);
@@ -223,6 +225,35 @@ TEST_F(DirVkTest, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions)
   EXPECT_LT(relative_error({0.22f, -0.15f}, {0.45f, 0.15f}), 0.15) << "bleeding region";
 }
 
+TEST_F(DirVkTest, CpuAndGpuBackendsAgreeAndAutoPicksTheCpuOnASoftwareDevice) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const MrScene scene = cube_scene();
+  DirVkOptions gpu_options = test_options();
+  const std::vector<Vpl> vpls = make_vpls(scene, 64);
+  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 64, 48);
+  DirRendererVk renderer(context, 64, 48);
+  renderer.set_scene(scene, gpu_options);
+  const DifferentialImages gpu = renderer.render(camera, vpls, gpu_options);
+  EXPECT_FALSE(renderer.last_timings().cpu_shading);
+  DirVkOptions auto_options = gpu_options;
+  auto_options.backend = DirBackend::Auto;
+  const DifferentialImages automatic = renderer.render(camera, vpls, auto_options);
+  EXPECT_EQ(renderer.last_timings().cpu_shading, context.is_cpu_device());
+  DirVkOptions cpu_options = gpu_options;
+  cpu_options.backend = DirBackend::Cpu;
+  const DifferentialImages cpu = renderer.render(camera, vpls, cpu_options);
+  EXPECT_TRUE(renderer.last_timings().cpu_shading);
+  int close = 0;
+  for (std::size_t i = 0; i < gpu.real.pixels().size(); ++i) {
+    const float tolerance = 1e-3f * luminance(cpu.real_virtual.pixels()[i]) + 1e-5f;
+    if (length(gpu.real_virtual.pixels()[i] - cpu.real_virtual.pixels()[i]) <= tolerance &&
+        length(gpu.real.pixels()[i] - cpu.real.pixels()[i]) <= tolerance)
+      ++close;
+    EXPECT_EQ(automatic.real.pixels()[i], (context.is_cpu_device() ? cpu : gpu).real.pixels()[i]);
+  }
+  EXPECT_GT(close, static_cast<int>(gpu.real.pixels().size()) * 98 / 100);
+}
+
 TEST_F(DirVkTest, RejectsMisuse) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   EXPECT_THROW(DirRendererVk(context, 0, 10), Error);
@@ -235,6 +266,9 @@ TEST_F(DirVkTest, RejectsMisuse) {
   other.shadow_tile = 128;
   EXPECT_THROW((void)renderer.render(camera, {}, other), Error);
   EXPECT_THROW((void)renderer.render(camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 32, 24), {}, options), Error);
+  other = options;
+  other.interleave = 0;
+  EXPECT_THROW((void)renderer.render(camera, {}, other), Error);
   IsmOptions too_many;
   too_many.points_per_vpl = 8192;
   EXPECT_THROW((void)sample_ism_points(open_cube_scene(), too_many), Error);
