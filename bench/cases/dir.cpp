@@ -6,14 +6,19 @@
 // differential image DeltaL = TM(L_rv) - TM(L_r) where it matters (|DeltaL_reference| > 0.01:
 // shadows and colour bleeding), the composite's RMSE (the camera image being the reference's
 // TM(L_r)), and the path tracer's composite RMSE when it gets DIR's wall time (equal time).
-// The renderer measured here is DIR's CPU reference with exact visibility; the Vulkan renderer
-// will report into the same fields.
+// The renderer measured is the Vulkan one (VPL generation included in its time); the CPU DIR
+// with exact visibility (dir_cpu.h) reports the same fields under "cpu_exact_visibility".
 // dir/gbuffer_640x480: the first Vulkan stage of DIR against its ray-cast reference.
+// dir/frame_640x480_64vpl, dir/frame_640x480_256vpl: one whole frame at 640x480 (VPLs on the
+// CPU, then G-buffer, shadow maps, ISMs and shading on the GPU), with the GPU time per step.
+// dir/one_vs_two_pass: one render writing L_rv and L_r against two renders of the same
+// renderer writing one each (what a renderer without the differential pass would need).
 #include <chrono>
 #include <cmath>
 
 #include "bench.h"
 #include "relight/render/dir_cpu.h"
+#include "relight/render/dir_vk.h"
 #include "relight/render/gbuffer_vk.h"
 #include "relight/render/path_tracer.h"
 #include "relight/render/procedural_models.h"
@@ -70,7 +75,35 @@ Errors compare(const render::DifferentialImages& ours, const render::Differentia
   return {norm > 0.0 ? diff / norm : 0.0, std::sqrt(squared / (3.0 * static_cast<double>(ours.real.size())))};
 }
 
+struct CurvePoint {
+  double ms = 0.0;
+  Errors errors;
+};
+
+/// Renders with `render(vpls)` for 64, 256 and 1024 light samples; the time includes the VPLs.
+template <class Render>
+bench::Json vpl_curve(const render::MrScene& scene, const render::DifferentialImages& reference, Render&& render,
+                      CurvePoint& at_256) {
+  const render::RayTracer tracer(scene);
+  bench::Json curve = bench::Json::array();
+  for (int count : {64, 256, 1024}) {
+    const auto start = Clock::now();
+    render::VplOptions vpl_options;
+    vpl_options.count = count;
+    const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options);
+    const render::DifferentialImages images = render(vpls);
+    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    const Errors e = compare(images, reference);
+    curve.push_back({{"light_samples", count}, {"vpls", vpls.size()}, {"ms", ms}, {"delta_rel_error", e.delta_rel},
+                     {"composite_rmse", e.composite_rmse}});
+    if (count == 256) at_256 = {ms, e};
+  }
+  return curve;
+}
+
 bench::Json vs_reference(const bench::Options&) {
+  auto context = vk::try_create_vulkan();
+  if (!context) return {{"skipped", "no Vulkan device"}};
   const render::MrScene scene = bench_scene();
   const render::MrCamera camera = bench_camera();
   render::PathTracerOptions pt_options;
@@ -78,42 +111,122 @@ bench::Json vs_reference(const bench::Options&) {
   pt_options.seed = 99;
   const int reference_spp = 1024;
   const render::DifferentialImages reference = render::render_reference(scene, camera, reference_spp, pt_options);
+
   const render::RayTracer tracer(scene);
-  bench::Json curve = bench::Json::array();
-  double ms_256 = 0.0;
-  Errors errors_256;
-  for (int count : {64, 256, 1024}) {
-    const auto start = Clock::now();
-    render::VplOptions vpl_options;
-    vpl_options.count = count;
-    const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options);
-    render::DirOptions options;
-    options.min_distance = 0.05f;
-    const render::DifferentialImages dir = render::shade_instant_radiosity(scene, tracer, camera, vpls, options);
-    const double ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-    const Errors e = compare(dir, reference);
-    curve.push_back({{"light_samples", count}, {"vpls", vpls.size()}, {"ms", ms}, {"delta_rel_error", e.delta_rel},
-                     {"composite_rmse", e.composite_rmse}});
-    if (count == 256) {
-      ms_256 = ms;
-      errors_256 = e;
-    }
-  }
-  // The path tracer with DIR's (256 light samples) wall time.
+  render::DirOptions cpu_options;
+  cpu_options.min_distance = 0.05f;
+  CurvePoint cpu_256;
+  const bench::Json cpu_curve = vpl_curve(scene, reference, [&](const std::vector<render::Vpl>& vpls) {
+    return render::shade_instant_radiosity(scene, tracer, camera, vpls, cpu_options);
+  }, cpu_256);
+
+  render::DirVkOptions vk_options;
+  vk_options.shading = cpu_options;
+  render::DirRendererVk renderer(*context, camera.intrinsics.width, camera.intrinsics.height);
+  renderer.set_scene(scene, vk_options);
+  (void)renderer.render(camera, {}, vk_options);  // warm-up: pipelines, buffers
+  CurvePoint vk_256;
+  const bench::Json vk_curve = vpl_curve(scene, reference, [&](const std::vector<render::Vpl>& vpls) {
+    return renderer.render(camera, vpls, vk_options);
+  }, vk_256);
+
+  // The path tracer with the Vulkan renderer's (256 light samples) wall time.
   pt_options.seed = 7;
   render::DifferentialPathTracer pt(scene, pt_options);
   pt.reset(camera);
-  pt.render(1 << 20, std::chrono::duration<double, std::milli>(ms_256));
+  pt.render(1 << 20, std::chrono::duration<double, std::milli>(vk_256.ms));
   const Errors pt_errors = compare(pt.images(), reference);
-  return {{"renderer", "dir_cpu_exact_visibility"},
-          {"ms", ms_256},
-          {"delta_rel_error", errors_256.delta_rel},
-          {"composite_rmse", errors_256.composite_rmse},
+  return {{"renderer", "dir_vulkan"},
+          {"device", context->device_info().name},
+          {"ms", vk_256.ms},
+          {"delta_rel_error", vk_256.errors.delta_rel},
+          {"composite_rmse", vk_256.errors.composite_rmse},
           {"pt_equal_time_rmse", pt_errors.composite_rmse},
           {"pt_equal_time_spp", pt.samples_done()},
           {"pt_equal_time_delta_rel_error", pt_errors.delta_rel},
           {"reference_spp", reference_spp},
-          {"by_vpl_count", curve}};
+          {"by_vpl_count", vk_curve},
+          {"cpu_exact_visibility", {{"ms", cpu_256.ms},
+                                    {"delta_rel_error", cpu_256.errors.delta_rel},
+                                    {"composite_rmse", cpu_256.errors.composite_rmse},
+                                    {"by_vpl_count", cpu_curve}}}};
+}
+
+render::MrCamera kinect_camera() {
+  render::MrCamera camera = bench_camera();
+  camera.intrinsics = PinholeIntrinsics{};  // Kinect v1, 640x480
+  return camera;
+}
+
+/// dir/frame_640x480_*: VPL generation + one frame (backend Auto: ISMs and shading on the CPU
+/// on a software device), against the same frame with every step on Vulkan; median wall times,
+/// and the per-step times of the last Auto frame.
+bench::Json frame_640x480(const bench::Options& options, int light_samples) {
+  auto context = vk::try_create_vulkan();
+  if (!context) return {{"skipped", "no Vulkan device"}};
+  const render::MrScene scene = bench_scene();
+  const render::MrCamera camera = kinect_camera();
+  const render::RayTracer tracer(scene);
+  render::DirVkOptions automatic, on_gpu;
+  on_gpu.backend = render::DirBackend::Gpu;
+  render::DirRendererVk renderer(*context, 640, 480);
+  renderer.set_scene(scene, automatic);
+  render::VplOptions vpl_options;
+  vpl_options.count = light_samples;
+  std::vector<render::Vpl> vpls;
+  double vpl_ms = 0.0;
+  render::DirVkTimings t;
+  const auto frame = [&](const render::DirVkOptions& dir_options) {
+    const auto start = Clock::now();
+    vpls = render::generate_vpls(scene, tracer, vpl_options);
+    vpl_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    (void)renderer.render(camera, vpls, dir_options);
+  };
+  const bench::Comparison c = bench::compare_interleaved(
+      [&] {
+        frame(automatic);
+        t = renderer.last_timings();
+      },
+      [&] { frame(on_gpu); }, std::max(3, options.repetitions / 2));
+  bench::Json json = bench::comparison_json(c, "all_steps_on_vulkan");
+  json["fps"] = 1000.0 / c.ms;
+  json["vpls"] = vpls.size();
+  json["device"] = context->device_info().name;
+  json["shading_backend"] = t.cpu_shading ? "cpu" : "vulkan";
+  json["stages_ms"] = {{"vpl_generation_cpu", vpl_ms}, {"gbuffer", t.gbuffer_ms}, {"shadow_maps", t.shadow_maps_ms},
+                       {"ism", t.ism_ms}, {"shading", t.shading_ms}, {"merge", t.merge_ms}};
+  json["interleave"] = automatic.interleave;
+  json["shadow_tile"] = automatic.shadow_tile;
+  json["ism_tile"] = automatic.ism.tile;
+  json["ism_points_per_vpl"] = automatic.ism.points_per_vpl;
+  return json;
+}
+
+/// dir/one_vs_two_pass: 640x480, 256 light samples, VPLs generated once.
+bench::Json one_vs_two_pass(const bench::Options& options) {
+  auto context = vk::try_create_vulkan();
+  if (!context) return {{"skipped", "no Vulkan device"}};
+  const render::MrScene scene = bench_scene();
+  const render::MrCamera camera = kinect_camera();
+  render::DirVkOptions both;
+  render::DirRendererVk renderer(*context, 640, 480);
+  renderer.set_scene(scene, both);
+  render::VplOptions vpl_options;
+  vpl_options.count = 256;
+  const std::vector<render::Vpl> vpls = render::generate_vpls(scene, render::RayTracer(scene), vpl_options);
+  render::DirVkOptions rv_only = both, r_only = both;
+  rv_only.output = render::DirOutput::RealVirtualOnly;
+  r_only.output = render::DirOutput::RealOnly;
+  const bench::Comparison c = bench::compare_interleaved([&] { (void)renderer.render(camera, vpls, both); },
+                                                         [&] {
+                                                           (void)renderer.render(camera, vpls, rv_only);
+                                                           (void)renderer.render(camera, vpls, r_only);
+                                                         },
+                                                         options.repetitions);
+  bench::Json json = bench::comparison_json(c, "two_pass");
+  json["vpls"] = vpls.size();
+  json["device"] = context->device_info().name;
+  return json;
 }
 
 /// dir/gbuffer_640x480: the rasterised G-buffer of the synthetic scene with the pebble (about
@@ -122,9 +235,8 @@ bench::Json vs_reference(const bench::Options&) {
 bench::Json gbuffer_640x480(const bench::Options& options) {
   auto context = vk::try_create_vulkan();
   if (!context) return {{"skipped", "no Vulkan device"}};
-  render::MrScene scene = bench_scene();
-  render::MrCamera camera = bench_camera();
-  camera.intrinsics = PinholeIntrinsics{};  // Kinect v1, 640x480
+  const render::MrScene scene = bench_scene();
+  const render::MrCamera camera = kinect_camera();
   render::GBufferVk renderer(*context, 640, 480);
   renderer.set_scene(scene);
   const render::RayTracer tracer(scene);
@@ -141,3 +253,6 @@ bench::Json gbuffer_640x480(const bench::Options& options) {
 
 RELIGHT_BENCH_CASE("dir/vs_reference", vs_reference);
 RELIGHT_BENCH_CASE("dir/gbuffer_640x480", gbuffer_640x480);
+RELIGHT_BENCH_CASE("dir/frame_640x480_64vpl", [](const bench::Options& o) { return frame_640x480(o, 64); });
+RELIGHT_BENCH_CASE("dir/frame_640x480_256vpl", [](const bench::Options& o) { return frame_640x480(o, 256); });
+RELIGHT_BENCH_CASE("dir/one_vs_two_pass", one_vs_two_pass);

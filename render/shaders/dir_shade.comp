@@ -101,21 +101,21 @@ float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
   return depth <= stored + texel ? 1.0 : 0.0;
 }
 
-// ism_visibility() (ism.h).
-float ism_visibility(uint index, int layer, Vpl vpl, vec3 point) {
+// IsmLookup (ism.h): V_r and V_v from the texel both layers share.
+vec2 ism_visibility(uint index, Vpl vpl, vec3 point) {
   vec3 t, b;
   const vec3 n = vpl.normal_flags.xyz;
   orthonormal_basis(n, t, b);
   const vec3 q = point - vpl.position_material.xyz;
   const float distance = length(q);
-  if (!(distance > 0.0)) return 1.0;
+  if (!(distance > 0.0)) return vec2(1.0);
   const int tile = params.ism_tile;
   const vec2 texel = paraboloid_texel(vec3(dot(q, t), dot(q, b), dot(q, n)) / distance, tile);
   const ivec2 xy = clamp(ivec2(floor(texel)), ivec2(0), ivec2(tile - 1));
-  const uint tile_index = uint(layer) * params.vpl_count + index;
-  const float stored = ism_atlas[(tile_index * uint(tile) + uint(xy.y)) * uint(tile) + uint(xy.x)];
-  const float bias = 0.02 + distance * 8.0 / float(tile);
-  return distance <= stored + bias ? 1.0 : 0.0;
+  const uint i = (index * uint(tile) + uint(xy.y)) * uint(tile) + uint(xy.x);
+  const float reach = distance - (0.02 + distance * 8.0 / float(tile));
+  return vec2(reach <= ism_atlas[i] ? 1.0 : 0.0,
+              reach <= ism_atlas[params.vpl_count * uint(tile * tile) + i] ? 1.0 : 0.0);
 }
 
 void main() {
@@ -195,9 +195,9 @@ void main() {
       const Material mv = materials[floatBitsToUint(vpl.position_material.w)];
       const vec3 contribution = vpl.flux.xyz * phong(mv, vpl.normal_flags.xyz, vpl.incident.xyz, -wi) *
                                 phong(m, n, wi, wo) * (cos_x * cos_y / max(d2, min_d2));
-      const float v_r = ism_visibility(j, 0, vpl, point);
-      if (v_r == 0.0) continue;
-      if (in_rv) indirect_rv += contribution * ism_visibility(j, 1, vpl, point);
+      const vec2 seen = ism_visibility(j, vpl, point);
+      if (seen.x == 0.0) continue;
+      if (in_rv) indirect_rv += contribution * seen.y;
       if (in_r) indirect_r += contribution;
     }
   }

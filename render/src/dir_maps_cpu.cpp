@@ -23,7 +23,8 @@ class MapShader {
  public:
   MapShader(const MrScene& scene, const ShadowLayout& layout, std::span<const float> shadow_atlas,
             std::span<const Vpl> vpls, std::span<const float> ism_atlas, const DirVkOptions& options)
-      : scene_(scene), layout_(layout), shadow_atlas_(shadow_atlas), vpls_(vpls), ism_atlas_(ism_atlas), options_(options) {}
+      : scene_(scene), layout_(layout), shadow_atlas_(shadow_atlas), vpls_(vpls), ism_(ism_atlas, options.ism, vpls),
+        options_(options) {}
 
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
                                float real_pixel, std::uint32_t subset) const {
@@ -75,8 +76,9 @@ class MapShader {
       const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(scene_.materials[vpl.material], vpl.normal, vpl.incident, -wi))
                                     .cwiseProduct(phong_brdf(m, n, wi, wo)) *
                                 (cos_x * cos_y / std::max(distance2, min_distance2));
-      if (ism_visibility(ism_atlas_, options_.ism, count, j, 0, vpl, point) == 0.f) continue;
-      if (in_rv) rv += contribution * ism_visibility(ism_atlas_, options_.ism, count, j, 1, vpl, point);
+      const IsmLookup::Visibility seen = ism_(j, point);
+      if (seen.real == 0.f) continue;
+      if (in_rv) rv += contribution * seen.virtual_;
       if (in_r) r += contribution;
     }
     out.indirect_real_virtual = rv * static_cast<float>(subsets);
@@ -87,7 +89,7 @@ class MapShader {
   const ShadowLayout& layout_;
   std::span<const float> shadow_atlas_;
   std::span<const Vpl> vpls_;
-  std::span<const float> ism_atlas_;
+  IsmLookup ism_;
   const DirVkOptions& options_;
 };
 

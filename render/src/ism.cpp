@@ -204,22 +204,32 @@ std::vector<float> ism_atlas_cpu(const IsmPointPools& points, std::span<const Vp
   return atlas;
 }
 
-float ism_visibility(std::span<const float> atlas, const IsmOptions& options, std::uint32_t vpl_count,
-                     std::uint32_t index, int layer, const Vpl& vpl, const Vec3& point) {
-  const VplFrame frame(vpl);
-  float distance = 0.f;
-  const Vec3 dir = frame.local(point, distance);
-  if (!(distance > 0.f)) return 1.f;
-  const int tile = options.tile;
-  const Vec2 texel = paraboloid_texel(dir, tile);
-  const int x = std::clamp(static_cast<int>(std::floor(texel.x())), 0, tile - 1);
-  const int y = std::clamp(static_cast<int>(std::floor(texel.y())), 0, tile - 1);
-  const std::size_t t = static_cast<std::size_t>(layer) * vpl_count + index;
-  const float stored = atlas[(t * static_cast<std::size_t>(tile) + static_cast<std::size_t>(y)) * static_cast<std::size_t>(tile) +
-                             static_cast<std::size_t>(x)];
+IsmLookup::IsmLookup(std::span<const float> atlas, const IsmOptions& options, std::span<const Vpl> vpls)
+    : atlas_(atlas),
+      tile_(options.tile),
+      layer_stride_(vpls.size() * static_cast<std::size_t>(options.tile) * static_cast<std::size_t>(options.tile)) {
+  if (atlas.size() < 2 * layer_stride_) throw Error("the ISM atlas is smaller than its VPLs need");
+  frames_.reserve(vpls.size());
+  for (const Vpl& vpl : vpls) {
+    Frame f{vpl.position, {}, {}, vpl.normal};
+    orthonormal_basis(f.n, f.t, f.b);
+    frames_.push_back(f);
+  }
+}
+
+IsmLookup::Visibility IsmLookup::operator()(std::uint32_t index, const Vec3& point) const {
+  const Frame& f = frames_[index];
+  const Vec3 q = point - f.origin;
+  const float distance = q.norm();
+  if (!(distance > 0.f)) return {};
+  const Vec2 texel = paraboloid_texel(Vec3(q.dot(f.t), q.dot(f.b), q.dot(f.n)) / distance, tile_);
+  const int x = std::clamp(static_cast<int>(std::floor(texel.x())), 0, tile_ - 1);
+  const int y = std::clamp(static_cast<int>(std::floor(texel.y())), 0, tile_ - 1);
+  const std::size_t i = (index * static_cast<std::size_t>(tile_) + static_cast<std::size_t>(y)) * static_cast<std::size_t>(tile_) +
+                        static_cast<std::size_t>(x);
   // Two texels' worth of angle (a paraboloid texel spans about 4 / tile radians at the pole).
-  const float bias = 0.02f + distance * 8.f / static_cast<float>(tile);
-  return distance <= stored + bias ? 1.f : 0.f;
+  const float reach = distance - (0.02f + distance * 8.f / static_cast<float>(tile_));
+  return {reach <= atlas_[i] ? 1.f : 0.f, reach <= atlas_[layer_stride_ + i] ? 1.f : 0.f};
 }
 
 }  // namespace relight::render

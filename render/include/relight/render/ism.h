@@ -21,7 +21,7 @@
 //
 // Atlas layout (floats, kShadowEmpty where nothing is seen): tile t = layer * vpl_count + vpl,
 // layer 0 real and 1 virtual, texel (x, y) at (t * tile + y) * tile + x. ism_atlas_cpu() is the
-// reference of the Vulkan splat + pull-push (ism_vk.h); ism_visibility() is the lookup that the
+// reference of the Vulkan splat + pull-push (ism_vk.h); IsmLookup is the lookup that the
 // shading pass mirrors in GLSL (dir_shade.comp).
 #include <Eigen/Core>
 #include <cstdint>
@@ -66,10 +66,29 @@ struct IsmPointPools {
 [[nodiscard]] std::vector<float> ism_atlas_cpu(const IsmPointPools& points, std::span<const Vpl> vpls,
                                                const IsmOptions& options);
 
-/// 1 when `point` is visible from VPL `index` (of `vpl_count`) through `layer` (0 real, 1 virtual).
-/// The depth bias grows with the distance and the tile's angular texel size.
-[[nodiscard]] float ism_visibility(std::span<const float> atlas, const IsmOptions& options, std::uint32_t vpl_count,
-                                   std::uint32_t index, int layer, const Vpl& vpl, const Eigen::Vector3f& point);
+/// Visibility lookups in an ISM atlas. Both layers share the texel, so one lookup answers V_r and
+/// V_v; each VPL's frame is computed once. The depth bias grows with the distance and the tile's
+/// angular texel size.
+class IsmLookup {
+ public:
+  IsmLookup(std::span<const float> atlas, const IsmOptions& options, std::span<const Vpl> vpls);
+
+  struct Visibility {
+    float real = 1.f;     ///< V_r
+    float virtual_ = 1.f; ///< V_v
+  };
+  /// Whether `point` is visible from VPL `index` through each layer.
+  [[nodiscard]] Visibility operator()(std::uint32_t index, const Eigen::Vector3f& point) const;
+
+ private:
+  struct Frame {
+    Eigen::Vector3f origin, t, b, n;
+  };
+  std::span<const float> atlas_;
+  int tile_;
+  std::size_t layer_stride_;
+  std::vector<Frame> frames_;
+};
 
 /// Texel coordinates in [0, tile) of `direction` (unit, VPL frame, z along the VPL normal).
 [[nodiscard]] Eigen::Vector2f paraboloid_texel(const Eigen::Vector3f& local_direction, int tile);
