@@ -167,4 +167,15 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
   return out;
 }
 
+DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
+                                  const DirVkOptions& options) {
+  const RayTracer tracer(scene);
+  const GBuffer gbuffer = gbuffer_cpu(tracer, camera, options.shading.threads);
+  const ShadowLayout layout = plan_shadow_views(scene, options.shadow_tile);
+  const std::vector<float> shadow_atlas = shadow_atlas_cpu(tracer, layout, options.shading.threads);
+  const std::vector<float> ism_atlas = ism_atlas_cpu(sample_ism_points(scene, options.ism), vpls, options.ism);
+  return shade_dir_from_maps(gbuffer, scene, camera.camera_to_world.translation().cast<float>(), layout, shadow_atlas,
+                             vpls, ism_atlas, options);
+}
+
 }  // namespace relight::render

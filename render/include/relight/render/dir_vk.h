@@ -91,6 +91,12 @@ class DirRendererVk {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The whole method without a GPU, step for step the same algorithm (ray-cast G-buffer and
+/// shadow maps, CPU ISMs, shade_dir_from_maps): the fallback where no Vulkan device exists.
+/// `vpls` as for DirRendererVk::render.
+[[nodiscard]] DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
+                                                const DirVkOptions& options = {});
+
 /// The shading pass on the CPU, from the same inputs as the GPU's.
 [[nodiscard]] DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene,
                                                      const Eigen::Vector3f& camera_centre, const ShadowLayout& layout,
