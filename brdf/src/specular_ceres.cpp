@@ -7,6 +7,7 @@
 
 #include "relight/brdf/specular_fit.h"
 #include "specular_model.h"
+#include "specular_terms.h"
 
 namespace relight::brdf {
 
@@ -34,19 +35,22 @@ struct SampleResidual {
   }
 };
 
-/// Residual with the lights fixed (phase 1): one block (k_s, n).
-struct ShapeResidual {
-  const SpecularSample* sample;
-  const Eigen::Vector3f* kd;
-  const ShadingLights* lights;
-
-  template <class T>
-  bool operator()(const T* shape, T* residual) const {
-    T model[3];
-    detail::model_radiance<T>(*sample, *kd, *lights, shape[0], shape[1], nullptr, 0, model);
-    for (int c = 0; c < 3; ++c) residual[c] = T(double(sample->radiance[c])) - model[c];
+/// Every residual with the lights fixed, in one block over (k_s, n) with the analytic Jacobian
+/// of detail::ShapeTerms: a residual block per sample would cost Ceres more bookkeeping than the
+/// model itself.
+class ShapeCost final : public ceres::CostFunction {
+ public:
+  explicit ShapeCost(const detail::ShapeTerms& terms) : terms_(terms) {
+    set_num_residuals(static_cast<int>(3 * terms.samples()));
+    mutable_parameter_block_sizes()->push_back(2);
+  }
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override {
+    terms_.residuals(parameters[0][0], parameters[0][1], residuals, jacobians ? jacobians[0] : nullptr);
     return true;
   }
+
+ private:
+  const detail::ShapeTerms& terms_;
 };
 
 ceres::Solver::Options solver_options(const SpecularOptions& options) {
@@ -70,14 +74,21 @@ void bound_shape(ceres::Problem& cp, double* shape, const SpecularOptions& optio
 
 constexpr std::size_t kLightSamples = 128;
 
-/// (k_s, n) with the lights fixed; returns F (Ceres minimises half of it).
+/// (k_s, n) with the lights fixed; returns F (Ceres minimises half of it). A negative shape[0]
+/// starts from detail::start_shape().
 double solve_shape(const SpecularProblem& problem, const ShadingLights& lights, const SpecularOptions& options,
                    const ceres::Solver::Options& so, double* shape, int& iterations) {
-  ceres::Problem cp;
-  for (const SpecularSample& s : problem.samples) {
-    cp.AddResidualBlock(new ceres::AutoDiffCostFunction<ShapeResidual, 3, 2>(new ShapeResidual{&s, &problem.kd, &lights}),
-                        nullptr, shape);
+  const detail::ShapeTerms terms(problem, lights);
+  if (shape[0] < 0.0) {
+    const detail::StartShape start = detail::start_shape(terms, options);
+    shape[0] = start.ks;
+    shape[1] = start.n;
   }
+  ShapeCost cost(terms);
+  ceres::Problem::Options po;
+  po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem cp(po);
+  cp.AddResidualBlock(&cost, nullptr, shape);
   bound_shape(cp, shape, options);
   ceres::Solver::Summary summary;
   ceres::Solve(so, &cp, &summary);
@@ -101,8 +112,7 @@ class CeresSolver final : public SpecularSolver {
       detail::finish_fit(fit, problem, options);
       return fit;
     }
-    double shape[2] = {std::clamp<double>(options.ks_start, 0.0, options.ks_max),
-                       std::clamp<double>(options.n_start, options.n_min, options.n_max)};
+    double shape[2] = {-1.0, 0.0};  // from detail::start_shape()
     double offsets[2][3] = {{0, 0, 0}, {0, 0, 0}};
     const ceres::Solver::Options so = solver_options(options);
     int iterations = 0;

@@ -9,6 +9,7 @@
 
 #include "relight/core/error.h"
 #include "specular_model.h"
+#include "specular_terms.h"
 
 namespace relight::brdf {
 
@@ -70,11 +71,10 @@ class NelderMeadSolver final : public SpecularSolver {
     int evaluations = 0;
     const Bounds shape_bounds{{bounds.lower[0], bounds.lower[1]}, {bounds.upper[0], bounds.upper[1]}};
 
-    // Phase A: (k_s, log n) with the lights where they are. With fixed lights the diffuse part
-    // and log<r.v> of every sample are constants, so F costs one exp per lit sample and light.
-    std::vector<double> shape{std::clamp<double>(options.ks_start, 0.0, options.ks_max),
-                              std::clamp(std::log(static_cast<double>(options.n_start)), bounds.lower[1], bounds.upper[1])};
+    // Phase A: (k_s, log n) with the lights where they are (detail::ShapeTerms), from the best
+    // exponent of a coarse grid with its least-squares k_s.
     std::vector<double> offsets(static_cast<std::size_t>(3 * moving), 0.0);
+    std::vector<double> shape;
     double best_f = fit_shape(problem, ordered, moving, offsets, shape_bounds, options, shape, evaluations);
 
     const double residuals = 3.0 * static_cast<double>(std::max<std::size_t>(1, problem.samples.size()));
@@ -92,9 +92,10 @@ class NelderMeadSolver final : public SpecularSolver {
       auto clamp = [&](std::vector<double>& v) {
         for (std::size_t i = 0; i < v.size(); ++i) v[i] = std::clamp(v[i], bounds.lower[i], bounds.upper[i]);
       };
+      detail::FullModel model(subset, ordered, moving);
       auto f = [&](const std::vector<double>& v) {
         ++evaluations;
-        return objective_ordered(subset, ordered, moving, v[0], std::exp(v[1]), v.data() + 2);
+        return model.objective(v[0], std::exp(v[1]), v.data() + 2);
       };
       std::vector<double> steps(x.size());
       steps[0] = 0.05 * options.ks_max;
@@ -134,6 +135,14 @@ class NelderMeadSolver final : public SpecularSolver {
  private:
   static constexpr std::size_t kLightSamples = 256;
   static constexpr int kLightProbe = 150;
+  // The light phase's simplex has converged at this size: 1 mm of light offset, 0.1 % of n, and
+  // in k_s below what 8-bit data resolve; the shape fit that follows polishes k_s and n.
+  static constexpr double kLightSimplexSize = 1e-3;
+  // The shape fit's (log n) simplex: one dimension halves cheaply, and noise-free data leave F
+  // near zero, where a coarser n would still show.
+  static constexpr double kShapeSimplexSize = 1e-6;
+  // A restart that lowers F by less than this fraction ends the restarts.
+  static constexpr double kRestartGain = 1e-6;
 
   /// Restarted Nelder-Mead: fresh simplices of halving size from the best vertex until a restart
   /// no longer improves F.
@@ -142,100 +151,44 @@ class NelderMeadSolver final : public SpecularSolver {
                        int max_evaluations, int& evaluations) {
     for (int restart = 0; restart < 4 && evaluations < max_evaluations; ++restart) {
       const double before = fx;
-      minimise(f, clamp, x, fx, steps, max_evaluations, evaluations);
-      if (restart > 0 && before - fx <= 1e-9 * std::max(1.0, before)) break;
+      minimise(f, clamp, x, fx, steps, kLightSimplexSize, max_evaluations, evaluations);
+      if (restart > 0 && before - fx <= kRestartGain * before) break;
       for (double& step : steps) step *= 0.5;
     }
   }
 
-  /// Fits (k_s, log n) with the lights fixed at `offsets`; returns F on all samples.
+  /// Fits (k_s, log n) with the lights fixed at `offsets`; returns F on all samples. For fixed
+  /// lights and n the model is linear in k_s, so the simplex searches log n alone and every
+  /// vertex takes its least-squares k_s in [0, ks_max] (variable projection: the same minimum as
+  /// over both, in far fewer evaluations). Starts from detail::start_shape(), or from `shape`
+  /// when given.
   static double fit_shape(const SpecularProblem& problem, const ShadingLights& ordered, int moving,
                           const std::vector<double>& offsets, const Bounds& bounds, const SpecularOptions& options,
                           std::vector<double>& shape, int& evaluations) {
-    const FixedTerms terms = fixed_terms(problem, ordered, moving, offsets);
-    auto clamp = [&](std::vector<double>& v) {
-      for (std::size_t i = 0; i < 2; ++i) v[i] = std::clamp(v[i], bounds.lower[i], bounds.upper[i]);
-    };
+    const detail::ShapeTerms terms(problem, detail::moved_lights(ordered, moving, offsets.data()));
+    const detail::StartShape start = detail::start_shape(terms, options);
+    evaluations += start.evaluations;
+    std::vector<double> log_n{shape.empty() ? std::log(start.n) : shape[1]};
+    auto clamp = [&](std::vector<double>& v) { v[0] = std::clamp(v[0], bounds.lower[1], bounds.upper[1]); };
     auto f = [&](const std::vector<double>& v) {
       ++evaluations;
-      return terms.objective(v[0], std::exp(v[1]));
+      return terms.best_ks(std::exp(v[0]), options.ks_max).objective;
     };
-    double fx = f(shape);
-    restarts(f, clamp, shape, fx, {0.25 * options.ks_max, 0.7}, evaluations + options.max_evaluations, evaluations);
+    double fx = f(log_n);
+    // The grid brackets the minimum within one spacing. One run: restarts guard against a
+    // simplex that collapses onto a subspace, which a one-dimensional simplex cannot.
+    minimise(f, clamp, log_n, fx, {0.5 * start.log_n_spacing}, kShapeSimplexSize,
+             evaluations + options.max_evaluations, evaluations);
+    shape = {terms.best_ks(std::exp(log_n[0]), options.ks_max).ks, log_n[0]};
     return fx;
   }
 
-  /// Per sample: the residual without the specular term and, per light that lights it with
-  /// <r.v> > 0, the irradiance and log<r.v>.
-  struct FixedTerms {
-    struct Lobe {
-      double irradiance[3];
-      double log_rv;
-    };
-    std::vector<double> base;  // 3 per sample
-    std::vector<Lobe> lobes;
-    std::vector<std::uint32_t> first;  // per sample + 1: range into lobes
-
-    [[nodiscard]] double objective(double ks, double n) const {
-      const double scale = ks * (n + 2.0) * 0.5 / std::numbers::pi;
-      double sum = 0.0;
-      for (std::size_t i = 0; i + 1 < first.size(); ++i) {
-        double spec[3] = {0.0, 0.0, 0.0};
-        for (std::uint32_t j = first[i]; j < first[i + 1]; ++j) {
-          const double lobe = std::exp(n * lobes[j].log_rv);
-          for (int c = 0; c < 3; ++c) spec[c] += lobes[j].irradiance[c] * lobe;
-        }
-        for (int c = 0; c < 3; ++c) {
-          const double r = base[3 * i + static_cast<std::size_t>(c)] - scale * spec[c];
-          sum += r * r;
-        }
-      }
-      return sum;
-    }
-  };
-
-  static FixedTerms fixed_terms(const SpecularProblem& problem, const ShadingLights& ordered, int moving,
-                                const std::vector<double>& offsets) {
-    // The lights moved by `offsets`, then the model with k_s = 0 gives the diffuse part.
-    ShadingLights moved = ordered;
-    for (int l = 0; l < moving; ++l) {
-      for (int c = 0; c < 3; ++c) {
-        moved.lights[static_cast<std::size_t>(l)].vector[c] += static_cast<float>(offsets[static_cast<std::size_t>(3 * l + c)]);
-      }
-    }
-    FixedTerms t;
-    t.first.push_back(0);
-    const double inv_pi = 1.0 / std::numbers::pi;
-    for (const SpecularSample& s : problem.samples) {
-      const Eigen::Vector3d p = s.position.cast<double>(), n = s.normal.cast<double>();
-      const Eigen::Vector3d view = -p.normalized();
-      Eigen::Vector3d diffuse = moved.ambient.cast<double>();
-      for (const ShadingLight& light : moved.lights) {
-        Eigen::Vector3d dir = light.vector.cast<double>();
-        double scale = 1.0;
-        if (light.point) {
-          dir -= p;
-          scale = 1.0 / dir.squaredNorm();
-        }
-        dir.normalize();
-        const double cosine = n.dot(dir);
-        if (!(cosine > 0.0)) continue;
-        const Eigen::Vector3d e = light.power.cast<double>() * (scale * cosine);
-        diffuse += e * inv_pi;
-        const double rv = (2.0 * cosine * n - dir).dot(view);
-        if (rv > 1e-12) t.lobes.push_back({{e.x(), e.y(), e.z()}, std::log(rv)});
-      }
-      for (int c = 0; c < 3; ++c) t.base.push_back(double(s.radiance[c]) - double(problem.kd[c]) * diffuse[c]);
-      t.first.push_back(static_cast<std::uint32_t>(t.lobes.size()));
-    }
-    return t;
-  }
-
   // One Nelder-Mead run (reflection 1, expansion 2, contraction 1/2, shrink 1/2) from `x` with
-  // the given initial steps; every vertex is projected onto the bounds.
+  // the given initial steps, until the simplex is smaller than `min_size` in every coordinate;
+  // every vertex is projected onto the bounds.
   template <class F, class Clamp>
   static void minimise(F& f, Clamp& clamp, std::vector<double>& x, double& fx, const std::vector<double>& steps,
-                       int max_evaluations, int& evaluations) {
+                       double min_size, int max_evaluations, int& evaluations) {
     const std::size_t dims = x.size();
     std::vector<std::vector<double>> simplex(dims + 1, x);
     std::vector<double> values(dims + 1, fx);
@@ -257,7 +210,7 @@ class NelderMeadSolver final : public SpecularSolver {
       if (values[worst] - values[best] <= 1e-10 * std::max(1e-12, std::abs(values[best]))) break;
       double size = 0.0;
       for (std::size_t i = 0; i < dims; ++i) size = std::max(size, std::abs(simplex[worst][i] - simplex[best][i]));
-      if (size < 1e-7) break;
+      if (size < min_size) break;
       std::fill(centroid.begin(), centroid.end(), 0.0);
       for (std::size_t v = 0; v <= dims; ++v) {
         if (v == worst) continue;

@@ -49,8 +49,9 @@ struct SpecularOptions {
   float ks_max = 1.f;
   float n_min = 1.f;
   float n_max = 1000.f;
-  float ks_start = 0.3f;
-  float n_start = 20.f;
+  /// The fits start from the best of this many exponents spaced evenly in log n over
+  /// [n_min, n_max], each with its least-squares k_s (for fixed n the model is linear in k_s).
+  int start_exponents = 12;
   /// How many of the strongest lights may move (at most 2); 0 keeps every light fixed.
   int moving_lights = 2;
   float point_offset_max = 0.05f;      ///< metres, per axis, for point lights

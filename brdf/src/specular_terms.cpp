@@ -1,0 +1,204 @@
+// Vectorised forms of the specular objective (specular_terms.h).
+#include "specular_terms.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace relight::brdf::detail {
+
+namespace {
+
+constexpr double kInvPi = std::numbers::inv_pi;
+// <omega_o . r_l> at or below this counts as no lobe (as in model_radiance).
+constexpr double kMinRv = 1e-12;
+
+Eigen::ArrayXf coordinate(const std::vector<SpecularSample>& samples, int axis, Eigen::Vector3f SpecularSample::*field) {
+  Eigen::ArrayXf out(static_cast<Eigen::Index>(samples.size()));
+  for (std::size_t i = 0; i < samples.size(); ++i) out[static_cast<Eigen::Index>(i)] = (samples[i].*field)[axis];
+  return out;
+}
+
+}  // namespace
+
+ShapeTerms::ShapeTerms(const SpecularProblem& problem, const ShadingLights& lights) {
+  const auto count = static_cast<Eigen::Index>(problem.samples.size());
+  for (int c = 0; c < 3; ++c) base_[static_cast<std::size_t>(c)].resize(count);
+  lobes_.resize(lights.lights.size());
+  for (Lobe& lobe : lobes_) {
+    for (Eigen::ArrayXd& e : lobe.irradiance) e.setZero(count);
+    lobe.log_rv.setZero(count);
+  }
+  for (Eigen::Index i = 0; i < count; ++i) {
+    const SpecularSample& s = problem.samples[static_cast<std::size_t>(i)];
+    const Eigen::Vector3d p = s.position.cast<double>(), n = s.normal.cast<double>();
+    const Eigen::Vector3d view = -p.normalized();
+    Eigen::Vector3d diffuse = lights.ambient.cast<double>();
+    for (std::size_t l = 0; l < lights.lights.size(); ++l) {
+      const ShadingLight& light = lights.lights[l];
+      Eigen::Vector3d dir = light.vector.cast<double>();
+      double scale = 1.0;
+      if (light.point) {
+        dir -= p;
+        scale = 1.0 / dir.squaredNorm();
+      }
+      dir.normalize();
+      const double cosine = n.dot(dir);
+      if (!(cosine > 0.0)) continue;
+      const Eigen::Vector3d e = light.power.cast<double>() * (scale * cosine);
+      diffuse += e * kInvPi;
+      const double rv = (2.0 * cosine * n - dir).dot(view);
+      if (!(rv > kMinRv)) continue;
+      for (int c = 0; c < 3; ++c) lobes_[l].irradiance[static_cast<std::size_t>(c)][i] = e[c];
+      lobes_[l].log_rv[i] = std::log(rv);
+    }
+    for (int c = 0; c < 3; ++c) {
+      base_[static_cast<std::size_t>(c)][i] = double(s.radiance[c]) - double(problem.kd[c]) * diffuse[c];
+    }
+  }
+}
+
+void ShapeTerms::lobe_sums(double n, std::array<Eigen::ArrayXd, 3>& sums, std::array<Eigen::ArrayXd, 3>* slope) const {
+  for (Eigen::ArrayXd& s : sums) s.setZero(samples());
+  if (slope) {
+    for (Eigen::ArrayXd& s : *slope) s.setZero(samples());
+  }
+  Eigen::ArrayXd lobe;
+  for (const Lobe& l : lobes_) {
+    lobe = (n * l.log_rv).exp();
+    for (std::size_t c = 0; c < 3; ++c) {
+      sums[c] += l.irradiance[c] * lobe;
+      if (slope) (*slope)[c] += l.irradiance[c] * l.log_rv * lobe;
+    }
+  }
+}
+
+double ShapeTerms::objective(double ks, double n) const {
+  std::array<Eigen::ArrayXd, 3> sums;
+  lobe_sums(n, sums, nullptr);
+  const double scale = ks * (n + 2.0) * 0.5 * kInvPi;
+  double f = 0.0;
+  for (std::size_t c = 0; c < 3; ++c) f += (base_[c] - scale * sums[c]).square().sum();
+  return f;
+}
+
+ShapeTerms::Projected ShapeTerms::best_ks(double n, double ks_max) const {
+  std::array<Eigen::ArrayXd, 3> sums;
+  lobe_sums(n, sums, nullptr);
+  const double lobe_scale = (n + 2.0) * 0.5 * kInvPi;
+  double bb = 0.0, bt = 0.0, tt = 0.0;
+  for (std::size_t c = 0; c < 3; ++c) {
+    bb += base_[c].square().sum();
+    bt += lobe_scale * (base_[c] * sums[c]).sum();
+    tt += lobe_scale * lobe_scale * sums[c].square().sum();
+  }
+  const double ks = tt > 0.0 ? std::clamp(bt / tt, 0.0, ks_max) : 0.0;
+  return {ks, std::max(0.0, bb - 2.0 * ks * bt + ks * ks * tt)};
+}
+
+void ShapeTerms::residuals(double ks, double n, double* residuals, double* jacobian) const {
+  std::array<Eigen::ArrayXd, 3> sums, slope;
+  lobe_sums(n, sums, jacobian ? &slope : nullptr);
+  const double lobe_scale = (n + 2.0) * 0.5 * kInvPi;
+  const Eigen::Index count = samples();
+  for (std::size_t c = 0; c < 3; ++c) {
+    Eigen::Map<Eigen::ArrayXd, 0, Eigen::InnerStride<3>> r(residuals + c, count);
+    r = base_[c] - ks * lobe_scale * sums[c];
+    if (!jacobian) continue;
+    Eigen::Map<Eigen::ArrayXd, 0, Eigen::InnerStride<6>> d_ks(jacobian + 2 * c, count);
+    Eigen::Map<Eigen::ArrayXd, 0, Eigen::InnerStride<6>> d_n(jacobian + 2 * c + 1, count);
+    d_ks = -lobe_scale * sums[c];
+    d_n = -ks * (0.5 * kInvPi * sums[c] + lobe_scale * slope[c]);
+  }
+}
+
+ShadingLights moved_lights(const ShadingLights& ordered, int moving, const double* offsets) {
+  ShadingLights moved = ordered;
+  for (int l = 0; l < moving && offsets; ++l) {
+    for (int c = 0; c < 3; ++c) {
+      moved.lights[static_cast<std::size_t>(l)].vector[c] += static_cast<float>(offsets[3 * l + c]);
+    }
+  }
+  return moved;
+}
+
+StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options) {
+  const int count = std::max(2, options.start_exponents);
+  const double low = std::log(static_cast<double>(options.n_min)), high = std::log(static_cast<double>(options.n_max));
+  StartShape best;
+  best.log_n_spacing = (high - low) / (count - 1);
+  double best_f = std::numeric_limits<double>::infinity();
+  for (int k = 0; k < count; ++k) {
+    const double n = std::exp(low + k * best.log_n_spacing);
+    const ShapeTerms::Projected p = terms.best_ks(n, options.ks_max);
+    if (p.objective < best_f) {
+      best_f = p.objective;
+      best.ks = p.ks;
+      best.n = n;
+    }
+  }
+  best.evaluations = count;
+  return best;
+}
+
+FullModel::FullModel(const SpecularProblem& problem, const ShadingLights& ordered, int moving)
+    : kd_(problem.kd), ambient_(ordered.ambient), lights_(ordered), moving_(moving) {
+  const auto& s = problem.samples;
+  px_ = coordinate(s, 0, &SpecularSample::position);
+  py_ = coordinate(s, 1, &SpecularSample::position);
+  pz_ = coordinate(s, 2, &SpecularSample::position);
+  nx_ = coordinate(s, 0, &SpecularSample::normal);
+  ny_ = coordinate(s, 1, &SpecularSample::normal);
+  nz_ = coordinate(s, 2, &SpecularSample::normal);
+  for (int c = 0; c < 3; ++c) radiance_[static_cast<std::size_t>(c)] = coordinate(s, c, &SpecularSample::radiance);
+  const Eigen::ArrayXf inv_distance = (px_.square() + py_.square() + pz_.square()).rsqrt();
+  vx_ = -px_ * inv_distance;
+  vy_ = -py_ * inv_distance;
+  vz_ = -pz_ * inv_distance;
+  n_dot_v_ = nx_ * vx_ + ny_ * vy_ + nz_ * vz_;
+}
+
+double FullModel::objective(double ks_in, double n_in, const double* offsets) {
+  const auto ks = static_cast<float>(ks_in), n = static_cast<float>(n_in);
+  constexpr float kInvPiF = std::numbers::inv_pi_v<float>;
+  constexpr auto kMinRvF = static_cast<float>(kMinRv);
+  const float lobe_scale = ks * (n + 2.f) * 0.5f * kInvPiF;
+  const Eigen::Index count = px_.size();
+  for (int c = 0; c < 3; ++c) model_[static_cast<std::size_t>(c)].setConstant(count, kd_[c] * ambient_[c]);
+  for (std::size_t l = 0; l < lights_.lights.size(); ++l) {
+    const ShadingLight& light = lights_.lights[l];
+    Eigen::Vector3f at = light.vector;
+    if (static_cast<int>(l) < moving_) {
+      at += Eigen::Vector3d(offsets[3 * l], offsets[3 * l + 1], offsets[3 * l + 2]).cast<float>();
+    }
+    if (light.point) {
+      dx_ = at.x() - px_;
+      dy_ = at.y() - py_;
+      dz_ = at.z() - pz_;
+      inv_d_ = (dx_.square() + dy_.square() + dz_.square()).rsqrt();
+      dx_ *= inv_d_;
+      dy_ *= inv_d_;
+      dz_ *= inv_d_;
+      irradiance_ = inv_d_.square();  // 1 / d^2
+    } else {
+      at.normalize();
+      dx_.setConstant(count, at.x());
+      dy_.setConstant(count, at.y());
+      dz_.setConstant(count, at.z());
+      irradiance_.setOnes(count);
+    }
+    cosine_ = nx_ * dx_ + ny_ * dy_ + nz_ * dz_;
+    rv_ = 2.f * cosine_ * n_dot_v_ - (vx_ * dx_ + vy_ * dy_ + vz_ * dz_);
+    irradiance_ = (cosine_ > 0.f).select(irradiance_ * cosine_, 0.f);
+    lobe_ = (rv_ > kMinRvF).select((n * rv_.max(kMinRvF).log()).exp(), 0.f);
+    for (int c = 0; c < 3; ++c) {
+      model_[static_cast<std::size_t>(c)] += (light.power[c] * irradiance_) * (kd_[c] * kInvPiF + lobe_scale * lobe_);
+    }
+  }
+  double f = 0.0;
+  for (std::size_t c = 0; c < 3; ++c) f += (radiance_[c] - model_[c]).cast<double>().square().sum();
+  return f;
+}
+
+}  // namespace relight::brdf::detail
