@@ -24,6 +24,13 @@ vec2 paraboloid_texel(vec3 d, int tile) {
   return (d.xy * scale * 0.5 + 0.5) * float(tile);
 }
 
+// paraboloid_direction() (ism.h): the unit direction through texel coordinates.
+vec3 paraboloid_direction(vec2 texel, int tile) {
+  const vec2 uv = texel / float(tile) * 2.0 - 1.0;
+  const float r2 = dot(uv, uv);
+  return vec3(uv * (2.0 / (1.0 + r2)), (1.0 - r2) / (1.0 + r2));
+}
+
 // ism_point_index() (ism.h) in 32 bits: (vpl * 7919 + i) mod pool, exact for pools of at most
 // 2^16 points (validated on the host).
 uint ism_point_index(uint vpl, uint i, uint pool) {

@@ -65,6 +65,11 @@ void main() {
   const int y0 = max(max(0, int(floor(low.y))), cy - MAX_SPLAT / 2);
   const int x1 = min(min(tile - 1, int(floor(high.x))), x0 + MAX_SPLAT - 1);
   const int y1 = min(min(tile - 1, int(floor(high.y))), y0 + MAX_SPLAT - 1);
+  // Per texel: the distance along its direction to the point's tangent plane (ism.cpp: splat()).
+  const vec3 pn = point.normal.xyz;
+  const vec3 plane_normal_local = vec3(dot(pn, t), dot(pn, b), dot(pn, n));
+  const float plane_offset = dot(q, pn);
+  const float near = distance - 2.0 * h, far = distance + 2.0 * h;
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       const vec2 p = vec2(x, y) + 0.5;
@@ -74,7 +79,11 @@ void main() {
         positive = positive && e >= 0.0;
         negative = negative && e <= 0.0;
       }
-      if (positive || negative) atomicMin(atlas[base + uint(y * tile + x)], bits);
+      if (positive || negative) {
+        const float facing = dot(paraboloid_direction(p, tile), plane_normal_local);
+        const float along = abs(facing) > 1e-3 ? clamp(plane_offset / facing, near, far) : distance;
+        atomicMin(atlas[base + uint(y * tile + x)], floatBitsToUint(max(along, 0.0)));
+      }
     }
   atomicMin(atlas[base + uint(cy * tile + cx)], bits);
 }

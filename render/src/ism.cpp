@@ -112,6 +112,13 @@ void splat(const VplFrame& frame, const IsmPoint& point, int tile, float* texels
   const int y0 = std::max({0, static_cast<int>(std::floor(low.y())), cy - kMaxSplat / 2});
   const int x1 = std::min({tile - 1, static_cast<int>(std::floor(high.x())), x0 + kMaxSplat - 1});
   const int y1 = std::min({tile - 1, static_cast<int>(std::floor(high.y())), y0 + kMaxSplat - 1});
+  // The splat is a piece of the point's tangent plane: each texel stores the distance along its
+  // own direction to that plane (within the splat's depth range), so that a plane seen at a
+  // grazing angle does not shadow itself.
+  const Vec3 to_point = point.position - frame.origin;
+  const Vec3 plane_normal_local(point.normal.dot(frame.t), point.normal.dot(frame.b), point.normal.dot(frame.n));
+  const float plane_offset = to_point.dot(point.normal);
+  const float near = distance - 2.f * point.half_size, far = distance + 2.f * point.half_size;
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
       const Vec2 p(static_cast<float>(x) + 0.5f, static_cast<float>(y) + 0.5f);
@@ -122,8 +129,10 @@ void splat(const VplFrame& frame, const IsmPoint& point, int tile, float* texels
         negative = negative && e <= 0.f;
       }
       if (positive || negative) {
+        const float facing = paraboloid_direction(p, tile).dot(plane_normal_local);
+        const float along = std::abs(facing) > 1e-3f ? std::clamp(plane_offset / facing, near, far) : distance;
         float& texel = texels[static_cast<std::size_t>(y) * static_cast<std::size_t>(tile) + static_cast<std::size_t>(x)];
-        texel = std::min(texel, distance);
+        texel = std::min(texel, std::max(along, 0.f));
       }
     }
   float& own = texels[static_cast<std::size_t>(cy) * static_cast<std::size_t>(tile) + static_cast<std::size_t>(cx)];
@@ -173,6 +182,14 @@ void fill_holes(float* texels, int tile, int levels) {
 IsmPointPools sample_ism_points(const MrScene& scene, const IsmOptions& options) {
   validate(options);
   return {sample_layer(scene, true, options, 1), sample_layer(scene, false, options, 2)};
+}
+
+Vec3 paraboloid_direction(const Vec2& texel, int tile) {
+  const auto size = static_cast<float>(tile);
+  const float u = texel.x() / size * 2.f - 1.f, v = texel.y() / size * 2.f - 1.f;
+  const float r2 = u * u + v * v;
+  const float scale = 2.f / (1.f + r2);
+  return {u * scale, v * scale, (1.f - r2) / (1.f + r2)};
 }
 
 Vec2 paraboloid_texel(const Vec3& d, int tile) {

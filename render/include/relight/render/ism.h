@@ -92,5 +92,7 @@ class IsmLookup {
 
 /// Texel coordinates in [0, tile) of `direction` (unit, VPL frame, z along the VPL normal).
 [[nodiscard]] Eigen::Vector2f paraboloid_texel(const Eigen::Vector3f& local_direction, int tile);
+/// The inverse: the unit direction (VPL frame) through texel coordinates (e.g. a texel centre).
+[[nodiscard]] Eigen::Vector3f paraboloid_direction(const Eigen::Vector2f& texel, int tile);
 
 }  // namespace relight::render
