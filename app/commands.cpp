@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "json_config.h"
+#include "mixed_reality_scene.h"
 #include "replay.h"
 
 namespace relight::app {
@@ -26,6 +27,27 @@ void add_compute_options(CLI::App& command, ReplayOptions& options) {
       ->check(CLI::IsMember({"method1", "method2"}))
       ->capture_default_str();
 }
+
+}  // namespace
+
+void add_render_options(CLI::App& command, ReplayOptions& options) {
+  command.add_option("--object", options.objects, "Virtual object to render into every frame: .obj, .gltf, .glb (repeatable)");
+  command.add_option("--place", options.places,
+                     std::string("Placement x,y,z[,yaw_degrees[,scale]] per --object, world frame (synthetic default ") +
+                         kDefaultSynthPlacement + ")");
+  command.add_option("--lights", options.lights, "Lights JSON of `relight lights` (needed to render into a recorded sequence)");
+  command.add_option("--virtual-light", options.virtual_lights, "A virtual point light x,y,z,intensity[,r,g,b] (repeatable)");
+  command.add_option("--vpls", options.vpls, "Light samples for virtual point lights per frame")
+      ->check(CLI::Range(0, 4096))
+      ->capture_default_str();
+  command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command.add_flag("--buffers", options.write_buffers, "Also write L_rv and L_r per frame (EXR) under frames/");
+  command.add_flag("!--no-video", options.video, "Do not write composite.mp4");
+}
+
+namespace {
 
 struct Registry {
   Runners runners;
@@ -52,6 +74,7 @@ void register_replay(CLI::App& app) {
                      "none, or a layout JSON file; writes marker_trajectory.txt")
       ->capture_default_str();
   add_compute_options(*replay, *options);
+  add_render_options(*replay, *options);
   registry().runners[replay] = [options] { return run_replay(*options); };
 }
 

@@ -7,6 +7,8 @@
 
 namespace relight::app {
 
+struct ReplayOptions;
+
 void register_commands(CLI::App& app);
 /// Each subcommand registers its runner in `runners`, keyed by its CLI11 subcommand.
 using Runners = std::map<const CLI::App*, std::function<int()>>;
@@ -16,6 +18,9 @@ void register_lights(CLI::App& app, Runners& runners);
 void register_render(CLI::App& app, Runners& runners);
 /// `relight devices`, `relight live` and `relight record` (OpenNI2 devices, live_command.cpp).
 void register_live(CLI::App& app, Runners& runners);
+
+/// The options of differential rendering (--object, --place, --lights, ...) shared by replay and live.
+void add_render_options(CLI::App& command, ReplayOptions& options);
 
 /// Runs the subcommand that was selected on the command line; returns the exit code.
 int run_selected(CLI::App& app);

@@ -11,12 +11,14 @@ void FrameWriterStage::declare(StageBuilder& builder) {
   for (const auto& name : color_names_) colors_.push_back(builder.read<ColorImage>(name));
   for (const auto& name : depth_names_) depths_.push_back(builder.read<DepthMap>(name));
   for (const auto& name : normal_names_) normals_.push_back(builder.read<NormalMap>(name));
+  for (const auto& name : radiance_names_) radiances_.push_back(builder.read<RadianceImage>(name));
 }
 
-std::filesystem::path FrameWriterStage::file_for(std::int64_t frame, const std::string& buffer) const {
+std::filesystem::path FrameWriterStage::file_for(std::int64_t frame, const std::string& buffer,
+                                                 const char* extension) const {
   char name[64];
   std::snprintf(name, sizeof name, "%06lld_", static_cast<long long>(frame));
-  return folder_ / (name + buffer + ".png");
+  return folder_ / (name + buffer + extension);
 }
 
 void FrameWriterStage::run(StageContext& context) {
@@ -33,6 +35,9 @@ void FrameWriterStage::run(StageContext& context) {
   }
   for (std::size_t i = 0; i < normals_.size(); ++i) {
     write_color(file_for(context.frame_index(), normal_names_[i]), normal_preview(context.get(normals_[i])));
+  }
+  for (std::size_t i = 0; i < radiances_.size(); ++i) {
+    write_radiance(file_for(context.frame_index(), radiance_names_[i], ".exr"), context.get(radiances_[i]));
   }
 }
 

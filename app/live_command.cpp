@@ -282,6 +282,7 @@ void register_live(CLI::App& app, Runners& runners) {
   live->add_option("--markers", live_options->replay.markers, "AprilTag layout JSON for the camera pose, or none")
       ->capture_default_str();
   add_live_compute_options(*live, live_options->replay);
+  add_render_options(*live, live_options->replay);
   runners[live] = [live_options] { return run_live(*live_options); };
 
   auto record_options = std::make_shared<RecordOptions>();

@@ -8,19 +8,18 @@
 #include <sstream>
 
 #include "commands.h"
+#include "mixed_reality_scene.h"
 #include "relight/capture/tum_sequence.h"
 #include "relight/colormap/color_space.h"
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
 #include "relight/core/image_io.h"
 #include "relight/core/progress.h"
-#include "relight/lights/light_output.h"
 #include "relight/render/composite.h"
 #include "relight/render/depth_mesh.h"
 #include "relight/render/model_io.h"
 #include "relight/render/procedural_models.h"
 #include "relight/render/scene_from_synth.h"
-#include "relight/render/scene_lights.h"
 
 namespace relight::app {
 
@@ -47,59 +46,22 @@ struct RenderReferenceOptions {
   bool quiet = false;
 };
 
-/// Where a virtual object goes when --place is not given on a synthetic sequence: on the table,
-/// to the right of the marker.
-constexpr const char* kDefaultSynthPlacement = "0.35,-0.2,0.75,30";
-
-bool is_synthetic(const fs::path& sequence) {
-  const fs::path scene = sequence / "scene.json";
-  if (!fs::is_regular_file(scene)) return false;
-  const nlohmann::json json = nlohmann::json::parse(read_text_file(scene), nullptr, false);
-  if (json.is_discarded()) throw Error(scene.string() + ": not valid JSON");
-  return json.value("generator", std::string()) == "relight synth";
-}
-
 /// The real part of the scene: the synthetic scene's exact geometry, or the frame's depth mesh
 /// with the lights of --lights.
 MrScene real_scene(const RenderReferenceOptions& command, bool synthetic, const TumSequence& sequence,
                    const RgbdFrame& frame) {
   if (synthetic) {
     MrScene scene = render::scene_from_synth(synth::default_indoor_scene());
-    if (!command.lights.empty())
-      throw Error("--lights applies to recorded sequences; a synthetic sequence brings its own lights");
+    scene.lights = real_lights(true, command.sequence, command.lights);
     return scene;
   }
-  if (command.lights.empty())
-    throw Error(command.sequence.string() + " is a recorded sequence: give its lights with --lights FILE (from `relight lights`)");
   MrScene scene;
+  scene.lights = real_lights(false, command.sequence, command.lights);
   render::DepthMeshMaterials materials;
   materials.material = scene.add_material({"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
   scene.meshes.push_back(render::mesh_from_positions(render::positions_from_depth(frame.depth, sequence.intrinsics()),
                                                      nullptr, *frame.info.camera_to_world, materials));
-  render::add_lights(scene, lights_from_json(read_text_file(command.lights), command.lights.string()));
   return scene;
-}
-
-/// "x,y,z,intensity[,r,g,b]": a virtual point light of radiant intensity intensity * (r,g,b) W/sr.
-render::MrLight parse_virtual_light(const std::string& text) {
-  std::vector<float> v;
-  std::stringstream stream(text);
-  std::string field;
-  while (std::getline(stream, field, ',')) {
-    char* end = nullptr;
-    v.push_back(std::strtof(field.c_str(), &end));
-    if (field.empty() || *end != '\0' || !std::isfinite(v.back()))
-      throw Error("--virtual-light '" + text + "': '" + field + "' is not a number");
-  }
-  if (v.size() != 4 && v.size() != 7) throw Error("--virtual-light '" + text + "' needs x,y,z,intensity[,r,g,b]");
-  render::MrLight light;
-  light.kind = render::LightKind::Point;
-  light.position = {v[0], v[1], v[2]};
-  const Eigen::Vector3f colour = v.size() == 7 ? Eigen::Vector3f(v[4], v[5], v[6]) : Eigen::Vector3f::Ones();
-  if (v[3] < 0.f || colour.minCoeff() < 0.f) throw Error("--virtual-light '" + text + "': intensity and colour must not be negative");
-  light.intensity = v[3] * colour;
-  light.real = false;
-  return light;
 }
 
 PinholeIntrinsics downsampled(const PinholeIntrinsics& k, int factor) {

@@ -8,6 +8,7 @@
 #include "frame_range.h"
 #include "frame_writer_stage.h"
 #include "marker_trajectory_stage.h"
+#include "mixed_reality_scene.h"
 #include "relight/capture/marker_pose.h"
 #include "relight/capture/openni_source.h"
 #include "relight/capture/source_stage.h"
@@ -22,7 +23,9 @@
 #include "relight/vk/backend.h"
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
+#include "relight/render/dir_stage.h"
 #include "report.h"
+#include "video_writer_stage.h"
 
 namespace relight::app {
 
@@ -111,6 +114,27 @@ std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
   return parse_tag_layout(text, scene.string());
 }
 
+/// The DIR stage and its outputs, when the options ask for any virtual content.
+void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options) {
+  if (options.objects.empty() && options.virtual_lights.empty()) return;
+  if (options.vpls < 0 || options.vpls > 4096) throw Error("--vpls must be 0 to 4096");
+  if (!(options.exposure > 0.f)) throw Error("--exposure must be positive");
+  const auto sequence = options.sequence.empty() ? default_sequence() : options.sequence;
+  const bool synthetic = sequence.extension() != ".oni" && is_synthetic(sequence);
+  render::DirSceneContent content;
+  content.lights = real_lights(synthetic, sequence, options.lights);
+  for (const std::string& light : options.virtual_lights) content.lights.push_back(parse_virtual_light(light));
+  content.objects = virtual_objects(options.objects, options.places, synthetic);
+  render::DirStageOptions dir;
+  dir.vpls.count = options.vpls;
+  dir.tone_map.exposure = options.exposure;
+  pipeline.graph->emplace<render::DirStage>(pipeline.vulkan.get(), std::move(content), dir);
+  pipeline.graph->keep("composite");
+  if (options.video)
+    pipeline.graph->emplace<VideoWriterStage>(options.out / "composite.mp4", "composite");
+  pipeline.renders = true;
+}
+
 void add_marker_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
   auto layout = marker_layout(options);
   if (!layout) return;
@@ -148,6 +172,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   graph.keep("normals");
   graph.keep("positions");
   add_marker_pose(pipeline, options);
+  add_differential_rendering(pipeline, options);
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
     writer->add_color("color");
@@ -155,6 +180,11 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
     writer->add_depth("depth_smoothed");
     if (method2) writer->add_depth("depth_filtered");
     writer->add_normals("normals");
+    if (pipeline.renders) writer->add_color("composite");
+    if (pipeline.renders && options.write_buffers) {
+      writer->add_radiance("L_rv");
+      writer->add_radiance("L_r");
+    }
     graph.add(std::move(writer));
   }
   return pipeline;
@@ -188,7 +218,8 @@ int run_replay(const ReplayOptions& options) {
   write_file_atomically(options.out / "report.json", report.dump(2) + "\n");
   if (!options.quiet) {
     std::cerr << "relight replay: " << graph.frames_run() << " frames in " << seconds << " s; results in "
-              << options.out.string() << " (report.json, graph.dot, frames/)\n";
+              << options.out.string() << " (report.json, graph.dot, frames/"
+              << (pipeline.renders && options.video ? ", composite.mp4" : "") << ")\n";
   }
   return 0;
 }

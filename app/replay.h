@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "relight/capture/frame_source.h"
 #include "relight/core/frame_graph.h"
@@ -29,6 +30,15 @@ struct ReplayOptions {
   std::string markers = "auto";
   bool skip_bad_frames = false;  ///< TUM frames that cannot be read: warn and skip instead of failing
   std::string geometry = "method1";  ///< normals: method1 (NormalsRawDepth) | method2 (DepthWarpMerge + NormalsFromPositions)
+  /// Differential rendering (render/dir_stage.h) runs when there is an object or a virtual light.
+  std::vector<std::filesystem::path> objects;  ///< .obj / .gltf / .glb
+  std::vector<std::string> places;             ///< one x,y,z[,yaw[,scale]] per object
+  std::filesystem::path lights;                ///< lights JSON of `relight lights` (recorded sequences)
+  std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]
+  int vpls = 64;                               ///< first-bounce light samples per frame
+  float exposure = 1.f;                        ///< tone mapping of the rendered light
+  bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
+  bool video = true;                           ///< composite.mp4
 };
 
 
@@ -38,6 +48,7 @@ struct ReplayPipeline {
   std::unique_ptr<FrameGraph> graph;
   std::string compute;  ///< one line: which backend runs the per-pixel stages, on which device
   app::MarkerTrajectoryStage* markers = nullptr;  ///< set when the marker pose runs
+  bool renders = false;                           ///< the DIR stage is in the graph
   ReplayPipeline();
   ~ReplayPipeline();
   ReplayPipeline(ReplayPipeline&&) noexcept;

@@ -1,0 +1,75 @@
+#include "mixed_reality_scene.h"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+#include "relight/lights/light_output.h"
+#include "relight/render/model_io.h"
+#include "relight/render/scene_from_synth.h"
+#include "relight/render/scene_lights.h"
+
+namespace relight::app {
+
+namespace fs = std::filesystem;
+
+bool is_synthetic(const fs::path& sequence) {
+  const fs::path scene = sequence / "scene.json";
+  if (!fs::is_regular_file(scene)) return false;
+  const nlohmann::json json = nlohmann::json::parse(read_text_file(scene), nullptr, false);
+  if (json.is_discarded()) throw Error(scene.string() + ": not valid JSON");
+  return json.value("generator", std::string()) == "relight synth";
+}
+
+render::MrLight parse_virtual_light(const std::string& text) {
+  std::vector<float> v;
+  std::stringstream stream(text);
+  std::string field;
+  while (std::getline(stream, field, ',')) {
+    char* end = nullptr;
+    v.push_back(std::strtof(field.c_str(), &end));
+    if (field.empty() || *end != '\0' || !std::isfinite(v.back()))
+      throw Error("--virtual-light '" + text + "': '" + field + "' is not a number");
+  }
+  if (v.size() != 4 && v.size() != 7) throw Error("--virtual-light '" + text + "' needs x,y,z,intensity[,r,g,b]");
+  render::MrLight light;
+  light.kind = render::LightKind::Point;
+  light.position = {v[0], v[1], v[2]};
+  const Eigen::Vector3f colour = v.size() == 7 ? Eigen::Vector3f(v[4], v[5], v[6]) : Eigen::Vector3f::Ones();
+  if (v[3] < 0.f || colour.minCoeff() < 0.f) throw Error("--virtual-light '" + text + "': intensity and colour must not be negative");
+  light.intensity = v[3] * colour;
+  light.real = false;
+  return light;
+}
+
+std::vector<render::MrLight> real_lights(bool synthetic, const fs::path& sequence, const fs::path& lights_file) {
+  if (synthetic) {
+    if (!lights_file.empty())
+      throw Error("--lights applies to recorded sequences; a synthetic sequence brings its own lights");
+    return render::scene_from_synth(synth::default_indoor_scene()).lights;
+  }
+  if (lights_file.empty())
+    throw Error(sequence.string() + " is a recorded sequence: give its lights with --lights FILE (from `relight lights`)");
+  render::MrScene scene;
+  render::add_lights(scene, lights_from_json(read_text_file(lights_file), lights_file.string()));
+  return scene.lights;
+}
+
+std::vector<std::pair<render::VirtualModel, render::Placement>> virtual_objects(const std::vector<fs::path>& objects,
+                                                                               const std::vector<std::string>& places,
+                                                                               bool synthetic) {
+  if (!places.empty() && places.size() != objects.size())
+    throw Error("give one --place per --object (" + std::to_string(objects.size()) + " objects, " +
+                std::to_string(places.size()) + " placements)");
+  if (places.empty() && !objects.empty() && !synthetic)
+    throw Error("--place x,y,z[,yaw[,scale]] is needed to put an object into a recorded scene");
+  std::vector<std::pair<render::VirtualModel, render::Placement>> out;
+  for (std::size_t i = 0; i < objects.size(); ++i)
+    out.emplace_back(render::load_model(objects[i]),
+                     render::Placement::parse(places.empty() ? kDefaultSynthPlacement : places[i]));
+  return out;
+}
+
+}  // namespace relight::app

@@ -1,0 +1,36 @@
+#pragma once
+// What the commands that render virtual objects into a sequence share (render-reference,
+// replay, live): telling a synthetic sequence from a recorded one, the real lights of each, and
+// the virtual objects and lights given on the command line.
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "relight/render/mr_scene.h"
+#include "relight/render/virtual_model.h"
+
+namespace relight::app {
+
+/// Where a virtual object goes when --place is not given on a synthetic sequence: on the table,
+/// to the right of the marker.
+inline constexpr const char* kDefaultSynthPlacement = "0.35,-0.2,0.75,30";
+
+/// True for a sequence written by `relight synth` (its scene.json says so).
+[[nodiscard]] bool is_synthetic(const std::filesystem::path& sequence);
+
+/// "x,y,z,intensity[,r,g,b]": a virtual point light of radiant intensity intensity * (r,g,b) W/sr.
+[[nodiscard]] render::MrLight parse_virtual_light(const std::string& text);
+
+/// The real lights: a synthetic sequence's own (the default indoor scene's), or those of the
+/// lights JSON of `relight lights` for a recorded one. Throws relight::Error when a recorded
+/// sequence has no lights file, or a synthetic one is given one.
+[[nodiscard]] std::vector<render::MrLight> real_lights(bool synthetic, const std::filesystem::path& sequence,
+                                                       const std::filesystem::path& lights_file);
+
+/// Loads each object and pairs it with its placement: one --place per object, or none on a
+/// synthetic sequence (every object then goes to kDefaultSynthPlacement).
+[[nodiscard]] std::vector<std::pair<render::VirtualModel, render::Placement>> virtual_objects(
+    const std::vector<std::filesystem::path>& objects, const std::vector<std::string>& places, bool synthetic);
+
+}  // namespace relight::app

@@ -1,0 +1,79 @@
+// `relight replay` with virtual content: composites per frame, composite.mp4, the L_rv/L_r
+// buffers on request, and one-line errors for what it cannot render.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cli.h"
+#include "relight/core/atomic_file.h"
+#include "relight/core/image_io.h"
+#include "temp_dir.h"
+
+namespace relight {
+namespace {
+
+using cli_test::expect_one_line_error;
+using cli_test::relight;
+
+const std::filesystem::path kData = RELIGHT_TEST_DATA;
+
+const std::filesystem::path& two_frame_sequence() {
+  static TempDir dir;
+  static const std::filesystem::path sequence = [] {
+    const auto path = dir.path() / "seq";
+    const auto result = relight("synth --quiet --frames 2 --no-gt --out " + path.string());
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    return path;
+  }();
+  return sequence;
+}
+
+TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
+  TempDir dir;
+  const auto out = dir.path() / "out";
+  const auto result = relight("replay --quiet " + two_frame_sequence().string() + " --object " +
+                              (kData / "models" / "glossy_pebble.gltf").string() + " --vpls 32 --buffers --out " +
+                              out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  for (const char* frame : {"000000", "000001"}) {
+    const ColorImage camera = read_color(out / "frames" / (std::string(frame) + "_color.png"));
+    const ColorImage composite = read_color(out / "frames" / (std::string(frame) + "_composite.png"));
+    ASSERT_EQ(composite.width(), camera.width());
+    int changed = 0;
+    for (std::size_t i = 0; i < camera.size(); ++i) changed += camera.pixels()[i] == composite.pixels()[i] ? 0 : 1;
+    EXPECT_GT(changed, 200) << "the pebble and its shadow";
+    EXPECT_LT(changed, static_cast<int>(camera.size()) / 4);
+    const RadianceImage lrv = read_radiance(out / "frames" / (std::string(frame) + "_L_rv.exr"));
+    EXPECT_EQ(lrv.width(), camera.width());
+  }
+  ASSERT_TRUE(std::filesystem::exists(out / "composite.mp4"));
+  EXPECT_GT(std::filesystem::file_size(out / "composite.mp4"), 1000u);
+  EXPECT_FALSE(std::filesystem::exists(out / "composite.partial.mp4"));
+  const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
+  EXPECT_NE(report.dump().find("\"dir\""), std::string::npos) << "the DIR stage is timed";
+}
+
+TEST(ReplayRenderCli, WithoutVirtualContentNothingIsRendered) {
+  TempDir dir;
+  const auto out = dir.path() / "out";
+  ASSERT_EQ(relight("replay --quiet --frames 1 " + two_frame_sequence().string() + " --out " + out.string()).exit_code, 0);
+  EXPECT_FALSE(std::filesystem::exists(out / "frames" / "000000_composite.png"));
+  EXPECT_FALSE(std::filesystem::exists(out / "composite.mp4"));
+}
+
+TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
+  TempDir dir;
+  const std::string out = " --out " + (dir.path() / "out").string();
+  const std::string seq = " " + two_frame_sequence().string();
+  const std::string pebble = " --object " + (kData / "models" / "glossy_pebble.gltf").string();
+  expect_one_line_error(relight("replay" + seq + " --object /no/such/model.glb" + out), 1);
+  expect_one_line_error(relight("replay" + seq + pebble + pebble + " --place 0,0,1" + out), 1);  // 2 objects, 1 place
+  expect_one_line_error(relight("replay" + seq + " --virtual-light 1,2,x,4" + out), 1);
+  // A recorded sequence needs its lights and a placement.
+  expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + " --place 0,0,1" + out), 1);
+  expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + out), 1);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "composite.mp4"));
+}
+
+}  // namespace
+}  // namespace relight
