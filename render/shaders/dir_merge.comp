@@ -1,0 +1,49 @@
+#version 450
+// Differential instant radiosity, merge pass (render/dir_vk.h): the geometry-aware blur that
+// turns interleaved indirect light back into a full image (Segovia et al. 2006; Knecht 2010 §4).
+// Each pixel averages the indirect light of the n x n window [x - n/2, x + n/2 - 1] (one pixel of
+// every VPL subset) over the neighbours on the same kind of surface (real or virtual) within 5 %
+// of its distance and with normals within ~25 degrees; direct light passes through unblurred.
+// The CPU mirror is merge_interleaved() in dir_maps_cpu.cpp.
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(std430, set = 0, binding = 0) readonly buffer GBuffer { vec4 gbuffer[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Shaded { vec4 shaded[]; };  // 4 per pixel
+layout(std430, set = 0, binding = 2) writeonly buffer Radiance { vec4 radiance[]; };  // 2 per pixel
+
+layout(push_constant) uniform Params {
+  uint width;
+  uint height;
+  uint interleave;
+} params;
+
+void main() {
+  const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+  const ivec2 size = ivec2(params.width, params.height);
+  if (p.x >= size.x || p.y >= size.y) return;
+  const uint pixels = params.width * params.height;
+  const uint i = uint(p.y) * params.width + uint(p.x);
+  const vec4 position = gbuffer[i];
+  const vec3 normal = gbuffer[pixels + i].xyz;
+  vec3 sum_rv = shaded[4u * i + 2u].xyz, sum_r = shaded[4u * i + 3u].xyz;
+  float weight = 1.0;
+  const int n = int(params.interleave);
+  if (n > 1 && position.w != 0.0) {
+    for (int dy = -n / 2; dy < n - n / 2; ++dy)
+      for (int dx = -n / 2; dx < n - n / 2; ++dx) {
+        const ivec2 q = p + ivec2(dx, dy);
+        if ((dx == 0 && dy == 0) || q.x < 0 || q.y < 0 || q.x >= size.x || q.y >= size.y) continue;
+        const uint j = uint(q.y) * params.width + uint(q.x);
+        const float dq = gbuffer[j].w;
+        if (dq == 0.0 || (dq < 0.0) != (position.w < 0.0)) continue;
+        if (abs(abs(dq) - abs(position.w)) > 0.05 * abs(position.w)) continue;
+        if (dot(gbuffer[pixels + j].xyz, normal) < 0.9) continue;
+        sum_rv += shaded[4u * j + 2u].xyz;
+        sum_r += shaded[4u * j + 3u].xyz;
+        weight += 1.0;
+      }
+  }
+  const vec4 direct_rv = shaded[4u * i];
+  radiance[2u * i] = vec4(direct_rv.xyz + sum_rv / weight, direct_rv.w);
+  radiance[2u * i + 1u] = vec4(shaded[4u * i + 1u].xyz + sum_r / weight, 0.0);
+}
