@@ -17,10 +17,11 @@ void finish_fit(SpecularFit& fit, const SpecularProblem& problem, const Specular
 
 namespace {
 
-/// Residual of one sample: observed minus model, 3 channels. Blocks: (k_s, n), offset of moving
-/// light 0, offset of moving light 1 (an unused block is held constant at zero).
-struct SampleResidual {
-  const SpecularSample* sample;
+/// Residuals of the light phase's samples (observed minus model, 3 channels each) in one block
+/// per parameter group: (k_s, n), offset of moving light 0, offset of moving light 1 (an unused
+/// block is held constant at zero).
+struct SubsetResidual {
+  const std::vector<SpecularSample>* samples;
   const Eigen::Vector3f* kd;
   const ShadingLights* lights;
   int moving;
@@ -28,11 +29,30 @@ struct SampleResidual {
   template <class T>
   bool operator()(const T* shape, const T* offset0, const T* offset1, T* residual) const {
     const std::array<const T*, 2> offsets{offset0, offset1};
-    T model[3];
-    detail::model_radiance<T>(*sample, *kd, *lights, shape[0], shape[1], offsets.data(), moving, model);
-    for (int c = 0; c < 3; ++c) residual[c] = T(double(sample->radiance[c])) - model[c];
+    for (const SpecularSample& sample : *samples) {
+      T model[3];
+      detail::model_radiance<T>(sample, *kd, *lights, shape[0], shape[1], offsets.data(), moving, model);
+      for (int c = 0; c < 3; ++c) *residual++ = T(double(sample.radiance[c])) - model[c];
+    }
     return true;
   }
+};
+
+/// Ends the light phase after `probe` iterations that lowered the cost by less than 10 %: the
+/// misfit has another cause (shadows, mixed materials) than misplaced lights (as Nelder-Mead's
+/// probe).
+class LightProbe final : public ceres::IterationCallback {
+ public:
+  explicit LightProbe(int probe) : probe_(probe) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary& summary) override {
+    if (summary.iteration == 0) initial_ = summary.cost;
+    if (summary.iteration == probe_ && summary.cost > 0.9 * initial_) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    return ceres::SOLVER_CONTINUE;
+  }
+
+ private:
+  int probe_;
+  double initial_ = 0.0;
 };
 
 /// Every residual with the lights fixed, in one block over (k_s, n) with the analytic Jacobian
@@ -73,6 +93,8 @@ void bound_shape(ceres::Problem& cp, double* shape, const SpecularOptions& optio
 }
 
 constexpr std::size_t kLightSamples = 128;
+constexpr int kLightProbeIterations = 5;
+constexpr double kLightFunctionTolerance = 1e-4;
 
 /// (k_s, n) with the lights fixed; returns F (Ceres minimises half of it). A negative shape[0]
 /// starts from detail::start_shape().
@@ -128,12 +150,12 @@ class CeresSolver final : public SpecularSolver {
       std::vector<SpecularSample> subset;
       const std::size_t stride = problem.samples.size() / kLightSamples + 1;
       for (std::size_t i = 0; i < problem.samples.size(); i += stride) subset.push_back(problem.samples[i]);
-      ceres::Problem cp;
-      for (const SpecularSample& s : subset) {
-        auto* cost = new ceres::AutoDiffCostFunction<SampleResidual, 3, 2, 3, 3>(
-            new SampleResidual{&s, &problem.kd, &ordered, moving});
-        cp.AddResidualBlock(cost, nullptr, shape2, offsets2[0], offsets2[1]);
-      }
+      ceres::AutoDiffCostFunction<SubsetResidual, ceres::DYNAMIC, 2, 3, 3> cost(
+          new SubsetResidual{&subset, &problem.kd, &ordered, moving}, static_cast<int>(3 * subset.size()));
+      ceres::Problem::Options po;
+      po.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+      ceres::Problem cp(po);
+      cp.AddResidualBlock(&cost, nullptr, shape2, offsets2[0], offsets2[1]);
       bound_shape(cp, shape2, options);
       for (int l = 0; l < 2; ++l) {
         if (l >= moving) {
@@ -147,8 +169,13 @@ class CeresSolver final : public SpecularSolver {
           cp.SetParameterUpperBound(offsets2[l], c, d);
         }
       }
+      LightProbe probe(kLightProbeIterations);
+      ceres::Solver::Options light_options = so;
+      light_options.callbacks.push_back(&probe);
+      // The light phase only has to find where the lights go; the shape fit after it polishes.
+      light_options.function_tolerance = kLightFunctionTolerance;
       ceres::Solver::Summary summary;
-      ceres::Solve(so, &cp, &summary);
+      ceres::Solve(light_options, &cp, &summary);
       iterations += static_cast<int>(summary.iterations.size());
       ShadingLights moved = ordered;
       for (int l = 0; l < moving; ++l) {

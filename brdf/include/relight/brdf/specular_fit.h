@@ -7,18 +7,23 @@
 //   F = sum_i sum_c ( L_i,c - model_c(x_i; k_d, k_s, n, lights) )^2
 //
 // with the model of shading.h (both the diffuse and the specular term subtracted). Two solvers
-// behind one interface:
-//   - Nelder-Mead (own implementation), every vertex projected onto the parameter box, restarted
-//     from the best vertex with a fresh simplex until a restart no longer improves F; in phases:
-//     (A) k_s and log n with the lights fixed (precomputed per-sample terms: one exp per lit
-//     sample and light), (B) if the residual is still above light_refine_rms and the cluster is
-//     not diffuse, every parameter on a subset of 256 samples (stopped after a 150-evaluation
-//     probe when that lowers F by less than 10 %), (C) k_s and log n again on all
-//     samples with the moved lights, kept if F drops;
-//   - Ceres: one ceres::AutoDiffCostFunction per sample (3 residuals), parameter bounds on every
-//     block, Levenberg-Marquardt, in the same phases: (k_s, n) alone; under the same condition
-//     as phase B, blocks (k_s, n) and one 3-vector offset per moving light on the 128-sample
-//     subset; (k_s, n) again on all samples with the moved lights.
+// behind one interface, both starting from the best of a coarse grid of exponents with each
+// one's least-squares k_s (for fixed lights and n the model is linear in k_s), and both
+// evaluating F over structure-of-arrays samples (src/specular_terms.h):
+//   - Nelder-Mead (own implementation), every vertex projected onto the parameter box, in
+//     phases: (A) log n alone with the lights fixed, every vertex taking its least-squares k_s
+//     (variable projection: the same minimum as over (k_s, log n), with a one-dimensional
+//     simplex); (B) if the residual is still above light_refine_rms and the cluster is not
+//     diffuse, every parameter on a subset of 256 samples, restarted from the best vertex with a
+//     fresh simplex until a restart no longer improves F (stopped after a 150-evaluation probe
+//     that lowers F by less than 10 %); (C) phase A again on all samples with the moved lights,
+//     kept if F drops;
+//   - Ceres, Levenberg-Marquardt with parameter bounds on every block, in the same phases:
+//     (k_s, n) as one residual block over all samples with the analytic Jacobian; under the
+//     same condition as phase B, blocks (k_s, n) and one 3-vector offset per moving light in one
+//     ceres::AutoDiffCostFunction over a 128-sample subset (stopped after a 5-iteration probe
+//     that lowers the cost by less than 10 %, or at a relative cost change of 1e-4); (k_s, n)
+//     again on all samples with the moved lights.
 // Ceres stays out of this header (compile time, shared/design/platform.md).
 //
 // When the fit's RMS residual stays above `max_rms`, or k_s comes out below `min_ks`, the cluster
