@@ -54,6 +54,8 @@ void fit_materials(const ColorImage& color, const Mask* highlights, const Positi
                    const NormalMap& normals, const ShadingLights& lights, const BrdfOptions& options,
                    const SpecularSolver& solver, Materials& materials) {
   const int clusters = static_cast<int>(materials.clusters.size());
+  std::vector<std::vector<SpecularSample>> samples =
+      select_cluster_samples(color, positions, normals, materials.ids, clusters, highlights, options.max_samples);
   parallel_rows(
       clusters, options.threads,
       [&](int begin, int end) {
@@ -62,7 +64,7 @@ void fit_materials(const ColorImage& color, const Mask* highlights, const Positi
           SpecularProblem problem;
           problem.kd = m.kd;
           problem.lights = lights;
-          problem.samples = select_samples(color, positions, normals, materials.ids, k, highlights, options.max_samples);
+          problem.samples = std::move(samples[static_cast<std::size_t>(k)]);
           if (problem.samples.empty()) {
             m.ks = 0.f;
             m.fit_rms = -1.f;

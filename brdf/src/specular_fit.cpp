@@ -166,9 +166,16 @@ class NelderMeadSolver final : public SpecularSolver {
                           const std::vector<double>& offsets, const Bounds& bounds, const SpecularOptions& options,
                           std::vector<double>& shape, int& evaluations) {
     const detail::ShapeTerms terms(problem, detail::moved_lights(ordered, moving, offsets.data()));
-    const detail::StartShape start = detail::start_shape(terms, options);
-    evaluations += start.evaluations;
-    std::vector<double> log_n{shape.empty() ? std::log(start.n) : shape[1]};
+    // From phase B's optimum the simplex starts at the grid's spacing without the grid.
+    detail::StartShape start;
+    if (shape.empty()) {
+      start = detail::start_shape(terms, options);
+      evaluations += start.evaluations;
+    } else {
+      start = detail::start_shape_spacing(options);
+      start.n = std::exp(shape[1]);
+    }
+    std::vector<double> log_n{std::log(start.n)};
     auto clamp = [&](std::vector<double>& v) { v[0] = std::clamp(v[0], bounds.lower[1], bounds.upper[1]); };
     auto f = [&](const std::vector<double>& v) {
       ++evaluations;
@@ -284,40 +291,56 @@ double specular_objective(const SpecularProblem& problem, const SpecularOptions&
   return objective_ordered(problem, ordered, moving, ks, n, flat.empty() ? nullptr : flat.data());
 }
 
-std::vector<SpecularSample> select_samples(const ColorImage& color, const PositionMap& positions,
-                                           const NormalMap& normals, const LabelImage& ids, int cluster,
-                                           const Mask* highlights, int max_samples) {
+std::vector<std::vector<SpecularSample>> select_cluster_samples(const ColorImage& color, const PositionMap& positions,
+                                                                const NormalMap& normals, const LabelImage& ids,
+                                                                int clusters, const Mask* highlights, int max_samples) {
   if (!color.same_shape(positions) || !color.same_shape(normals) || !color.same_shape(ids)) {
     throw Error("brdf specular: colour, positions, normals and cluster ids must have the same size");
   }
-  const auto label = static_cast<std::uint16_t>(cluster + 1);
-  std::vector<std::uint32_t> plain, bright;
+  const auto count = static_cast<std::size_t>(std::max(0, clusters));
+  std::vector<std::vector<std::uint32_t>> plain(count), bright(count);
   for (std::size_t i = 0; i < ids.size(); ++i) {
-    if (ids.pixels()[i] != label) continue;
+    const std::uint16_t label = ids.pixels()[i];
+    if (label == 0 || label > count) continue;
     const Rgb8 c = color.pixels()[i];
     if (std::max({c.r, c.g, c.b}) >= 254) continue;
     if (!is_valid_normal(normals.pixels()[i]) || !is_valid_depth(positions.pixels()[i].z)) continue;
-    (highlights && highlights->pixels()[i] ? bright : plain).push_back(static_cast<std::uint32_t>(i));
+    (highlights && highlights->pixels()[i] ? bright : plain)[label - 1u].push_back(static_cast<std::uint32_t>(i));
   }
-  std::vector<std::uint32_t> chosen;
   const auto budget = static_cast<std::size_t>(std::max(0, max_samples));
-  auto take_strided = [&](const std::vector<std::uint32_t>& from, std::size_t count) {
-    if (from.size() <= count) {
-      chosen.insert(chosen.end(), from.begin(), from.end());
-      return;
+  std::vector<std::vector<SpecularSample>> out(count);
+  std::vector<std::uint32_t> chosen;
+  for (std::size_t k = 0; k < count; ++k) {
+    chosen.clear();
+    auto take_strided = [&](const std::vector<std::uint32_t>& from, std::size_t take) {
+      if (from.size() <= take) {
+        chosen.insert(chosen.end(), from.begin(), from.end());
+        return;
+      }
+      for (std::size_t t = 0; t < take; ++t) chosen.push_back(from[t * from.size() / take]);
+    };
+    take_strided(bright[k], budget / 2);
+    take_strided(plain[k], budget - chosen.size());
+    out[k].reserve(chosen.size());
+    for (const std::uint32_t i : chosen) {
+      const Rgb8 c = color.pixels()[i];
+      const Float3 p = positions.pixels()[i], n = normals.pixels()[i];
+      out[k].push_back(
+          {{srgb8_to_linear(c.r), srgb8_to_linear(c.g), srgb8_to_linear(c.b)}, {p.x, p.y, p.z}, {n.x, n.y, n.z}});
     }
-    for (std::size_t k = 0; k < count; ++k) chosen.push_back(from[k * from.size() / count]);
-  };
-  take_strided(bright, budget / 2);
-  take_strided(plain, budget - chosen.size());
-  std::vector<SpecularSample> samples;
-  samples.reserve(chosen.size());
-  for (const std::uint32_t i : chosen) {
-    const Rgb8 c = color.pixels()[i];
-    const Float3 p = positions.pixels()[i], n = normals.pixels()[i];
-    samples.push_back({{srgb8_to_linear(c.r), srgb8_to_linear(c.g), srgb8_to_linear(c.b)}, {p.x, p.y, p.z}, {n.x, n.y, n.z}});
   }
-  return samples;
+  return out;
+}
+
+std::vector<SpecularSample> select_samples(const ColorImage& color, const PositionMap& positions,
+                                           const NormalMap& normals, const LabelImage& ids, int cluster,
+                                           const Mask* highlights, int max_samples) {
+  if (!color.same_shape(ids)) throw Error("brdf specular: colour, positions, normals and cluster ids must have the same size");
+  // Only `cluster` (label cluster + 1) is kept: the others map to label 0.
+  LabelImage only(ids.width(), ids.height());
+  const auto label = static_cast<std::uint16_t>(cluster + 1);
+  for (std::size_t i = 0; i < ids.size(); ++i) only.pixels()[i] = ids.pixels()[i] == label ? 1 : 0;
+  return std::move(select_cluster_samples(color, positions, normals, only, 1, highlights, max_samples)[0]);
 }
 
 std::unique_ptr<SpecularSolver> make_nelder_mead_solver() { return std::make_unique<NelderMeadSolver>(); }

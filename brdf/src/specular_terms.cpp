@@ -123,11 +123,18 @@ ShadingLights moved_lights(const ShadingLights& ordered, int moving, const doubl
   return moved;
 }
 
-StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options) {
+StartShape start_shape_spacing(const SpecularOptions& options) {
   const int count = std::max(2, options.start_exponents);
   const double low = std::log(static_cast<double>(options.n_min)), high = std::log(static_cast<double>(options.n_max));
-  StartShape best;
-  best.log_n_spacing = (high - low) / (count - 1);
+  StartShape start;
+  start.log_n_spacing = (high - low) / (count - 1);
+  return start;
+}
+
+StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options) {
+  const int count = std::max(2, options.start_exponents);
+  const double low = std::log(static_cast<double>(options.n_min));
+  StartShape best = start_shape_spacing(options);
   double best_f = std::numeric_limits<double>::infinity();
   for (int k = 0; k < count; ++k) {
     const double n = std::exp(low + k * best.log_n_spacing);

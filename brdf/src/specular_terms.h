@@ -68,6 +68,8 @@ struct StartShape {
   int evaluations = 0;
 };
 [[nodiscard]] StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options);
+/// Only the grid's log n spacing (no evaluations).
+[[nodiscard]] StartShape start_shape_spacing(const SpecularOptions& options);
 
 class FullModel {
  public:

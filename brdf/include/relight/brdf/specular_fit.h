@@ -106,4 +106,9 @@ class SpecularSolver {
                                                          const NormalMap& normals, const LabelImage& ids, int cluster,
                                                          const Mask* highlights, int max_samples = 2048);
 
+/// select_samples() for clusters 0 .. clusters - 1 at once, in one pass over the image.
+[[nodiscard]] std::vector<std::vector<SpecularSample>> select_cluster_samples(
+    const ColorImage& color, const PositionMap& positions, const NormalMap& normals, const LabelImage& ids,
+    int clusters, const Mask* highlights, int max_samples = 2048);
+
 }  // namespace relight::brdf
