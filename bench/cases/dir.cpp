@@ -1,5 +1,5 @@
 // Differential instant radiosity against the path tracer (render/dir_cpu.h, render/path_tracer.h)
-// on the synthetic scene with the shipped pebble on the table, 160x120, one indirect bounce in
+// on the synthetic scene with the shipped pebble on the table, 320x240, one indirect bounce in
 // both, the sky switched off (DIR lights the environment with directional lights, direct only).
 //
 // dir/vs_reference: for 64, 256 and 1024 light samples, the mean relative error of the
@@ -105,11 +105,12 @@ bench::Json vs_reference(const bench::Options&) {
   auto context = vk::try_create_vulkan();
   if (!context) return {{"skipped", "no Vulkan device"}};
   const render::MrScene scene = bench_scene();
-  const render::MrCamera camera = bench_camera();
+  render::MrCamera camera = bench_camera();
+  camera.intrinsics = PinholeIntrinsics{525.0, 525.0, 159.5, 119.5, 320, 240};  // bench_camera() at twice the size
   render::PathTracerOptions pt_options;
   pt_options.max_bounces = 1;
   pt_options.seed = 99;
-  const int reference_spp = 1024;
+  const int reference_spp = 256;
   const render::DifferentialImages reference = render::render_reference(scene, camera, reference_spp, pt_options);
 
   const render::RayTracer tracer(scene);

@@ -31,6 +31,58 @@ vec3 paraboloid_direction(vec2 texel, int tile) {
   return vec3(uv * (2.0 / (1.0 + r2)), (1.0 - r2) / (1.0 + r2));
 }
 
+// TileProjection (ism.h): a VPL tile's mapping, the hemisphere's paraboloid (tan_half = 0) or a
+// perspective view of the cone around the virtual objects' bounding sphere.
+struct Projection {
+  vec3 origin, t, b, n;
+  float tan_half;
+};
+
+Projection hemisphere(Vpl vpl) {
+  Projection p;
+  p.origin = vpl.position_material.xyz;
+  p.n = vpl.normal_flags.xyz;
+  orthonormal_basis(p.n, p.t, p.b);
+  p.tan_half = 0.0;
+  return p;
+}
+
+Projection towards(Vpl vpl, vec4 sphere) {
+  const vec3 to_centre = sphere.xyz - vpl.position_material.xyz;
+  const float distance = length(to_centre), radius = sphere.w;
+  if (!(radius > 0.0) || distance <= 1.05 * radius) return hemisphere(vpl);
+  Projection p;
+  p.origin = vpl.position_material.xyz;
+  p.n = to_centre / distance;
+  orthonormal_basis(p.n, p.t, p.b);
+  p.tan_half = radius / sqrt(distance * distance - radius * radius);
+  return p;
+}
+
+vec3 projection_local(Projection p, vec3 point, out float distance) {
+  const vec3 q = point - p.origin;
+  distance = length(q);
+  return vec3(dot(q, p.t), dot(q, p.b), dot(q, p.n)) / distance;
+}
+
+bool projection_texel(Projection p, vec3 d, int tile, out vec2 coordinates) {
+  if (p.tan_half == 0.0) {
+    coordinates = paraboloid_texel(d, tile);
+    return true;
+  }
+  coordinates = vec2(0.0);
+  if (d.z <= 0.0) return false;
+  coordinates = (d.xy * (1.0 / (d.z * p.tan_half)) * 0.5 + 0.5) * float(tile);
+  return all(greaterThanEqual(coordinates, vec2(0.0))) && all(lessThan(coordinates, vec2(tile)));
+}
+
+vec3 projection_direction(Projection p, vec2 coordinates, int tile) {
+  if (p.tan_half == 0.0) return paraboloid_direction(coordinates, tile);
+  return normalize(vec3((coordinates / float(tile) * 2.0 - 1.0) * p.tan_half, 1.0));
+}
+
+float texel_angle(Projection p, int tile) { return p.tan_half == 0.0 ? 4.0 / float(tile) : 2.0 * p.tan_half / float(tile); }
+
 // ism_point_index() (ism.h) in 32 bits: (vpl * 7919 + i) mod pool, exact for pools of at most
 // 2^16 points (validated on the host).
 uint ism_point_index(uint vpl, uint i, uint pool) {

@@ -58,6 +58,7 @@ layout(push_constant) uniform Params {
   uint pad;
   vec4 camera_centre;
   vec4 environment;
+  vec4 virtual_bounds;  // IsmPointPools::virtual_bounds
 } params;
 
 // phong_brdf() (phong_brdf.h).
@@ -87,7 +88,7 @@ float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
   const ShadowView view = views[index];
   const float texel = positional ? view.texel_size.x * length(towards_light) : view.texel_size.x;
   const vec3 facing = dot(normal, towards_light) < 0.0 ? -normal : normal;
-  const vec3 receiver = point + 1.5 * texel * facing;
+  const vec3 receiver = point + 0.5 * texel * facing;
   const vec4 clip = view.world_to_clip * vec4(receiver, 1.0);
   if (clip.w <= 0.0) return 1.0;
   const vec2 ndc = clip.xy / clip.w;
@@ -101,21 +102,24 @@ float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
   return depth <= stored + texel ? 1.0 : 0.0;
 }
 
-// IsmLookup (ism.h): V_r and V_v from the texel both layers share.
-vec2 ism_visibility(uint index, Vpl vpl, vec3 point) {
-  vec3 t, b;
-  const vec3 n = vpl.normal_flags.xyz;
-  orthonormal_basis(n, t, b);
-  const vec3 q = point - vpl.position_material.xyz;
-  const float distance = length(q);
-  if (!(distance > 0.0)) return vec2(1.0);
+// IsmLookup::visible (ism.h).
+float ism_visible(Projection projection, uint tile_offset, vec3 point) {
+  float distance;
+  const vec3 dir = projection_local(projection, point, distance);
+  vec2 texel;
+  if (!(distance > 0.0) || !projection_texel(projection, dir, params.ism_tile, texel)) return 1.0;
   const int tile = params.ism_tile;
-  const vec2 texel = paraboloid_texel(vec3(dot(q, t), dot(q, b), dot(q, n)) / distance, tile);
   const ivec2 xy = clamp(ivec2(floor(texel)), ivec2(0), ivec2(tile - 1));
-  const uint i = (index * uint(tile) + uint(xy.y)) * uint(tile) + uint(xy.x);
-  const float reach = distance - (0.02 + distance * 8.0 / float(tile));
-  return vec2(reach <= ism_atlas[i] ? 1.0 : 0.0,
-              reach <= ism_atlas[params.vpl_count * uint(tile * tile) + i] ? 1.0 : 0.0);
+  const float reach = distance - (0.02 + distance * 2.0 * texel_angle(projection, tile));
+  return reach <= ism_atlas[tile_offset + uint(xy.y * tile + xy.x)] ? 1.0 : 0.0;
+}
+
+// IsmLookup: V_r from the VPL's hemisphere tile, V_v from its (focused) virtual tile.
+vec2 ism_visibility(uint index, Vpl vpl, vec3 point) {
+  const uint texels = uint(params.ism_tile * params.ism_tile);
+  const float real = ism_visible(hemisphere(vpl), index * texels, point);
+  if (real == 0.0) return vec2(0.0);
+  return vec2(real, ism_visible(towards(vpl, params.virtual_bounds), (params.vpl_count + index) * texels, point));
 }
 
 void main() {

@@ -21,6 +21,8 @@ layout(push_constant) uniform Params {
   uint vpl_count;
   uint real_pool;
   uint virtual_pool;
+  uint pad0, pad1, pad2;
+  vec4 virtual_bounds;  // IsmPointPools::virtual_bounds
 } params;
 
 const int MAX_SPLAT = 16;  // kMaxSplat
@@ -34,17 +36,12 @@ void main() {
   if (pool == 0u) return;
   const Point point = points[(layer == 0u ? 0u : params.real_pool) + ism_point_index(vpl_index, slot, pool)];
   const Vpl vpl = vpls[vpl_index];
-  vec3 t, b;
-  const vec3 n = vpl.normal_flags.xyz;
-  orthonormal_basis(n, t, b);
-  const vec3 origin = vpl.position_material.xyz;
-  const vec3 q = point.position_half_size.xyz - origin;
-  const float distance = length(q);
-  if (!(distance > 1e-4)) return;
-  const vec3 centre_dir = vec3(dot(q, t), dot(q, b), dot(q, n)) / distance;
-  if (centre_dir.z <= 0.0) return;
+  const Projection projection = layer == 0u ? hemisphere(vpl) : towards(vpl, params.virtual_bounds);
+  float distance;
+  const vec3 centre_dir = projection_local(projection, point.position_half_size.xyz, distance);
+  vec2 centre;
+  if (!(distance > 1e-4) || centre_dir.z <= 0.0 || !projection_texel(projection, centre_dir, params.tile, centre)) return;
   const int tile = params.tile;
-  const vec2 centre = paraboloid_texel(centre_dir, tile);
   vec3 tp, bp;
   orthonormal_basis(point.normal.xyz, tp, bp);
   const float h = point.position_half_size.w;
@@ -52,9 +49,16 @@ void main() {
   vec2 corners[4];
   vec2 low = centre, high = centre;
   for (int k = 0; k < 4; ++k) {
-    const vec3 c = point.position_half_size.xyz + h * (signs[k].x * tp + signs[k].y * bp) - origin;
-    const float cd = length(c);
-    corners[k] = cd > 1e-4 ? paraboloid_texel(vec3(dot(c, t), dot(c, b), dot(c, n)) / cd, tile) : centre;
+    float corner_distance;
+    const vec3 dir = projection_local(projection, point.position_half_size.xyz + h * (signs[k].x * tp + signs[k].y * bp),
+                                      corner_distance);
+    if (!(corner_distance > 1e-4) || dir.z <= 1e-3) {
+      corners[k] = centre;
+    } else {
+      vec2 c;
+      projection_texel(projection, dir, tile, c);
+      corners[k] = c;
+    }
     low = min(low, corners[k]);
     high = max(high, corners[k]);
   }
@@ -67,8 +71,8 @@ void main() {
   const int y1 = min(min(tile - 1, int(floor(high.y))), y0 + MAX_SPLAT - 1);
   // Per texel: the distance along its direction to the point's tangent plane (ism.cpp: splat()).
   const vec3 pn = point.normal.xyz;
-  const vec3 plane_normal_local = vec3(dot(pn, t), dot(pn, b), dot(pn, n));
-  const float plane_offset = dot(q, pn);
+  const vec3 plane_normal_local = vec3(dot(pn, projection.t), dot(pn, projection.b), dot(pn, projection.n));
+  const float plane_offset = dot(point.position_half_size.xyz - projection.origin, pn);
   const float near = distance - 2.0 * h, far = distance + 2.0 * h;
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
@@ -80,7 +84,7 @@ void main() {
         negative = negative && e <= 0.0;
       }
       if (positive || negative) {
-        const float facing = dot(paraboloid_direction(p, tile), plane_normal_local);
+        const float facing = dot(projection_direction(projection, p, tile), plane_normal_local);
         const float along = abs(facing) > 1e-3 ? clamp(plane_offset / facing, near, far) : distance;
         atomicMin(atlas[base + uint(y * tile + x)], floatBitsToUint(max(along, 0.0)));
       }

@@ -22,9 +22,10 @@ struct Radiance {
 class MapShader {
  public:
   MapShader(const MrScene& scene, const ShadowLayout& layout, std::span<const float> shadow_atlas,
-            std::span<const Vpl> vpls, std::span<const float> ism_atlas, const DirVkOptions& options)
-      : scene_(scene), layout_(layout), shadow_atlas_(shadow_atlas), vpls_(vpls), ism_(ism_atlas, options.ism, vpls),
-        options_(options) {}
+            std::span<const Vpl> vpls, std::span<const float> ism_atlas, const Eigen::Vector4f& virtual_bounds,
+            const DirVkOptions& options)
+      : scene_(scene), layout_(layout), shadow_atlas_(shadow_atlas), vpls_(vpls),
+        ism_(ism_atlas, options.ism, vpls, virtual_bounds), options_(options) {}
 
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
                                float real_pixel, std::uint32_t subset) const {
@@ -127,14 +128,14 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
 DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene, const Vec3& camera_centre,
                                        const ShadowLayout& layout, std::span<const float> shadow_atlas,
                                        std::span<const Vpl> vpls, std::span<const float> ism_atlas,
-                                       const DirVkOptions& options) {
+                                       const Eigen::Vector4f& virtual_bounds, const DirVkOptions& options) {
   const int width = gbuffer.position.width(), height = gbuffer.position.height();
   if (shadow_atlas.size() < static_cast<std::size_t>(layout.atlas_width()) * static_cast<std::size_t>(layout.atlas_height()))
     throw Error("shade_dir_from_maps: the shadow atlas is smaller than its layout");
   const std::size_t ism_texels = 2 * vpls.size() * static_cast<std::size_t>(options.ism.tile) * static_cast<std::size_t>(options.ism.tile);
   if (ism_atlas.size() < ism_texels) throw Error("shade_dir_from_maps: the ISM atlas is smaller than its VPLs need");
   if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
-  const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, options);
+  const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, virtual_bounds, options);
   const Vec3 environment = scene.environment.radiance;
   const int n = options.interleave;
   Image<Radiance> shaded(width, height);
@@ -173,9 +174,10 @@ DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, 
   const GBuffer gbuffer = gbuffer_cpu(tracer, camera, options.shading.threads);
   const ShadowLayout layout = plan_shadow_views(scene, options.shadow_tile);
   const std::vector<float> shadow_atlas = shadow_atlas_cpu(tracer, layout, options.shading.threads);
-  const std::vector<float> ism_atlas = ism_atlas_cpu(sample_ism_points(scene, options.ism), vpls, options.ism);
+  const IsmPointPools points = sample_ism_points(scene, options.ism);
+  const std::vector<float> ism_atlas = ism_atlas_cpu(points, vpls, options.ism);
   return shade_dir_from_maps(gbuffer, scene, camera.camera_to_world.translation().cast<float>(), layout, shadow_atlas,
-                             vpls, ism_atlas, options);
+                             vpls, ism_atlas, points.virtual_bounds, options);
 }
 
 }  // namespace relight::render

@@ -28,6 +28,7 @@ struct ShadeParams {
   std::uint32_t flags, interleave, pad = 0;
   float camera_centre[4];
   float environment[4];
+  float virtual_bounds[4];
 };
 static_assert(sizeof(ShadeParams) <= 128);
 
@@ -174,7 +175,9 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
                            d.layout.columns, d.layout.rows(), options.ism.tile, options.shading.min_distance,
                            shade_flags(options), static_cast<std::uint32_t>(options.interleave), 0,
                            {centre.x(), centre.y(), centre.z(), 1.f},
-                           {environment.x(), environment.y(), environment.z(), 0.f}};
+                           {environment.x(), environment.y(), environment.z(), 0.f},
+                           {d.points.virtual_bounds.x(), d.points.virtual_bounds.y(), d.points.virtual_bounds.z(),
+                            d.points.virtual_bounds.w()}};
   const bool cpu_shading =
       options.backend == DirBackend::Cpu || (options.backend == DirBackend::Auto && d.context.is_cpu_device());
   d.context.submit([&](VkCommandBuffer cmd) {
@@ -233,7 +236,8 @@ DifferentialImages DirRendererVk::shade_on_cpu(const MrCamera& camera, std::span
   d.cpu_ism_atlas = ism_atlas_cpu(d.points, vpls, options.ism);
   const auto ism_done = Clock::now();
   DifferentialImages out = shade_dir_from_maps(last_gbuffer(), *d.scene, camera.camera_to_world.translation().cast<float>(),
-                                               d.layout, last_shadow_atlas(), vpls, d.cpu_ism_atlas, options);
+                                               d.layout, last_shadow_atlas(), vpls, d.cpu_ism_atlas,
+                                               d.points.virtual_bounds, options);
   const auto done = Clock::now();
   d.timings.ism_ms = std::chrono::duration<double, std::milli>(ism_done - start).count();
   d.timings.shading_ms = std::chrono::duration<double, std::milli>(done - ism_done).count();

@@ -72,27 +72,15 @@ std::vector<IsmPoint> sample_layer(const MrScene& scene, bool real, const IsmOpt
   return points;  // already in random order: every contiguous run is a uniform subset
 }
 
-struct VplFrame {
-  Vec3 origin, t, b, n;
-
-  explicit VplFrame(const Vpl& vpl) : origin(vpl.position), n(vpl.normal) { orthonormal_basis(n, t, b); }
-  /// Unit direction towards `p` in the frame, and the distance.
-  [[nodiscard]] Vec3 local(const Vec3& p, float& distance) const {
-    const Vec3 q = p - origin;
-    distance = q.norm();
-    return Vec3(q.dot(t), q.dot(b), q.dot(n)) / distance;
-  }
-};
-
 float edge(const Vec2& a, const Vec2& b, const Vec2& p) {
   return (b.x() - a.x()) * (p.y() - a.y()) - (b.y() - a.y()) * (p.x() - a.x());
 }
 
-void splat(const VplFrame& frame, const IsmPoint& point, int tile, float* texels) {
+void splat(const TileProjection& projection, const IsmPoint& point, int tile, float* texels) {
   float distance = 0.f;
-  const Vec3 centre_dir = frame.local(point.position, distance);
-  if (!(distance > 1e-4f) || centre_dir.z() <= 0.f) return;
-  const Vec2 centre = paraboloid_texel(centre_dir, tile);
+  const Vec3 centre_dir = projection.local(point.position, distance);
+  Vec2 centre;
+  if (!(distance > 1e-4f) || centre_dir.z() <= 0.f || !projection.texel(centre_dir, tile, centre)) return;
   Vec3 tp, bp;
   orthonormal_basis(point.normal, tp, bp);
   std::array<Vec2, 4> corners;
@@ -100,9 +88,11 @@ void splat(const VplFrame& frame, const IsmPoint& point, int tile, float* texels
   Vec2 low = centre, high = centre;
   for (std::size_t k = 0; k < 4; ++k) {
     float corner_distance = 0.f;
-    const Vec3 c = point.position + point.half_size * (signs[k][0] * tp + signs[k][1] * bp);
-    const Vec3 dir = frame.local(c, corner_distance);
-    corners[k] = corner_distance > 1e-4f ? paraboloid_texel(dir, tile) : centre;
+    const Vec3 dir = projection.local(point.position + point.half_size * (signs[k][0] * tp + signs[k][1] * bp), corner_distance);
+    // A corner behind the view keeps the centre (the quad shrinks rather than blowing up); one
+    // outside a perspective view keeps its coordinates (the texel range is clamped below).
+    if (!(corner_distance > 1e-4f) || dir.z() <= 1e-3f) corners[k] = centre;
+    else (void)projection.texel(dir, tile, corners[k]);
     low = low.cwiseMin(corners[k]);
     high = high.cwiseMax(corners[k]);
   }
@@ -115,9 +105,9 @@ void splat(const VplFrame& frame, const IsmPoint& point, int tile, float* texels
   // The splat is a piece of the point's tangent plane: each texel stores the distance along its
   // own direction to that plane (within the splat's depth range), so that a plane seen at a
   // grazing angle does not shadow itself.
-  const Vec3 to_point = point.position - frame.origin;
-  const Vec3 plane_normal_local(point.normal.dot(frame.t), point.normal.dot(frame.b), point.normal.dot(frame.n));
-  const float plane_offset = to_point.dot(point.normal);
+  const Vec3 plane_normal_local(point.normal.dot(projection.t), point.normal.dot(projection.b),
+                                point.normal.dot(projection.n));
+  const float plane_offset = (point.position - projection.origin).dot(point.normal);
   const float near = distance - 2.f * point.half_size, far = distance + 2.f * point.half_size;
   for (int y = y0; y <= y1; ++y)
     for (int x = x0; x <= x1; ++x) {
@@ -129,7 +119,7 @@ void splat(const VplFrame& frame, const IsmPoint& point, int tile, float* texels
         negative = negative && e <= 0.f;
       }
       if (positive || negative) {
-        const float facing = paraboloid_direction(p, tile).dot(plane_normal_local);
+        const float facing = projection.direction(p, tile).dot(plane_normal_local);
         const float along = std::abs(facing) > 1e-3f ? std::clamp(plane_offset / facing, near, far) : distance;
         float& texel = texels[static_cast<std::size_t>(y) * static_cast<std::size_t>(tile) + static_cast<std::size_t>(x)];
         texel = std::min(texel, std::max(along, 0.f));
@@ -137,6 +127,17 @@ void splat(const VplFrame& frame, const IsmPoint& point, int tile, float* texels
     }
   float& own = texels[static_cast<std::size_t>(cy) * static_cast<std::size_t>(tile) + static_cast<std::size_t>(cx)];
   own = std::min(own, distance);
+}
+
+/// Centre and radius of a sphere around `points` (radius 0 when there are none).
+Eigen::Vector4f bounding_sphere(const std::vector<IsmPoint>& points) {
+  Eigen::AlignedBox3f box;
+  for (const IsmPoint& p : points) box.extend(p.position);
+  if (box.isEmpty()) return Eigen::Vector4f::Zero();
+  const Vec3 c = box.center();
+  float radius = 0.f;
+  for (const IsmPoint& p : points) radius = std::max(radius, (p.position - c).norm() + p.half_size);
+  return {c.x(), c.y(), c.z(), radius * 1.01f + 1e-3f};
 }
 
 /// Pull-push over one tile (see the header).
@@ -181,7 +182,53 @@ void fill_holes(float* texels, int tile, int levels) {
 
 IsmPointPools sample_ism_points(const MrScene& scene, const IsmOptions& options) {
   validate(options);
-  return {sample_layer(scene, true, options, 1), sample_layer(scene, false, options, 2)};
+  IsmPointPools pools{sample_layer(scene, true, options, 1), sample_layer(scene, false, options, 2)};
+  if (options.focus_virtual) pools.virtual_bounds = bounding_sphere(pools.virtual_points);
+  return pools;
+}
+
+TileProjection TileProjection::hemisphere(const Vpl& vpl) {
+  TileProjection p{vpl.position, {}, {}, vpl.normal, 0.f};
+  orthonormal_basis(p.n, p.t, p.b);
+  return p;
+}
+
+TileProjection TileProjection::towards(const Vpl& vpl, const Eigen::Vector4f& sphere) {
+  const Vec3 to_centre = sphere.head<3>() - vpl.position;
+  const float distance = to_centre.norm(), radius = sphere.w();
+  if (!(radius > 0.f) || distance <= 1.05f * radius) return hemisphere(vpl);
+  TileProjection p{vpl.position, {}, {}, to_centre / distance, radius / std::sqrt(distance * distance - radius * radius)};
+  orthonormal_basis(p.n, p.t, p.b);
+  return p;
+}
+
+Vec3 TileProjection::local(const Vec3& p, float& distance) const {
+  const Vec3 q = p - origin;
+  distance = q.norm();
+  return Vec3(q.dot(t), q.dot(b), q.dot(n)) / distance;
+}
+
+bool TileProjection::texel(const Vec3& d, int tile, Vec2& coordinates) const {
+  const auto size = static_cast<float>(tile);
+  if (tan_half == 0.f) {
+    coordinates = paraboloid_texel(d, tile);
+    return true;
+  }
+  if (d.z() <= 0.f) return false;
+  const float scale = 1.f / (d.z() * tan_half);
+  coordinates = {(d.x() * scale * 0.5f + 0.5f) * size, (d.y() * scale * 0.5f + 0.5f) * size};
+  return coordinates.x() >= 0.f && coordinates.y() >= 0.f && coordinates.x() < size && coordinates.y() < size;
+}
+
+Vec3 TileProjection::direction(const Vec2& coordinates, int tile) const {
+  if (tan_half == 0.f) return paraboloid_direction(coordinates, tile);
+  const auto size = static_cast<float>(tile);
+  return Vec3((coordinates.x() / size * 2.f - 1.f) * tan_half, (coordinates.y() / size * 2.f - 1.f) * tan_half, 1.f)
+      .normalized();
+}
+
+float TileProjection::texel_angle(int tile) const {
+  return tan_half == 0.f ? 4.f / static_cast<float>(tile) : 2.f * tan_half / static_cast<float>(tile);
 }
 
 Vec3 paraboloid_direction(const Vec2& texel, int tile) {
@@ -210,9 +257,11 @@ std::vector<float> ism_atlas_cpu(const IsmPointPools& points, std::span<const Vp
       const std::vector<IsmPoint>& pool = t < static_cast<int>(vpls.size()) ? points.real : points.virtual_points;
       float* texels = atlas.data() + static_cast<std::size_t>(t) * texels_per_tile;
       if (!pool.empty()) {
-        const VplFrame frame(vpls[vpl]);
+        const bool real = t < static_cast<int>(vpls.size());
+        const TileProjection projection =
+            real ? TileProjection::hemisphere(vpls[vpl]) : TileProjection::towards(vpls[vpl], points.virtual_bounds);
         for (int i = 0; i < options.points_per_vpl; ++i)
-          splat(frame, pool[ism_point_index(vpl, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(pool.size()))], tile,
+          splat(projection, pool[ism_point_index(vpl, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(pool.size()))], tile,
                 texels);
       }
       fill_holes(texels, tile, options.pull_push_levels);
@@ -221,32 +270,38 @@ std::vector<float> ism_atlas_cpu(const IsmPointPools& points, std::span<const Vp
   return atlas;
 }
 
-IsmLookup::IsmLookup(std::span<const float> atlas, const IsmOptions& options, std::span<const Vpl> vpls)
+IsmLookup::IsmLookup(std::span<const float> atlas, const IsmOptions& options, std::span<const Vpl> vpls,
+                     const Eigen::Vector4f& virtual_bounds)
     : atlas_(atlas),
       tile_(options.tile),
       layer_stride_(vpls.size() * static_cast<std::size_t>(options.tile) * static_cast<std::size_t>(options.tile)) {
   if (atlas.size() < 2 * layer_stride_) throw Error("the ISM atlas is smaller than its VPLs need");
-  frames_.reserve(vpls.size());
+  real_.reserve(vpls.size());
+  virtual_.reserve(vpls.size());
   for (const Vpl& vpl : vpls) {
-    Frame f{vpl.position, {}, {}, vpl.normal};
-    orthonormal_basis(f.n, f.t, f.b);
-    frames_.push_back(f);
+    real_.push_back(TileProjection::hemisphere(vpl));
+    virtual_.push_back(TileProjection::towards(vpl, virtual_bounds));
   }
 }
 
-IsmLookup::Visibility IsmLookup::operator()(std::uint32_t index, const Vec3& point) const {
-  const Frame& f = frames_[index];
-  const Vec3 q = point - f.origin;
-  const float distance = q.norm();
-  if (!(distance > 0.f)) return {};
-  const Vec2 texel = paraboloid_texel(Vec3(q.dot(f.t), q.dot(f.b), q.dot(f.n)) / distance, tile_);
+float IsmLookup::visible(const TileProjection& projection, std::size_t tile_offset, const Vec3& point) const {
+  float distance = 0.f;
+  const Vec3 dir = projection.local(point, distance);
+  Vec2 texel;
+  if (!(distance > 0.f) || !projection.texel(dir, tile_, texel)) return 1.f;
   const int x = std::clamp(static_cast<int>(std::floor(texel.x())), 0, tile_ - 1);
   const int y = std::clamp(static_cast<int>(std::floor(texel.y())), 0, tile_ - 1);
-  const std::size_t i = (index * static_cast<std::size_t>(tile_) + static_cast<std::size_t>(y)) * static_cast<std::size_t>(tile_) +
-                        static_cast<std::size_t>(x);
-  // Two texels' worth of angle (a paraboloid texel spans about 4 / tile radians at the pole).
-  const float reach = distance - (0.02f + distance * 8.f / static_cast<float>(tile_));
-  return {reach <= atlas_[i] ? 1.f : 0.f, reach <= atlas_[layer_stride_ + i] ? 1.f : 0.f};
+  const std::size_t i = tile_offset + static_cast<std::size_t>(y) * static_cast<std::size_t>(tile_) + static_cast<std::size_t>(x);
+  // Two texels' worth of angle, plus 2 cm.
+  const float reach = distance - (0.02f + distance * 2.f * projection.texel_angle(tile_));
+  return reach <= atlas_[i] ? 1.f : 0.f;
+}
+
+IsmLookup::Visibility IsmLookup::operator()(std::uint32_t index, const Vec3& point) const {
+  const std::size_t offset = static_cast<std::size_t>(index) * static_cast<std::size_t>(tile_) * static_cast<std::size_t>(tile_);
+  const float real = visible(real_[index], offset, point);
+  if (real == 0.f) return {0.f, 0.f};
+  return {real, visible(virtual_[index], layer_stride_ + offset, point)};
 }
 
 }  // namespace relight::render

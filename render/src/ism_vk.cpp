@@ -19,7 +19,8 @@ constexpr std::uint32_t kGroup = 64;
 
 struct SplatParams {
   std::int32_t tile;
-  std::uint32_t points_per_vpl, vpl_count, real_pool, virtual_pool;
+  std::uint32_t points_per_vpl, vpl_count, real_pool, virtual_pool, pad[3];
+  float virtual_bounds[4];
 };
 
 struct PullPushParams {
@@ -53,6 +54,7 @@ void IsmVk::set_points(const IsmPointPools& points) {
   if (points.real.size() + points.virtual_points.size() > 2 * 65536u)
     throw Error("too many ISM points (at most 65536 per layer)");
   real_points_ = static_cast<std::uint32_t>(points.real.size());
+  virtual_bounds_ = points.virtual_bounds;
   virtual_points_ = static_cast<std::uint32_t>(points.virtual_points.size());
   points_ = std::make_unique<vk::VulkanBuffer>(context_, std::max<std::size_t>(packed.size(), 8) * sizeof(float),
                                                vk::BufferDomain::Device);
@@ -88,7 +90,8 @@ void IsmVk::record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint3
   vkCmdFillBuffer(cmd, atlas_->handle(), 0, VK_WHOLE_SIZE, std::bit_cast<std::uint32_t>(kShadowEmpty));
   vk::compute_barrier(cmd);
   const SplatParams splat{options.tile, static_cast<std::uint32_t>(options.points_per_vpl), vpl_count, real_points_,
-                          virtual_points_};
+                          virtual_points_, {0, 0, 0},
+                          {virtual_bounds_.x(), virtual_bounds_.y(), virtual_bounds_.z(), virtual_bounds_.w()}};
   splat_.dispatch(cmd, splat_set_, splat, vk::ComputePipeline::group_count(splat.points_per_vpl, kGroup), vpl_count, 2);
   vk::compute_barrier(cmd);
   const int levels = options.pull_push_levels;

@@ -29,6 +29,7 @@ class IsmVk {
   vk::ComputePipeline splat_, pull_push_;
   std::unique_ptr<vk::VulkanBuffer> points_, atlas_, pyramid_;
   std::uint32_t real_points_ = 0, virtual_points_ = 0;
+  Eigen::Vector4f virtual_bounds_ = Eigen::Vector4f::Zero();
   vk::UniqueDescriptorSet splat_set_, pull_push_set_;
 };
 

@@ -139,7 +139,8 @@ TEST_F(DirVkTest, ShadingMatchesTheCpuMirrorOnTheSameMaps) {
   const DifferentialImages gpu = renderer.render(camera, vpls, options);
   const DifferentialImages cpu =
       shade_dir_from_maps(renderer.last_gbuffer(), scene, camera.camera_to_world.translation().cast<float>(),
-                          renderer.shadow_layout(), renderer.last_shadow_atlas(), vpls, renderer.last_ism_atlas(), options);
+                          renderer.shadow_layout(), renderer.last_shadow_atlas(), vpls, renderer.last_ism_atlas(),
+                          renderer.ism_points().virtual_bounds, options);
   int close = 0, virtual_pixels = 0;
   const int pixels = 64 * 48;
   for (int i = 0; i < pixels; ++i) {

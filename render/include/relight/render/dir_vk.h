@@ -97,10 +97,12 @@ class DirRendererVk {
 [[nodiscard]] DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
                                                 const DirVkOptions& options = {});
 
-/// The shading pass on the CPU, from the same inputs as the GPU's.
+/// The shading pass on the CPU, from the same inputs as the GPU's (`virtual_bounds`: the ISM
+/// point pools' IsmPointPools::virtual_bounds).
 [[nodiscard]] DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene,
                                                      const Eigen::Vector3f& camera_centre, const ShadowLayout& layout,
                                                      std::span<const float> shadow_atlas, std::span<const Vpl> vpls,
-                                                     std::span<const float> ism_atlas, const DirVkOptions& options);
+                                                     std::span<const float> ism_atlas,
+                                                     const Eigen::Vector4f& virtual_bounds, const DirVkOptions& options);
 
 }  // namespace relight::render

@@ -15,6 +15,12 @@
 // (orthonormal_basis()); every texel centre inside the mapped quad (at most kMaxSplat texels
 // across) and the texel under the point itself keep the minimum distance VPL -> point.
 //
+// Virtual focus: the virtual objects are small, and a hemisphere of tile x tile texels gives
+// them a few texels at best, so their shadows come out blocky or vanish under the depth bias.
+// A VPL outside the virtual objects' bounding sphere therefore maps its *virtual* tile as a
+// perspective view of the cone around that sphere (every virtual point lies inside it); the
+// real tile keeps the hemisphere. Directions outside the cone see nothing virtual (V_v = 1).
+//
 // Holes: pull-push (Marroquim et al. 2007): a coarser texel averages its valid children and is
 // valid when at least two are; holes of a finer level take their parent's value. Requiring two
 // children keeps the fill from growing a lone occluder's silhouette into empty space.
@@ -40,6 +46,7 @@ struct IsmOptions {
   int points_per_vpl = 1024;   ///< per layer
   int pool_factor = 16;        ///< pool size = pool_factor * points_per_vpl per layer
   int pull_push_levels = 3;    ///< coarser levels used to fill holes (tile >> levels >= 2)
+  bool focus_virtual = true;   ///< the virtual tile looks at the virtual objects only (above)
   std::uint64_t seed = 7;
 };
 
@@ -52,6 +59,30 @@ struct IsmPoint {
 struct IsmPointPools {
   std::vector<IsmPoint> real;
   std::vector<IsmPoint> virtual_points;
+  /// Centre and radius of a sphere around every virtual point; radius 0 = none, or focus off.
+  Eigen::Vector4f virtual_bounds = Eigen::Vector4f::Zero();
+};
+
+/// How one VPL's tile maps directions: the paraboloid of the hemisphere around the VPL normal
+/// (tan_half = 0), or a perspective view of the cone of half-angle atan(tan_half) around axis n.
+struct TileProjection {
+  Eigen::Vector3f origin, t, b, n;
+  float tan_half = 0.f;
+
+  [[nodiscard]] static TileProjection hemisphere(const Vpl& vpl);
+  /// The view of `sphere` (centre, radius) from the VPL; the hemisphere when the VPL is inside
+  /// or near the sphere, or the radius is 0.
+  [[nodiscard]] static TileProjection towards(const Vpl& vpl, const Eigen::Vector4f& sphere);
+
+  /// Unit direction towards `p` in the (t, b, n) frame, and its distance.
+  [[nodiscard]] Eigen::Vector3f local(const Eigen::Vector3f& p, float& distance) const;
+  /// Texel coordinates of a local direction; for a perspective view, false when it lies
+  /// outside the view.
+  [[nodiscard]] bool texel(const Eigen::Vector3f& local_direction, int tile, Eigen::Vector2f& coordinates) const;
+  /// The local unit direction through texel coordinates.
+  [[nodiscard]] Eigen::Vector3f direction(const Eigen::Vector2f& coordinates, int tile) const;
+  /// Angle spanned by one texel at the centre of the tile (radians).
+  [[nodiscard]] float texel_angle(int tile) const;
 };
 
 /// Area-uniform points on the real and on the virtual triangles of `scene` (shuffled).
@@ -71,7 +102,8 @@ struct IsmPointPools {
 /// angular texel size.
 class IsmLookup {
  public:
-  IsmLookup(std::span<const float> atlas, const IsmOptions& options, std::span<const Vpl> vpls);
+  IsmLookup(std::span<const float> atlas, const IsmOptions& options, std::span<const Vpl> vpls,
+            const Eigen::Vector4f& virtual_bounds);
 
   struct Visibility {
     float real = 1.f;     ///< V_r
@@ -81,13 +113,12 @@ class IsmLookup {
   [[nodiscard]] Visibility operator()(std::uint32_t index, const Eigen::Vector3f& point) const;
 
  private:
-  struct Frame {
-    Eigen::Vector3f origin, t, b, n;
-  };
+  [[nodiscard]] float visible(const TileProjection& projection, std::size_t tile_offset, const Eigen::Vector3f& point) const;
+
   std::span<const float> atlas_;
   int tile_;
   std::size_t layer_stride_;
-  std::vector<Frame> frames_;
+  std::vector<TileProjection> real_, virtual_;
 };
 
 /// Texel coordinates in [0, tile) of `direction` (unit, VPL frame, z along the VPL normal).
