@@ -1,6 +1,8 @@
 // Frame-graph stages of BRDF estimation (brdf_stages.h).
 #include "relight/brdf/brdf_stages.h"
 
+#include <algorithm>
+
 #include "relight/brdf/kmeans_vk.h"
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
@@ -23,18 +25,21 @@ const char* to_string(SpecularMethod method) {
   return method == SpecularMethod::Ceres ? "ceres" : "nelder_mead";
 }
 
-void gather_points(const RadianceImage& kd, const Mask& valid, std::vector<Float3>& points,
-                   std::vector<std::uint32_t>& pixels) {
+std::size_t gather_points(const RadianceImage& kd, const Mask& valid, std::vector<Float3>& points,
+                          std::vector<std::uint32_t>& pixels) {
   if (!kd.same_shape(valid)) throw Error("brdf K-means: k_d and its validity mask differ in size");
   points.clear();
   pixels.clear();
   points.reserve(kd.size());
   pixels.reserve(kd.size());
-  for (std::size_t i = 0; i < kd.size(); ++i) {
-    if (!valid.pixels()[i]) continue;
-    points.push_back(kmeans_feature(kd.pixels()[i]));
-    pixels.push_back(static_cast<std::uint32_t>(i));
+  for (const std::uint8_t mark : {std::uint8_t{1}, std::uint8_t{2}}) {
+    for (std::size_t i = 0; i < kd.size(); ++i) {
+      if (valid.pixels()[i] != mark) continue;
+      points.push_back(kmeans_feature(kd.pixels()[i]));
+      pixels.push_back(static_cast<std::uint32_t>(i));
+    }
   }
+  return static_cast<std::size_t>(std::count(valid.pixels().begin(), valid.pixels().end(), std::uint8_t{1}));
 }
 
 Materials materials_from_clusters(const KMeansResult& result, const std::vector<std::uint32_t>& pixels, int width,
@@ -86,8 +91,8 @@ void estimate_brdf(const ColorImage& color, const PositionMap& positions, const 
   estimate_diffuse(out.cleaned, positions, normals, lights, options.diffuse, out.kd, out.kd_valid);
   std::vector<Float3> points;
   std::vector<std::uint32_t> pixels;
-  gather_points(out.kd, out.kd_valid, points, pixels);
-  const KMeansResult result = tracker.run(engine, points);
+  const std::size_t clustered = gather_points(out.kd, out.kd_valid, points, pixels);
+  const KMeansResult result = tracker.run(engine, points, clustered);
   out.materials = materials_from_clusters(result, pixels, color.width(), color.height());
   fit_materials(color, &out.highlights, positions, normals, lights, options, solver, out.materials);
 }
@@ -152,9 +157,9 @@ void KMeansStage::declare(StageBuilder& builder) {
 
 void KMeansStage::run(StageContext& context) {
   const RadianceImage& kd = context.get(kd_);
-  gather_points(kd, context.get(valid_), points_, pixels_);
+  const std::size_t clustered = gather_points(kd, context.get(valid_), points_, pixels_);
   if (auto* gpu = dynamic_cast<KMeansVk*>(engine_.get())) gpu->reset_gpu_ms();
-  result_ = tracker_.run(*engine_, points_);
+  result_ = tracker_.run(*engine_, points_, clustered);
   if (auto* gpu = dynamic_cast<KMeansVk*>(engine_.get()); gpu && gpu->gpu_ms()) context.report_device_ms(*gpu->gpu_ms());
   context.get(clusters_) = materials_from_clusters(result_, pixels_, kd.width(), kd.height());
 }

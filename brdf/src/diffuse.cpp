@@ -20,7 +20,10 @@ float luminance(const Eigen::Vector3f& v) { return 0.2126f * v.x() + 0.7152f * v
 class RowShading {
  public:
   explicit RowShading(int width) {
-    for (Eigen::ArrayXf* a : {&px_, &py_, &pz_, &nx_, &ny_, &nz_, &dx_, &dy_, &dz_, &scale_, &cosine_}) a->resize(width);
+    for (Eigen::ArrayXf* a : {&px_, &py_, &pz_, &nx_, &ny_, &nz_, &dx_, &dy_, &dz_, &scale_, &cosine_, &n_dot_v_,
+                              &inv_view_, &mirror_, &inv_d_, &l_dot_v_}) {
+      a->resize(width);
+    }
     for (Eigen::ArrayXf& d : shading_) d.resize(width);
   }
 
@@ -36,18 +39,30 @@ class RowShading {
     }
     constexpr float inv_pi = std::numbers::inv_pi_v<float>;
     for (int c = 0; c < 3; ++c) shading_[static_cast<std::size_t>(c)].setConstant(lights.ambient[c]);
+    // omega_o = -p / |p|: <omega_o . r_l> = 2 <n.l> <n.omega_o> - <l.omega_o>.
+    inv_view_ = (px_.square() + py_.square() + pz_.square()).sqrt().inverse();
+    n_dot_v_ = -(nx_ * px_ + ny_ * py_ + nz_ * pz_) * inv_view_;
+    mirror_.setConstant(-1.f);
     for (const ShadingLight& light : lights.lights) {
       if (light.point) {
         dx_ = light.vector.x() - px_;
         dy_ = light.vector.y() - py_;
         dz_ = light.vector.z() - pz_;
         scale_ = dx_.square() + dy_.square() + dz_.square();  // d^2
-        cosine_ = (nx_ * dx_ + ny_ * dy_ + nz_ * dz_) / scale_.sqrt();
+        inv_d_ = scale_.sqrt().inverse();
+        dx_ *= inv_d_;
+        dy_ *= inv_d_;
+        dz_ *= inv_d_;
         scale_ = scale_.inverse();
       } else {
-        cosine_ = nx_ * light.vector.x() + ny_ * light.vector.y() + nz_ * light.vector.z();
+        dx_.setConstant(light.vector.x());
+        dy_.setConstant(light.vector.y());
+        dz_.setConstant(light.vector.z());
         scale_.setOnes();
       }
+      cosine_ = nx_ * dx_ + ny_ * dy_ + nz_ * dz_;
+      l_dot_v_ = -(dx_ * px_ + dy_ * py_ + dz_ * pz_) * inv_view_;
+      mirror_ = (cosine_ > 0.f).select(mirror_.max(2.f * cosine_ * n_dot_v_ - l_dot_v_), mirror_);
       scale_ = (cosine_ > 0.f).select(scale_ * cosine_ * inv_pi, 0.f);
       for (int c = 0; c < 3; ++c) shading_[static_cast<std::size_t>(c)] += light.power[c] * scale_;
     }
@@ -56,9 +71,12 @@ class RowShading {
   [[nodiscard]] Eigen::Vector3f at(int column) const {
     return {shading_[0][column], shading_[1][column], shading_[2][column]};
   }
+  /// The largest <omega_o . r_l> over the lights facing the pixel (-1 when none does).
+  [[nodiscard]] float mirror(int column) const { return mirror_[column]; }
 
  private:
-  Eigen::ArrayXf px_, py_, pz_, nx_, ny_, nz_, dx_, dy_, dz_, scale_, cosine_;
+  Eigen::ArrayXf px_, py_, pz_, nx_, ny_, nz_, dx_, dy_, dz_, scale_, cosine_, n_dot_v_, inv_view_, mirror_, inv_d_,
+      l_dot_v_;
   std::array<Eigen::ArrayXf, 3> shading_;
 };
 
@@ -85,7 +103,7 @@ void estimate(int width, int height, Linear&& linear_at, const PositionMap& posi
         if (luminance(d) < options.min_shading || d.minCoeff() <= 0.f) continue;
         const Eigen::Vector3f k = colour.cwiseQuotient(d).cwiseMax(0.f).cwiseMin(options.max_kd);
         kd(r, c) = {k.x(), k.y(), k.z()};
-        valid(r, c) = 1;
+        valid(r, c) = shading.mirror(c) > options.lobe_cos_min ? 2 : 1;
       }
     }
   }, 8);

@@ -277,15 +277,21 @@ KMeansResult kmeans(KMeansEngine& engine, std::span<const Float3> points, const 
 }
 
 KMeansResult KMeansTracker::run(KMeansEngine& engine, std::span<const Float3> points) {
+  return run(engine, points, points.size());
+}
+
+KMeansResult KMeansTracker::run(KMeansEngine& engine, std::span<const Float3> points, std::size_t clustered) {
   last_warm_ = last_random_ = false;
   KMeansResult best;
+  if (clustered == 0 || clustered > points.size()) clustered = points.size();
   if (points.empty()) {
     best.centres.assign(static_cast<std::size_t>(options_.clusters), Eigen::Vector3f::Zero());
     best.converged = true;
     ++frame_;
     return best;
   }
-  engine.set_points(points);
+  const std::span<const Float3> fit = points.first(clustered);
+  engine.set_points(fit);
   bool have = false;
   if (previous_ && static_cast<int>(previous_->size()) == options_.clusters) {
     best = lloyd(engine, *previous_, options_);
@@ -293,13 +299,68 @@ KMeansResult KMeansTracker::run(KMeansEngine& engine, std::span<const Float3> po
     last_warm_ = true;
   }
   if (!have || !best.converged || (random_every_ > 0 && frame_ % random_every_ == 0)) {
-    KMeansResult fresh = lloyd(engine, kmeans_pp_centres(points, options_.clusters, rng_), options_);
+    KMeansResult fresh = lloyd(engine, kmeans_pp_centres(fit, options_.clusters, rng_), options_);
     last_random_ = true;
     if (!have || fresh.compactness < best.compactness) best = std::move(fresh);
   }
+  double variance = assign_all(engine, points, clustered, best);
+  separate_merged_centres(engine, points, clustered, best, variance);
   previous_ = best.centres;
   ++frame_;
   return best;
+}
+
+double KMeansTracker::assign_all(KMeansEngine& engine, std::span<const Float3> points, std::size_t clustered,
+                                 KMeansResult& result) const {
+  if (clustered == points.size()) return result.compactness;
+  engine.set_points(points);
+  const double variance = engine.step(result.centres).total_variance();
+  engine.read_labels(result.labels);
+  return variance;
+}
+
+void KMeansTracker::separate_merged_centres(KMeansEngine& engine, std::span<const Float3> points,
+                                            std::size_t clustered, KMeansResult& result, double variance) const {
+  const auto squared = [](const Eigen::Vector3f& a, const Float3& p) {
+    const float dx = p.x - a.x(), dy = p.y - a.y(), dz = p.z - a.z();
+    return dx * dx + dy * dy + dz * dz;
+  };
+  const double merge2 = static_cast<double>(options_.merge_distance) * options_.merge_distance;
+  for (int round = 0; round + 1 < options_.clusters; ++round) {
+    // The closest pair of centres; nothing to do when every pair is farther than merge_distance.
+    std::size_t a = 0, b = 0;
+    double closest = merge2;
+    for (std::size_t i = 0; i < result.centres.size(); ++i) {
+      for (std::size_t j = i + 1; j < result.centres.size(); ++j) {
+        const double d = (result.centres[i] - result.centres[j]).squaredNorm();
+        if (d < closest) {
+          closest = d;
+          a = i;
+          b = j;
+        }
+      }
+    }
+    if (a == b) return;
+    // b moves to the point worst represented by its centre (among all points: a material seen
+    // only where the clustering leaves pixels out still gets its centre).
+    std::size_t farthest = 0;
+    float worst = -1.f;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      const float d = squared(result.centres[result.labels[i]], points[i]);
+      if (d > worst) {
+        worst = d;
+        farthest = i;
+      }
+    }
+    std::vector<Eigen::Vector3f> centres = result.centres;
+    centres[b] = Eigen::Vector3f(points[farthest].x, points[farthest].y, points[farthest].z);
+    if (clustered < points.size()) engine.set_points(points.first(clustered));
+    KMeansResult moved = lloyd(engine, std::move(centres), options_);
+    const double moved_variance = assign_all(engine, points, clustered, moved);
+    if (!(moved_variance < variance)) return;
+    result = std::move(moved);
+    variance = moved_variance;
+  }
 }
 
 double adjusted_rand_index(std::span<const int> a, std::span<const int> b) {

@@ -21,6 +21,7 @@ struct SceneClusters {
   std::vector<int> truth;        ///< albedo class per point
   std::vector<Float3> albedo;    ///< true k_d per point
   std::vector<std::uint8_t> lit; ///< 1 where no light is shadowed
+  std::size_t clustered = 0;     ///< the first points, marked 1 by the diffuse stage (the rest 2)
 };
 
 // Materials with the same albedo (floor/table wood, wall/tag white) cannot be told apart from
@@ -44,12 +45,16 @@ SceneClusters scene_points(const ColorImage& color, bool lit_only = false) {
   RadianceImage kd;
   estimate_diffuse(cleaned, s.positions, s.truth.normals, s.lights, {}, kd, valid);
   SceneClusters out;
-  for (std::size_t i = 0; i < kd.size(); ++i) {
-    if (!valid.pixels()[i] || (lit_only && s.shadowed.pixels()[i])) continue;
-    out.points.push_back(kmeans_feature(kd.pixels()[i]));
-    out.truth.push_back(albedo_class(s.scene, s.truth.material.pixels()[i]));
-    out.albedo.push_back(s.truth.albedo.pixels()[i]);
-    out.lit.push_back(s.shadowed.pixels()[i] ? 0 : 1);
+  // In the order of gather_points(): the pixels K-means clusters, then those it only assigns.
+  for (const std::uint8_t mark : {std::uint8_t{1}, std::uint8_t{2}}) {
+    for (std::size_t i = 0; i < kd.size(); ++i) {
+      if (valid.pixels()[i] != mark || (lit_only && s.shadowed.pixels()[i])) continue;
+      out.points.push_back(kmeans_feature(kd.pixels()[i]));
+      out.truth.push_back(albedo_class(s.scene, s.truth.material.pixels()[i]));
+      out.albedo.push_back(s.truth.albedo.pixels()[i]);
+      out.lit.push_back(s.shadowed.pixels()[i] ? 0 : 1);
+    }
+    if (mark == 1) out.clustered = out.points.size();
   }
   return out;
 }
@@ -106,16 +111,17 @@ TEST(KMeans, SyntheticClusterMapMatchesTheMaterialsAndCentresTheAlbedos) {
   const SceneClusters data = scene_points(test::brdf_scene().color, true);
   KMeansCpu cpu;
   KMeansTracker tracker;
-  const KMeansResult r = tracker.run(cpu, data.points);
+  const KMeansResult r = tracker.run(cpu, data.points, data.clustered);
   EXPECT_FALSE(tracker.last_used_warm_start());
   EXPECT_TRUE(tracker.last_ran_random());
   const double ari = adjusted_rand_index(as_int(r.labels), data.truth);
-  std::printf("kmeans: %zu points, ARI %.4f, %d iterations, compactness %.3f\n", data.points.size(), ari, r.iterations,
-              r.compactness);
-  // Issue goal 0.9; measured 0.885. What keeps it below: the table's broad specular sheen
-  // (k_s 0.15, n 20) is not white enough to be removed as a highlight, raises k_d by ~0.1 and
-  // takes a cluster of its own, so two of the small objects' classes have to share one.
-  EXPECT_GE(ari, 0.85);
+  std::printf("kmeans: %zu points (%zu clustered), ARI %.4f, %d iterations, compactness %.3f\n", data.points.size(),
+              data.clustered, ari, r.iterations, r.compactness);
+  // Issue goal 0.9; measured 0.950. Without leaving the pixels inside the lights' mirror cones
+  // out of the clustering (diffuse.h) and separating merged centres (kmeans.h) it was 0.885:
+  // the table's sheen (k_s 0.15, n 20) took a cluster of its own and the yellow object had none.
+  EXPECT_GE(ari, 0.9);
+  EXPECT_LT(data.clustered, data.points.size());
   int accurate = 0;
   // Each cluster's centre against the albedo of its majority class, over directly lit pixels.
   for (std::size_t k = 0; k < r.centres.size(); ++k) {
@@ -133,13 +139,13 @@ TEST(KMeans, SyntheticClusterMapMatchesTheMaterialsAndCentresTheAlbedos) {
                 r.centres[k].z(), test::brdf_scene().scene.materials[static_cast<std::size_t>(majority->first)].name.c_str(),
                 error);
   }
-  EXPECT_GE(accurate, 4);  // measured 5 of 6 (all but the sheen cluster)
+  EXPECT_EQ(accurate, 6);  // measured: every centre within 0.003 of its albedo
   // Frame 2 starts warm; frame 5 (index 5) runs from seeds as well.
-  (void)tracker.run(cpu, data.points);
+  (void)tracker.run(cpu, data.points, data.clustered);
   EXPECT_TRUE(tracker.last_used_warm_start());
   EXPECT_FALSE(tracker.last_ran_random());
-  for (int f = 2; f < 5; ++f) (void)tracker.run(cpu, data.points);
-  const KMeansResult fifth = tracker.run(cpu, data.points);
+  for (int f = 2; f < 5; ++f) (void)tracker.run(cpu, data.points, data.clustered);
+  const KMeansResult fifth = tracker.run(cpu, data.points, data.clustered);
   EXPECT_TRUE(tracker.last_used_warm_start());
   EXPECT_TRUE(tracker.last_ran_random());
   EXPECT_LE(fifth.compactness, r.compactness * (1 + 1e-9));
@@ -154,20 +160,20 @@ TEST(KMeans, ReportsTheAdjustedRandIndexWithColourNoise) {
   const SceneClusters data = scene_points(noisy, true);
   KMeansCpu cpu;
   KMeansTracker tracker;
-  const KMeansResult r = tracker.run(cpu, data.points);
+  const KMeansResult r = tracker.run(cpu, data.points, data.clustered);
   const double ari = adjusted_rand_index(as_int(r.labels), data.truth);
   std::printf("kmeans: colour noise sigma 2/255: ARI %.4f\n", ari);
-  EXPECT_GE(ari, 0.85);
+  EXPECT_GE(ari, 0.9);  // measured 0.950
 }
 
 TEST(KMeans, ReportsTheAdjustedRandIndexWithShadows) {
   const SceneClusters data = scene_points(test::brdf_scene().color);
   KMeansCpu cpu;
   KMeansTracker tracker;
-  const KMeansResult r = tracker.run(cpu, data.points);
+  const KMeansResult r = tracker.run(cpu, data.points, data.clustered);
   const double ari = adjusted_rand_index(as_int(r.labels), data.truth);
   std::printf("kmeans: shadowed pixels included: ARI %.4f\n", ari);
-  EXPECT_GE(ari, 0.6);
+  EXPECT_GE(ari, 0.65);  // measured 0.731
 }
 
 }  // namespace

@@ -6,7 +6,8 @@
 //   diffuse            reads "color_diffuse", PositionMap "positions", NormalMap "normals",
 //                      LightSet "lights", FrameInfo "frame" (camera_to_world; identity when unknown)
 //                      writes RadianceImage "kd", Mask "kd_valid"
-//   kmeans (CPU|Vulkan) reads "kd", "kd_valid"; writes Materials "clusters" (centres as k_d,
+//   kmeans (CPU|Vulkan) reads "kd", "kd_valid" (clusters the pixels marked 1, assigns those
+//                      marked 2); writes Materials "clusters" (centres as k_d,
 //                      k_s = 0, ids = cluster + 1 on valid pixels); warm-started from its own
 //                      previous result (KMeansTracker)
 //   specular_fit       reads "clusters", "color", "highlight_mask", "positions", "normals",
@@ -171,9 +172,11 @@ void fit_materials(const ColorImage& color, const Mask* highlights, const Positi
 [[nodiscard]] Materials materials_from_clusters(const KMeansResult& result, const std::vector<std::uint32_t>& pixels,
                                                 int width, int height);
 
-/// Gathers the K-means points (clamped k_d of valid pixels) and their pixel indices.
-void gather_points(const RadianceImage& kd, const Mask& valid, std::vector<Float3>& points,
-                   std::vector<std::uint32_t>& pixels);
+/// Gathers the K-means points (clamped k_d of valid pixels) and their pixel indices: first the
+/// pixels marked 1 (clustered), then those marked 2 (only assigned, diffuse.h); returns how many
+/// are clustered.
+std::size_t gather_points(const RadianceImage& kd, const Mask& valid, std::vector<Float3>& points,
+                          std::vector<std::uint32_t>& pixels);
 
 /// Phong re-render of the estimated materials (camera frame), black where ids is 0.
 [[nodiscard]] RadianceImage render_materials(const Materials& materials, const PositionMap& positions,

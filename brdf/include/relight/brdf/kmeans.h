@@ -31,6 +31,8 @@ struct KMeansOptions {
   int max_iterations = 20;
   double epsilon = 1e-4;     ///< relative change of the total variance that counts as converged
   int threads = 0;           ///< CPU threads (0 = worker_count(0))
+  /// KMeansTracker: centres closer than this (Euclidean, k_d units) describe one material.
+  float merge_distance = 0.05f;
 };
 
 struct KMeansResult {
@@ -103,12 +105,22 @@ class KMeansCpu final : public KMeansEngine {
 /// The per-frame policy of the issue: a warm start from the previous frame's centres; when that
 /// does not converge, and on every `random_every`-th frame regardless, also a run from k-means++
 /// seeds, keeping the lower compactness. The first frame (or after reset) runs from seeds only.
+///
+/// Then, as in ISODATA's merge step, two centres closer than merge_distance count as one
+/// material split in two (a glossy surface's residual sheen, or shading error, spreads its k_d
+/// along a line; Lloyd minimises the total variance by spending a cluster on that spread rather
+/// than on a small object of another colour): one of them moves to the point farthest from its
+/// centre and Lloyd runs again, kept while the compactness drops (at most K - 1 times).
 class KMeansTracker {
  public:
   explicit KMeansTracker(KMeansOptions options = {}, std::uint64_t seed = 1, int random_every = 5)
       : options_(options), rng_(seed), random_every_(random_every) {}
   /// Clusters this frame's points (clamped features).
   [[nodiscard]] KMeansResult run(KMeansEngine& engine, std::span<const Float3> points);
+  /// Clusters the first `clustered` points and then assigns every point to the nearest of the
+  /// resulting centres (one more step on all points): the labels cover all points, the
+  /// compactness is the clustering's. `clustered` 0 or all: run(engine, points).
+  [[nodiscard]] KMeansResult run(KMeansEngine& engine, std::span<const Float3> points, std::size_t clustered);
   void reset() { previous_.reset(); frame_ = 0; }
   [[nodiscard]] const KMeansOptions& options() const { return options_; }
   /// What the last run() did, for tests and reports.
@@ -116,6 +128,13 @@ class KMeansTracker {
   [[nodiscard]] bool last_ran_random() const { return last_random_; }
 
  private:
+  /// Labels of all points for `result`'s centres (one step when some points were not clustered);
+  /// returns the total variance of all points.
+  double assign_all(KMeansEngine& engine, std::span<const Float3> points, std::size_t clustered,
+                    KMeansResult& result) const;
+  void separate_merged_centres(KMeansEngine& engine, std::span<const Float3> points, std::size_t clustered,
+                               KMeansResult& result, double variance) const;
+
   KMeansOptions options_;
   std::mt19937_64 rng_;
   int random_every_;
