@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <numbers>
 
 namespace relight::brdf::detail {
@@ -13,6 +14,9 @@ namespace {
 constexpr double kInvPi = std::numbers::inv_pi;
 // <omega_o . r_l> at or below this counts as no lobe (as in model_radiance).
 constexpr double kMinRv = 1e-12;
+// exp(n g) below exp(-46) ~ 1e-20: a sample whose every lobe is that small for the current n
+// contributes its observation alone (the lobes change F by less than double rounding).
+constexpr double kNegligibleExponent = -46.0;
 
 Eigen::ArrayXf coordinate(const std::vector<SpecularSample>& samples, int axis, Eigen::Vector3f SpecularSample::*field) {
   Eigen::ArrayXf out(static_cast<Eigen::Index>(samples.size()));
@@ -57,40 +61,86 @@ ShapeTerms::ShapeTerms(const SpecularProblem& problem, const ShadingLights& ligh
       base_[static_cast<std::size_t>(c)][i] = double(s.radiance[c]) - double(problem.kd[c]) * diffuse[c];
     }
   }
+  sort_by_lobe();
 }
 
-void ShapeTerms::lobe_sums(double n, std::array<Eigen::ArrayXd, 3>& sums, std::array<Eigen::ArrayXd, 3>* slope) const {
-  for (Eigen::ArrayXd& s : sums) s.setZero(samples());
+void ShapeTerms::sort_by_lobe() {
+  const Eigen::Index count = samples();
+  std::vector<double> widest(static_cast<std::size_t>(count), -std::numeric_limits<double>::infinity());
+  for (const Lobe& lobe : lobes_) {
+    for (Eigen::Index i = 0; i < count; ++i) {
+      if (lobe.irradiance[0][i] != 0.0 || lobe.irradiance[1][i] != 0.0 || lobe.irradiance[2][i] != 0.0) {
+        widest[static_cast<std::size_t>(i)] = std::max(widest[static_cast<std::size_t>(i)], lobe.log_rv[i]);
+      }
+    }
+  }
+  std::vector<Eigen::Index> order(static_cast<std::size_t>(count));
+  std::iota(order.begin(), order.end(), Eigen::Index{0});
+  std::stable_sort(order.begin(), order.end(), [&](Eigen::Index a, Eigen::Index b) {
+    return widest[static_cast<std::size_t>(a)] > widest[static_cast<std::size_t>(b)];
+  });
+  auto permute = [&](Eigen::ArrayXd& a) {
+    Eigen::ArrayXd sorted(count);
+    for (Eigen::Index i = 0; i < count; ++i) sorted[i] = a[order[static_cast<std::size_t>(i)]];
+    a.swap(sorted);
+  };
+  for (Eigen::ArrayXd& b : base_) permute(b);
+  for (Lobe& lobe : lobes_) {
+    for (Eigen::ArrayXd& e : lobe.irradiance) permute(e);
+    permute(lobe.log_rv);
+  }
+  widest_.resize(static_cast<std::size_t>(count));
+  for (Eigen::Index i = 0; i < count; ++i) widest_[static_cast<std::size_t>(i)] = widest[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+  tail_bb_.assign(static_cast<std::size_t>(count) + 1, 0.0);
+  for (Eigen::Index i = count - 1; i >= 0; --i) {
+    double bb = 0.0;
+    for (const Eigen::ArrayXd& b : base_) bb += b[i] * b[i];
+    tail_bb_[static_cast<std::size_t>(i)] = tail_bb_[static_cast<std::size_t>(i) + 1] + bb;
+  }
+}
+
+Eigen::Index ShapeTerms::lit_samples(double n) const {
+  const double threshold = kNegligibleExponent / n;
+  return static_cast<Eigen::Index>(std::partition_point(widest_.begin(), widest_.end(),
+                                                        [&](double g) { return g >= threshold; }) -
+                                   widest_.begin());
+}
+
+void ShapeTerms::lobe_sums(double n, Eigen::Index lit, std::array<Eigen::ArrayXd, 3>& sums,
+                           std::array<Eigen::ArrayXd, 3>* slope) const {
+  for (Eigen::ArrayXd& s : sums) s.setZero(lit);
   if (slope) {
-    for (Eigen::ArrayXd& s : *slope) s.setZero(samples());
+    for (Eigen::ArrayXd& s : *slope) s.setZero(lit);
   }
   Eigen::ArrayXd lobe;
   for (const Lobe& l : lobes_) {
-    lobe = (n * l.log_rv).exp();
+    lobe = (n * l.log_rv.head(lit)).exp();
     for (std::size_t c = 0; c < 3; ++c) {
-      sums[c] += l.irradiance[c] * lobe;
-      if (slope) (*slope)[c] += l.irradiance[c] * l.log_rv * lobe;
+      sums[c] += l.irradiance[c].head(lit) * lobe;
+      if (slope) (*slope)[c] += l.irradiance[c].head(lit) * l.log_rv.head(lit) * lobe;
     }
   }
 }
 
 double ShapeTerms::objective(double ks, double n) const {
+  const Eigen::Index lit = lit_samples(n);
   std::array<Eigen::ArrayXd, 3> sums;
-  lobe_sums(n, sums, nullptr);
+  lobe_sums(n, lit, sums, nullptr);
   const double scale = ks * (n + 2.0) * 0.5 * kInvPi;
-  double f = 0.0;
-  for (std::size_t c = 0; c < 3; ++c) f += (base_[c] - scale * sums[c]).square().sum();
+  double f = tail_bb_[static_cast<std::size_t>(lit)];
+  for (std::size_t c = 0; c < 3; ++c) f += (base_[c].head(lit) - scale * sums[c]).square().sum();
   return f;
 }
 
 ShapeTerms::Projected ShapeTerms::best_ks(double n, double ks_max) const {
+  const Eigen::Index lit = lit_samples(n);
   std::array<Eigen::ArrayXd, 3> sums;
-  lobe_sums(n, sums, nullptr);
+  lobe_sums(n, lit, sums, nullptr);
   const double lobe_scale = (n + 2.0) * 0.5 * kInvPi;
-  double bb = 0.0, bt = 0.0, tt = 0.0;
+  const double bb = tail_bb_[0];
+  double bt = 0.0, tt = 0.0;
   for (std::size_t c = 0; c < 3; ++c) {
-    bb += base_[c].square().sum();
-    bt += lobe_scale * (base_[c] * sums[c]).sum();
+    bt += lobe_scale * (base_[c].head(lit) * sums[c]).sum();
     tt += lobe_scale * lobe_scale * sums[c].square().sum();
   }
   const double ks = tt > 0.0 ? std::clamp(bt / tt, 0.0, ks_max) : 0.0;
@@ -98,18 +148,21 @@ ShapeTerms::Projected ShapeTerms::best_ks(double n, double ks_max) const {
 }
 
 void ShapeTerms::residuals(double ks, double n, double* residuals, double* jacobian) const {
+  const Eigen::Index lit = lit_samples(n), count = samples();
   std::array<Eigen::ArrayXd, 3> sums, slope;
-  lobe_sums(n, sums, jacobian ? &slope : nullptr);
+  lobe_sums(n, lit, sums, jacobian ? &slope : nullptr);
   const double lobe_scale = (n + 2.0) * 0.5 * kInvPi;
-  const Eigen::Index count = samples();
   for (std::size_t c = 0; c < 3; ++c) {
     Eigen::Map<Eigen::ArrayXd, 0, Eigen::InnerStride<3>> r(residuals + c, count);
-    r = base_[c] - ks * lobe_scale * sums[c];
+    r.head(lit) = base_[c].head(lit) - ks * lobe_scale * sums[c];
+    r.tail(count - lit) = base_[c].tail(count - lit);
     if (!jacobian) continue;
     Eigen::Map<Eigen::ArrayXd, 0, Eigen::InnerStride<6>> d_ks(jacobian + 2 * c, count);
     Eigen::Map<Eigen::ArrayXd, 0, Eigen::InnerStride<6>> d_n(jacobian + 2 * c + 1, count);
-    d_ks = -lobe_scale * sums[c];
-    d_n = -ks * (0.5 * kInvPi * sums[c] + lobe_scale * slope[c]);
+    d_ks.head(lit) = -lobe_scale * sums[c];
+    d_n.head(lit) = -ks * (0.5 * kInvPi * sums[c] + lobe_scale * slope[c]);
+    d_ks.tail(count - lit).setZero();
+    d_n.tail(count - lit).setZero();
   }
 }
 

@@ -13,7 +13,9 @@
 //
 // with b the observation minus the diffuse part. F(k_s, n) costs one exp per sample and light,
 // and for fixed n the best k_s is a linear least-squares solution (variable projection), which
-// gives the solvers a starting point close to the optimum.
+// gives the solvers a starting point close to the optimum. The samples are kept ordered by
+// their widest lobe, so that an evaluation at exponent n touches only the prefix whose lobes are
+// not negligible (exp(n g) > 1e-20): glossy exponents skip most samples.
 //
 // FullModel: every parameter free (lights moved by offsets), for the light phase. It works in
 // float (four samples per SSE packet instead of two): the light phase only needs to find where
@@ -49,11 +51,20 @@ class ShapeTerms {
     std::array<Eigen::ArrayXd, 3> irradiance;
     Eigen::ArrayXd log_rv;
   };
-  /// sum_l E_l,c exp(n g_l) per channel (and sum_l E_l,c g_l exp(n g_l) when `slope`).
-  void lobe_sums(double n, std::array<Eigen::ArrayXd, 3>& sums, std::array<Eigen::ArrayXd, 3>* slope) const;
+  /// Orders the samples by their widest lobe (largest g_l), widest first, and sums b^2 over
+  /// every tail of that order.
+  void sort_by_lobe();
+  /// How many samples (a prefix of that order) have a lobe that is not negligible at exponent n.
+  [[nodiscard]] Eigen::Index lit_samples(double n) const;
+  /// sum_l E_l,c exp(n g_l) per channel (and sum_l E_l,c g_l exp(n g_l) when `slope`) of the
+  /// first `lit` samples.
+  void lobe_sums(double n, Eigen::Index lit, std::array<Eigen::ArrayXd, 3>& sums,
+                 std::array<Eigen::ArrayXd, 3>* slope) const;
 
   std::array<Eigen::ArrayXd, 3> base_;
   std::vector<Lobe> lobes_;
+  std::vector<double> widest_;  // per sample (sorted, descending): the largest g_l of a lobe
+  std::vector<double> tail_bb_;  // sum of b^2 over samples i.. of the sorted order
 };
 
 /// The lights with the first `moving` moved by offsets[3 l .. 3 l + 2] (null: none moved).
