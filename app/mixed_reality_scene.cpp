@@ -8,8 +8,8 @@
 #include "relight/core/error.h"
 #include "relight/lights/light_output.h"
 #include "relight/render/model_io.h"
-#include "relight/render/scene_from_synth.h"
-#include "relight/render/scene_lights.h"
+#include "relight/core/image_io.h"
+#include "relight/lights/light_stages.h"
 
 namespace relight::app {
 
@@ -44,17 +44,22 @@ render::MrLight parse_virtual_light(const std::string& text) {
   return light;
 }
 
-std::vector<render::MrLight> real_lights(bool synthetic, const fs::path& sequence, const fs::path& lights_file) {
-  if (synthetic) {
-    if (!lights_file.empty())
-      throw Error("--lights applies to recorded sequences; a synthetic sequence brings its own lights");
-    return render::scene_from_synth(synth::default_indoor_scene()).lights;
+LightSet real_light_set(bool synthetic, const fs::path& sequence, const fs::path& lights_file) {
+  if (!lights_file.empty()) return lights_from_json(read_text_file(lights_file), lights_file.string());
+  const fs::path probe = sequence / "probe.hdr";
+  if (!synthetic || !fs::is_regular_file(probe))
+    throw Error(sequence.string() + " has no light probe: give its lights with --lights FILE (from `relight lights`)");
+  // The product's own path: lights importance-sampled from the sequence's probe (sky, walls and
+  // the lamps as directional lights), as `relight lights PROBE --n 16` would give.
+  const RadianceImage image = read_radiance(probe);
+  LightExtractionOptions options;
+  options.lights = 16;
+  options.calibration = ProbeCalibration::centred_fisheye(image.width(), image.height());
+  try {
+    return extract_lights(image, options);
+  } catch (const Error& error) {
+    throw Error(probe.string() + ": " + error.what());
   }
-  if (lights_file.empty())
-    throw Error(sequence.string() + " is a recorded sequence: give its lights with --lights FILE (from `relight lights`)");
-  render::MrScene scene;
-  render::add_lights(scene, lights_from_json(read_text_file(lights_file), lights_file.string()));
-  return scene.lights;
 }
 
 std::vector<std::pair<render::VirtualModel, render::Placement>> virtual_objects(const std::vector<fs::path>& objects,

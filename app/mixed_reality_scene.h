@@ -7,6 +7,7 @@
 #include <utility>
 #include <vector>
 
+#include "relight/lights/light_set.h"
 #include "relight/render/mr_scene.h"
 #include "relight/render/virtual_model.h"
 
@@ -22,11 +23,11 @@ inline constexpr const char* kDefaultSynthPlacement = "0.35,-0.2,0.75,30";
 /// "x,y,z,intensity[,r,g,b]": a virtual point light of radiant intensity intensity * (r,g,b) W/sr.
 [[nodiscard]] render::MrLight parse_virtual_light(const std::string& text);
 
-/// The real lights: a synthetic sequence's own (the default indoor scene's), or those of the
-/// lights JSON of `relight lights` for a recorded one. Throws relight::Error when a recorded
-/// sequence has no lights file, or a synthetic one is given one.
-[[nodiscard]] std::vector<render::MrLight> real_lights(bool synthetic, const std::filesystem::path& sequence,
-                                                       const std::filesystem::path& lights_file);
+/// The measured lights of a sequence: the lights JSON of `relight lights` when given, else for a
+/// synthetic sequence 16 lights extracted from its probe.hdr. Throws relight::Error when there
+/// is neither.
+[[nodiscard]] LightSet real_light_set(bool synthetic, const std::filesystem::path& sequence,
+                                      const std::filesystem::path& lights_file);
 
 /// Loads each object and pairs it with its placement: one --place per object, or none on a
 /// synthetic sequence (every object then goes to kDefaultSynthPlacement).

@@ -20,6 +20,7 @@
 #include "relight/render/model_io.h"
 #include "relight/render/procedural_models.h"
 #include "relight/render/scene_from_synth.h"
+#include "relight/render/scene_lights.h"
 
 namespace relight::app {
 
@@ -51,12 +52,13 @@ struct RenderReferenceOptions {
 MrScene real_scene(const RenderReferenceOptions& command, bool synthetic, const TumSequence& sequence,
                    const RgbdFrame& frame) {
   if (synthetic) {
-    MrScene scene = render::scene_from_synth(synth::default_indoor_scene());
-    scene.lights = real_lights(true, command.sequence, command.lights);
-    return scene;
+    // The path tracer gets the synthetic scene's exact lights and sky.
+    if (!command.lights.empty())
+      throw Error("--lights applies to recorded sequences; a synthetic sequence brings its own lights");
+    return render::scene_from_synth(synth::default_indoor_scene());
   }
   MrScene scene;
-  scene.lights = real_lights(false, command.sequence, command.lights);
+  render::add_lights(scene, real_light_set(false, command.sequence, command.lights));
   render::DepthMeshMaterials materials;
   materials.material = scene.add_material({"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
   scene.meshes.push_back(render::mesh_from_positions(render::positions_from_depth(frame.depth, sequence.intrinsics()),

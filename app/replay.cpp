@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "constant_stage.h"
 #include "frame_range.h"
 #include "frame_writer_stage.h"
 #include "marker_trajectory_stage.h"
@@ -23,7 +24,9 @@
 #include "relight/vk/backend.h"
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
+#include "relight/brdf/brdf_stages.h"
 #include "relight/render/dir_stage.h"
+#include "relight/render/scene_lights.h"
 #include "report.h"
 #include "video_writer_stage.h"
 
@@ -114,24 +117,32 @@ std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
   return parse_tag_layout(text, scene.string());
 }
 
-/// The DIR stage and its outputs, when the options ask for any virtual content.
-void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options) {
+/// The lights, the BRDF stages (real materials) and the DIR stage with its outputs, when the
+/// options ask for any virtual content.
+void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel) {
   if (options.objects.empty() && options.virtual_lights.empty()) return;
   if (options.vpls < 0 || options.vpls > 4096) throw Error("--vpls must be 0 to 4096");
   if (!(options.exposure > 0.f)) throw Error("--exposure must be positive");
   const auto sequence = options.sequence.empty() ? default_sequence() : options.sequence;
   const bool synthetic = sequence.extension() != ".oni" && is_synthetic(sequence);
+  const LightSet measured = real_light_set(synthetic, sequence, options.lights);
   render::DirSceneContent content;
-  content.lights = real_lights(synthetic, sequence, options.lights);
+  render::MrScene lights;
+  render::add_lights(lights, measured);
+  content.lights = lights.lights;
   for (const std::string& light : options.virtual_lights) content.lights.push_back(parse_virtual_light(light));
   content.objects = virtual_objects(options.objects, options.places, synthetic);
+
+  FrameGraph& graph = *pipeline.graph;
+  graph.emplace<ConstantStage<LightSet>>("lights", measured);
+  brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
   render::DirStageOptions dir;
   dir.vpls.count = options.vpls;
   dir.tone_map.exposure = options.exposure;
-  pipeline.graph->emplace<render::DirStage>(pipeline.vulkan.get(), std::move(content), dir);
-  pipeline.graph->keep("composite");
-  if (options.video)
-    pipeline.graph->emplace<VideoWriterStage>(options.out / "composite.mp4", "composite");
+  dir.materials_buffer = "materials";
+  graph.emplace<render::DirStage>(pipeline.vulkan.get(), std::move(content), dir);
+  graph.keep("composite");
+  if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", "composite");
   pipeline.renders = true;
 }
 
@@ -172,7 +183,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   graph.keep("normals");
   graph.keep("positions");
   add_marker_pose(pipeline, options);
-  add_differential_rendering(pipeline, options);
+  add_differential_rendering(pipeline, options, per_pixel);
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
     writer->add_color("color");

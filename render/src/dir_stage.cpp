@@ -16,16 +16,47 @@ void DirStage::declare(StageBuilder& builder) {
   color_ = builder.read<ColorImage>("color");
   positions_ = builder.read<PositionMap>("positions");
   normals_ = builder.read<NormalMap>("normals");
+  if (!options_.materials_buffer.empty()) materials_ = builder.read<brdf::Materials>(options_.materials_buffer);
   composite_ = builder.write<ColorImage>("composite");
   real_virtual_ = builder.write<RadianceImage>("L_rv");
   real_ = builder.write<RadianceImage>("L_r");
   coverage_ = builder.write<CoverageImage>("virtual_coverage");
 }
 
-void DirStage::build_scene(const PositionMap& positions, const NormalMap& normals, const Pose& camera_to_world) {
+namespace {
+
+/// The clusters as MrScene materials (index = cluster), and the fallback for pixels without one.
+void add_cluster_materials(MrScene& scene, const brdf::Materials& materials, DepthMeshMaterials& mesh_materials,
+                           const PhongMaterial& fallback) {
+  Eigen::Vector3f weighted = Eigen::Vector3f::Zero();
+  float pixels = 0.f;
+  mesh_materials.material_of_label.push_back(0);  // label 0: no cluster, replaced below
+  for (std::size_t i = 0; i < materials.clusters.size(); ++i) {
+    const brdf::MaterialParams& c = materials.clusters[i];
+    mesh_materials.material_of_label.push_back(
+        scene.add_material({"cluster " + std::to_string(i), c.kd, c.ks, std::max(c.n, 1.f), Eigen::Vector3f::Zero()}));
+    weighted += static_cast<float>(c.pixels) * c.kd;
+    pixels += static_cast<float>(c.pixels);
+  }
+  PhongMaterial unclustered = fallback;
+  unclustered.name = "unclustered";
+  if (pixels > 0.f) unclustered.kd = weighted / pixels;
+  mesh_materials.material = scene.add_material(unclustered);
+  mesh_materials.material_of_label[0] = mesh_materials.material;
+  mesh_materials.labels = &materials.ids;
+}
+
+}  // namespace
+
+void DirStage::build_scene(const PositionMap& positions, const NormalMap& normals, const Pose& camera_to_world,
+                           const brdf::Materials* cluster_materials) {
   scene_ = MrScene{};
   DepthMeshMaterials materials;
-  materials.material = scene_.add_material(options_.reconstruction_material);
+  if (cluster_materials && cluster_materials->ids.width() == positions.width() &&
+      cluster_materials->ids.height() == positions.height())
+    add_cluster_materials(scene_, *cluster_materials, materials, options_.reconstruction_material);
+  else
+    materials.material = scene_.add_material(options_.reconstruction_material);
   TriangleMesh mesh = mesh_from_positions(positions, &normals, camera_to_world, materials, options_.mesh);
   mesh.name = "reconstruction";
   scene_.meshes.push_back(std::move(mesh));
@@ -42,7 +73,8 @@ void DirStage::run(StageContext& context) {
     throw Error("dir: the colour image (" + std::to_string(color.width()) + "x" + std::to_string(color.height()) +
                 ") and the position map (" + std::to_string(width) + "x" + std::to_string(height) + ") differ in size");
   const Pose camera_to_world = frame.camera_to_world.value_or(Pose::Identity());
-  build_scene(positions, context.get(normals_), camera_to_world);
+  build_scene(positions, context.get(normals_), camera_to_world,
+              options_.materials_buffer.empty() ? nullptr : &context.get(materials_));
 
   const std::vector<Vpl> vpls = generate_vpls(scene_, RayTracer(scene_), options_.vpls);
   vpl_count_ = vpls.size();

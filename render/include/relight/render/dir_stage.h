@@ -5,17 +5,23 @@
 // and composites them into the camera image (composite.h, eq. 5.1).
 //
 // Reads:  FrameInfo "frame" (intrinsics, camera_to_world: identity when absent), ColorImage
-//         "color", PositionMap "positions" and NormalMap "normals" (camera frame, reconstruct/).
+//         "color", PositionMap "positions" and NormalMap "normals" (camera frame, reconstruct/),
+//         and, when `materials_buffer` is set, brdf::Materials (the BRDF stages' clusters).
 // Writes: ColorImage "composite", RadianceImage "L_rv" and "L_r", CoverageImage
 //         "virtual_coverage".
 //
 // With a Vulkan context it renders with DirRendererVk (made on the first frame, remade when the
 // frame size changes); without one, with render_dir_cpu() (same algorithm, much slower).
-// Real surfaces all get `reconstruction_material` until the BRDF stage's materials are wired in.
+// Real surfaces take the material of their pixel's BRDF cluster; pixels without one (shadows,
+// too dark to estimate) take the pixel-weighted mean of the clusters, and without any Materials
+// every real surface is `reconstruction_material`. The real materials matter for the picture:
+// the differential adds TM(L_rv) - TM(L_r) to the camera image, so a virtual shadow computed
+// with a grey albedo on a brown table subtracts grey and tints the shadow orange.
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "relight/brdf/materials.h"
 #include "relight/colormap/tone_map.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
@@ -32,6 +38,7 @@ struct DirStageOptions {
   DepthMeshOptions mesh{.stride = 2};
   PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
   colormap::ToneMap tone_map{};
+  std::string materials_buffer;  ///< empty: no Materials input
 };
 
 /// What the stage adds to every frame's real geometry.
@@ -55,7 +62,8 @@ class DirStage final : public Stage {
   [[nodiscard]] std::size_t last_vpl_count() const { return vpl_count_; }
 
  private:
-  void build_scene(const PositionMap& positions, const NormalMap& normals, const Pose& camera_to_world);
+  void build_scene(const PositionMap& positions, const NormalMap& normals, const Pose& camera_to_world,
+                   const brdf::Materials* materials);
 
   vk::VulkanContext* context_;
   DirSceneContent content_;
@@ -68,6 +76,7 @@ class DirStage final : public Stage {
   Read<ColorImage> color_;
   Read<PositionMap> positions_;
   Read<NormalMap> normals_;
+  Read<brdf::Materials> materials_;
   Write<ColorImage> composite_;
   Write<RadianceImage> real_virtual_;
   Write<RadianceImage> real_;
