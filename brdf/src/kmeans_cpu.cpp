@@ -13,7 +13,6 @@ namespace relight::brdf {
 
 namespace {
 
-constexpr float kFeatureMax = static_cast<float>(RELIGHT_KMEANS_FEATURE_MAX);
 constexpr float kValueScale = static_cast<float>(RELIGHT_KMEANS_VALUE_SCALE);
 constexpr float kDistanceScale = static_cast<float>(RELIGHT_KMEANS_DISTANCE_SCALE);
 constexpr std::size_t kChunk = 8192;
@@ -29,11 +28,6 @@ void check_clusters(std::size_t clusters) {
 inline std::uint32_t quantise(float value, float scale) { return static_cast<std::uint32_t>(value * scale + 0.5f); }
 
 }  // namespace
-
-Float3 kmeans_feature(const Float3& v) {
-  auto clamp = [](float x) { return std::isfinite(x) ? std::clamp(x, 0.f, kFeatureMax) : 0.f; };
-  return {clamp(v.x), clamp(v.y), clamp(v.z)};
-}
 
 double ClusterSums::total_variance() const {
   std::uint64_t total = 0;
@@ -68,6 +62,7 @@ void KMeansCpu::set_points(std::span<const Float3> points) {
     qy_[i] = quantise(points[i].y, kValueScale);
     qz_[i] = quantise(points[i].z, kValueScale);
   }
+  active_ = n;
 }
 
 namespace {
@@ -136,7 +131,7 @@ __attribute__((target_clones("avx2", "default"))) void sum_block(
 ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres) {
   const std::size_t k_count = centres.size();
   check_clusters(k_count);
-  const std::size_t n = xs_.size();
+  const std::size_t n = active_;
   labels_.resize(n);
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<ClusterSums::Cluster> partial(chunks * k_count);
@@ -291,7 +286,8 @@ KMeansResult KMeansTracker::run(KMeansEngine& engine, std::span<const Float3> po
     return best;
   }
   const std::span<const Float3> fit = points.first(clustered);
-  engine.set_points(fit);
+  engine.set_points(points);
+  engine.use_first(clustered);
   bool have = false;
   if (previous_ && static_cast<int>(previous_->size()) == options_.clusters) {
     best = lloyd(engine, *previous_, options_);
@@ -313,7 +309,7 @@ KMeansResult KMeansTracker::run(KMeansEngine& engine, std::span<const Float3> po
 double KMeansTracker::assign_all(KMeansEngine& engine, std::span<const Float3> points, std::size_t clustered,
                                  KMeansResult& result) const {
   if (clustered == points.size()) return result.compactness;
-  engine.set_points(points);
+  engine.use_first(points.size());
   const double variance = engine.step(result.centres).total_variance();
   engine.read_labels(result.labels);
   return variance;
@@ -354,7 +350,7 @@ void KMeansTracker::separate_merged_centres(KMeansEngine& engine, std::span<cons
     }
     std::vector<Eigen::Vector3f> centres = result.centres;
     centres[b] = Eigen::Vector3f(points[farthest].x, points[farthest].y, points[farthest].z);
-    if (clustered < points.size()) engine.set_points(points.first(clustered));
+    engine.use_first(clustered);
     KMeansResult moved = lloyd(engine, std::move(centres), options_);
     const double moved_variance = assign_all(engine, points, clustered, moved);
     if (!(moved_variance < variance)) return;

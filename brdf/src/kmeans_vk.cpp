@@ -56,7 +56,7 @@ void KMeansVk::set_points(std::span<const Float3> points) {
     r.set = r.pipeline.bind({&*r.points, &r.centres, &*r.labels, &*r.partials});
   }
   context_.transfer().upload(std::as_bytes(points), *r.points);
-  points_ = static_cast<std::uint32_t>(points.size());
+  points_ = loaded_ = static_cast<std::uint32_t>(points.size());
 }
 
 ClusterSums KMeansVk::step(std::span<const Eigen::Vector3f> centres) {

@@ -107,6 +107,29 @@ TEST(KMeans, ResultDoesNotDependOnTheThreadCount) {
   EXPECT_EQ(a.iterations, b.iterations);
 }
 
+TEST(KMeans, UseFirstStepsOnAPrefixAsIfOnlyItWasSet) {
+  const SceneClusters data = scene_points(test::brdf_scene().color);
+  const std::size_t prefix = data.points.size() / 3;
+  std::mt19937_64 rng(5);
+  const auto centres = kmeans_pp_centres(data.points, 6, rng);
+  KMeansCpu all, only;
+  all.set_points(data.points);
+  all.use_first(prefix);
+  only.set_points(std::span<const Float3>(data.points).first(prefix));
+  const ClusterSums a = all.step(centres), b = only.step(centres);
+  std::vector<std::uint8_t> la, lb;
+  all.read_labels(la);
+  only.read_labels(lb);
+  EXPECT_EQ(la, lb);
+  ASSERT_EQ(a.clusters.size(), b.clusters.size());
+  for (std::size_t k = 0; k < a.clusters.size(); ++k) {
+    EXPECT_EQ(a.clusters[k].count, b.clusters[k].count);
+    EXPECT_EQ(a.clusters[k].distance, b.clusters[k].distance);
+  }
+  all.use_first(data.points.size());
+  EXPECT_GT(all.step(centres).total_variance(), a.total_variance());
+}
+
 TEST(KMeans, SyntheticClusterMapMatchesTheMaterialsAndCentresTheAlbedos) {
   const SceneClusters data = scene_points(test::brdf_scene().color, true);
   KMeansCpu cpu;

@@ -15,6 +15,8 @@
 // keeps its centre. The result's labels are the last assignment and its compactness the sum of
 // squared distances of that assignment.
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -22,6 +24,7 @@
 #include <span>
 #include <vector>
 
+#include "relight/brdf/brdf_shared.h"
 #include "relight/core/pixel.h"
 
 namespace relight::brdf {
@@ -56,8 +59,13 @@ struct ClusterSums {
   void update(std::vector<Eigen::Vector3f>& centres) const;
 };
 
-/// A feature clamped to the K-means range [0, RELIGHT_KMEANS_FEATURE_MAX].
-[[nodiscard]] Float3 kmeans_feature(const Float3& value);
+/// A feature clamped to the K-means range [0, RELIGHT_KMEANS_FEATURE_MAX] (non-finite: 0).
+[[nodiscard]] inline Float3 kmeans_feature(const Float3& v) {
+  auto clamp = [](float x) {
+    return std::isfinite(x) ? std::min(std::max(x, 0.f), static_cast<float>(RELIGHT_KMEANS_FEATURE_MAX)) : 0.f;
+  };
+  return {clamp(v.x), clamp(v.y), clamp(v.z)};
+}
 
 /// One Lloyd implementation: step() assigns and sums; the loop around it is shared (lloyd()).
 class KMeansEngine {
@@ -65,6 +73,9 @@ class KMeansEngine {
   virtual ~KMeansEngine() = default;
   /// Makes `points` (already clamped features) the data of the following step() calls.
   virtual void set_points(std::span<const Float3> points) = 0;
+  /// Restricts the following step() and read_labels() calls to the first `count` points of the
+  /// last set_points() (at most all of them), without setting them again.
+  virtual void use_first(std::size_t count) = 0;
   /// One assignment + reduction with `centres`.
   virtual ClusterSums step(std::span<const Eigen::Vector3f> centres) = 0;
   /// The assignment of the last step(), one cluster index per point.
@@ -77,11 +88,13 @@ class KMeansCpu final : public KMeansEngine {
  public:
   explicit KMeansCpu(int threads = 0) : threads_(threads) {}
   void set_points(std::span<const Float3> points) override;
+  void use_first(std::size_t count) override { active_ = std::min(count, xs_.size()); }
   ClusterSums step(std::span<const Eigen::Vector3f> centres) override;
   void read_labels(std::vector<std::uint8_t>& labels) override { labels = labels_; }
 
  private:
   int threads_;
+  std::size_t active_ = 0;                   // points that step() works on
   std::vector<float> xs_, ys_, zs_;           // points, structure of arrays
   std::vector<std::uint32_t> qx_, qy_, qz_;  // their fixed-point values (brdf_shared.h)
   std::vector<std::uint8_t> labels_;

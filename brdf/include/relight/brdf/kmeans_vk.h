@@ -5,6 +5,7 @@
 // (1200 rows of 5 uints per cluster for 640x480) and updates the centres. The sums are exact
 // integers, so for the same initial centres this engine and KMeansCpu give identical sums,
 // centres and assignments (tested). This header includes no Vulkan headers.
+#include <algorithm>
 #include <memory>
 #include <optional>
 
@@ -25,6 +26,9 @@ class KMeansVk final : public KMeansEngine {
   KMeansVk& operator=(const KMeansVk&) = delete;
 
   void set_points(std::span<const Float3> points) override;
+  void use_first(std::size_t count) override {
+    points_ = static_cast<std::uint32_t>(std::min<std::size_t>(count, loaded_));
+  }
   ClusterSums step(std::span<const Eigen::Vector3f> centres) override;
   void read_labels(std::vector<std::uint8_t>& labels) override;
 
@@ -36,7 +40,8 @@ class KMeansVk final : public KMeansEngine {
   struct Resources;
   vk::VulkanContext& context_;
   std::unique_ptr<Resources> resources_;
-  std::uint32_t points_ = 0;
+  std::uint32_t points_ = 0;  // points that step() works on
+  std::uint32_t loaded_ = 0;  // points of the last set_points()
   std::optional<double> gpu_ms_;
 };
 
