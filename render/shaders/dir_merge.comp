@@ -9,7 +9,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer GBuffer { vec4 gbuffer[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Shaded { vec4 shaded[]; };  // 4 per pixel
-layout(std430, set = 0, binding = 2) writeonly buffer Radiance { vec4 radiance[]; };  // 2 per pixel
+// 4 per pixel: L_rv (w: virtual coverage), L_r, and their indirect parts.
+layout(std430, set = 0, binding = 2) writeonly buffer Radiance { vec4 radiance[]; };
 
 layout(push_constant) uniform Params {
   uint width;
@@ -44,6 +45,8 @@ void main() {
       }
   }
   const vec4 direct_rv = shaded[4u * i];
-  radiance[2u * i] = vec4(direct_rv.xyz + sum_rv / weight, direct_rv.w);
-  radiance[2u * i + 1u] = vec4(shaded[4u * i + 1u].xyz + sum_r / weight, 0.0);
+  radiance[4u * i] = vec4(direct_rv.xyz + sum_rv / weight, direct_rv.w);
+  radiance[4u * i + 1u] = vec4(shaded[4u * i + 1u].xyz + sum_r / weight, 0.0);
+  radiance[4u * i + 2u] = vec4(sum_rv / weight, 0.0);
+  radiance[4u * i + 3u] = vec4(sum_r / weight, 0.0);
 }

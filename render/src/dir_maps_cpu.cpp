@@ -118,8 +118,10 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
       }
   }
   Radiance out;
-  out.real_virtual = own.real_virtual + sum_rv / weight;
-  out.real = own.real + sum_r / weight;
+  out.indirect_real_virtual = sum_rv / weight;
+  out.indirect_real = sum_r / weight;
+  out.real_virtual = own.real_virtual + out.indirect_real_virtual;
+  out.real = own.real + out.indirect_real;
   return out;
 }
 
@@ -155,13 +157,16 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
                                     scene.materials[gbuffer.material(y, x) - 1u], real_pixel, subset);
       }
   }, 4);
-  DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1};
+  DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,
+                         RadianceImage(width, height), RadianceImage(width, height)};
   parallel_rows(height, options.shading.threads, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
       for (int x = 0; x < width; ++x) {
         const Radiance r = merged_pixel(gbuffer, shaded, x, y, n);
         out.real_virtual(y, x) = {r.real_virtual.x(), r.real_virtual.y(), r.real_virtual.z()};
         out.real(y, x) = {r.real.x(), r.real.y(), r.real.z()};
+        out.indirect_real_virtual(y, x) = {r.indirect_real_virtual.x(), r.indirect_real_virtual.y(), r.indirect_real_virtual.z()};
+        out.indirect_real(y, x) = {r.indirect_real.x(), r.indirect_real.y(), r.indirect_real.z()};
         out.virtual_coverage(y, x) = gbuffer.distance(y, x) != 0.f && gbuffer.virtual_surface(y, x) ? 1.f : 0.f;
       }
   }, 8);
@@ -169,9 +174,11 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
 }
 
 DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
-                                  const DirVkOptions& options) {
+                                  const DirVkOptions& options, GBuffer* gbuffer_out) {
   const RayTracer tracer(scene);
-  const GBuffer gbuffer = gbuffer_cpu(tracer, camera, options.shading.threads);
+  GBuffer local;
+  GBuffer& gbuffer = gbuffer_out ? *gbuffer_out : local;
+  gbuffer = gbuffer_cpu(tracer, camera, options.shading.threads);
   const ShadowLayout layout = plan_shadow_views(scene, options.shadow_tile);
   const std::vector<float> shadow_atlas = shadow_atlas_cpu(tracer, layout, options.shading.threads);
   const IsmPointPools points = sample_ism_points(scene, options.ism);

@@ -21,6 +21,7 @@ void DirStage::declare(StageBuilder& builder) {
   real_virtual_ = builder.write<RadianceImage>("L_rv");
   real_ = builder.write<RadianceImage>("L_r");
   coverage_ = builder.write<CoverageImage>("virtual_coverage");
+  indirect_ = builder.write<RadianceImage>("L_rv_indirect");
 }
 
 namespace {
@@ -82,6 +83,7 @@ void DirStage::run(StageContext& context) {
   camera.intrinsics.width = width;
   camera.intrinsics.height = height;
   DifferentialImages images;
+  GBuffer gbuffer;
   if (context_) {
     if (!renderer_ || renderer_size_ != std::pair{width, height}) {
       renderer_ = std::make_unique<DirRendererVk>(*context_, width, height);
@@ -89,14 +91,18 @@ void DirStage::run(StageContext& context) {
     }
     renderer_->set_scene(scene_, options_.renderer);
     images = renderer_->render(camera, vpls, options_.renderer);
+    if (options_.temporal_smoothing) gbuffer = renderer_->last_gbuffer();
   } else {
-    images = render_dir_cpu(scene_, camera, vpls, options_.renderer);
+    images = render_dir_cpu(scene_, camera, vpls, options_.renderer, &gbuffer);
   }
+  if (options_.temporal_smoothing)
+    history_ = smooth_indirect(images, gbuffer, camera, history_ ? &*history_ : nullptr, options_.temporal);
   context.get(composite_) =
       differential_composite(color, images.real_virtual, images.real, images.virtual_coverage, options_.tone_map);
   context.get(real_virtual_) = std::move(images.real_virtual);
   context.get(real_) = std::move(images.real);
   context.get(coverage_) = std::move(images.virtual_coverage);
+  context.get(indirect_) = std::move(images.indirect_real_virtual);
 }
 
 }  // namespace relight::render

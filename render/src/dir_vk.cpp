@@ -107,7 +107,7 @@ struct DirRendererVk::Impl {
                         .push_constant_bytes = sizeof(MergeParams), .max_descriptor_sets = 2}),
         gbuffer_buffer(context, GBufferVk::packed_bytes(width, height)),
         shaded(context, 16 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
-        output(context, 8 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
+        output(context, 16 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
         merge_set(merge.bind({&gbuffer_buffer, &shaded, &output})),
         timers{vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context),
                vk::GpuTimer(context), vk::GpuTimer(context)} {}
@@ -195,14 +195,17 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
   d.timings = {ms(0), ms(1), ms(2), ms(3), ms(4), ms(5), cpu_shading};
   if (cpu_shading) return shade_on_cpu(camera, vpls, options);
 
-  std::vector<float> radiance(static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) * 8);
+  std::vector<float> radiance(static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) * 16);
   d.context.transfer().download(d.output, std::as_writable_bytes(std::span(radiance)));
-  DifferentialImages out{RadianceImage(d.width, d.height), RadianceImage(d.width, d.height), CoverageImage(d.width, d.height), 1};
+  DifferentialImages out{RadianceImage(d.width, d.height), RadianceImage(d.width, d.height), CoverageImage(d.width, d.height), 1,
+                         RadianceImage(d.width, d.height), RadianceImage(d.width, d.height)};
   for (std::size_t i = 0; i < out.real.pixels().size(); ++i) {
-    const float* p = &radiance[8 * i];
+    const float* p = &radiance[16 * i];
     out.real_virtual.pixels()[i] = {p[0], p[1], p[2]};
     out.virtual_coverage.pixels()[i] = p[3];
     out.real.pixels()[i] = {p[4], p[5], p[6]};
+    out.indirect_real_virtual.pixels()[i] = {p[8], p[9], p[10]};
+    out.indirect_real.pixels()[i] = {p[12], p[13], p[14]};
   }
   return out;
 }

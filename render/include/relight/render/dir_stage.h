@@ -8,15 +8,18 @@
 //         "color", PositionMap "positions" and NormalMap "normals" (camera frame, reconstruct/),
 //         and, when `materials_buffer` is set, brdf::Materials (the BRDF stages' clusters).
 // Writes: ColorImage "composite", RadianceImage "L_rv" and "L_r", CoverageImage
-//         "virtual_coverage".
+//         "virtual_coverage", RadianceImage "L_rv_indirect" (the VPL part of L_rv, smoothed).
 //
 // With a Vulkan context it renders with DirRendererVk (made on the first frame, remade when the
 // frame size changes); without one, with render_dir_cpu() (same algorithm, much slower).
+// The indirect light is smoothed over time (temporal_smoothing.h) with the stage's own history
+// of the last frame (G-buffer, camera, indirect light).
 // Real surfaces take the material of their pixel's BRDF cluster; pixels without one (shadows,
 // too dark to estimate) take the pixel-weighted mean of the clusters, and without any Materials
 // every real surface is `reconstruction_material`. The real materials matter for the picture:
 // the differential adds TM(L_rv) - TM(L_r) to the camera image, so a virtual shadow computed
 // with a grey albedo on a brown table subtracts grey and tints the shadow orange.
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -27,6 +30,7 @@
 #include "relight/core/rgbd_frame.h"
 #include "relight/render/depth_mesh.h"
 #include "relight/render/dir_vk.h"
+#include "relight/render/temporal_smoothing.h"
 #include "relight/render/virtual_model.h"
 #include "relight/render/vpl.h"
 
@@ -39,6 +43,8 @@ struct DirStageOptions {
   PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
   colormap::ToneMap tone_map{};
   std::string materials_buffer;  ///< empty: no Materials input
+  bool temporal_smoothing = true;
+  TemporalOptions temporal{};
 };
 
 /// What the stage adds to every frame's real geometry.
@@ -72,6 +78,7 @@ class DirStage final : public Stage {
   std::pair<int, int> renderer_size_{0, 0};
   MrScene scene_;
   std::size_t vpl_count_ = 0;
+  std::optional<TemporalHistory> history_;
   Read<FrameInfo> frame_;
   Read<ColorImage> color_;
   Read<PositionMap> positions_;
@@ -81,6 +88,7 @@ class DirStage final : public Stage {
   Write<RadianceImage> real_virtual_;
   Write<RadianceImage> real_;
   Write<CoverageImage> coverage_;
+  Write<RadianceImage> indirect_;
 };
 
 }  // namespace relight::render

@@ -95,7 +95,7 @@ class DirRendererVk {
 /// shadow maps, CPU ISMs, shade_dir_from_maps): the fallback where no Vulkan device exists.
 /// `vpls` as for DirRendererVk::render.
 [[nodiscard]] DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
-                                                const DirVkOptions& options = {});
+                                                const DirVkOptions& options = {}, GBuffer* gbuffer_out = nullptr);
 
 /// The shading pass on the CPU, from the same inputs as the GPU's (`virtual_bounds`: the ISM
 /// point pools' IsmPointPools::virtual_bounds).

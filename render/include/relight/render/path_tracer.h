@@ -53,6 +53,10 @@ struct DifferentialImages {
   RadianceImage real;          ///< L_r
   CoverageImage virtual_coverage;
   int samples_per_pixel = 0;
+  /// The indirect (VPL) part of L_rv and L_r, included in them; filled by the DIR renderers
+  /// (dir_vk.h) for temporal smoothing, empty otherwise.
+  RadianceImage indirect_real_virtual;
+  RadianceImage indirect_real;
 };
 
 /// Called after each progressive pass with (samples done, samples wanted).

@@ -1,0 +1,160 @@
+// Temporal smoothing of the indirect light (eqs. 5.11-5.15): blends where the surface is the
+// same, takes the new value at disocclusions and where r(p) changes (no ghosting of a moved
+// virtual object), and lowers the frame-to-frame flicker of the DIR stage on noisy depth.
+#include "relight/render/temporal_smoothing.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "../reconstruct/vulkan_test_env.h"
+#include "relight/render/dir_stage.h"
+#include "relight/render/procedural_models.h"
+#include "relight/render/scene_from_synth.h"
+#include "relight/synth/raycast.h"
+#include "relight/synth/trajectory.h"
+#include "relight/vk/context.h"
+#include "relight/vk/transfer.h"
+
+namespace relight::render {
+namespace {
+
+constexpr int kSize = 8;
+
+/// A wall at depth `depth` facing a camera at the origin (identity pose), every pixel real.
+GBuffer wall(float depth, const MrCamera& camera) {
+  GBuffer g{PositionMap(kSize, kSize), NormalMap(kSize, kSize), LabelImage(kSize, kSize), Mask(kSize, kSize),
+            DepthMap(kSize, kSize)};
+  for (int row = 0; row < kSize; ++row)
+    for (int col = 0; col < kSize; ++col) {
+      const Eigen::Vector3d ray = camera.intrinsics.ray(col, row);
+      const Eigen::Vector3d p = ray * (depth / ray.z());
+      g.position(row, col) = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+      g.normal(row, col) = {0.f, 0.f, -1.f};
+      g.material(row, col) = 1;
+      g.distance(row, col) = static_cast<float>(p.norm());
+    }
+  return g;
+}
+
+DifferentialImages indirect(float value) {
+  DifferentialImages images{RadianceImage(kSize, kSize), RadianceImage(kSize, kSize), CoverageImage(kSize, kSize), 1,
+                            RadianceImage(kSize, kSize), RadianceImage(kSize, kSize)};
+  for (auto* image : {&images.real_virtual, &images.real, &images.indirect_real_virtual, &images.indirect_real})
+    for (Float3& p : image->pixels()) p = {value, value, value};
+  return images;
+}
+
+MrCamera small_camera() {
+  return {PinholeIntrinsics{8.0, 8.0, 3.5, 3.5, kSize, kSize}, Pose::Identity()};
+}
+
+TEST(TemporalSmoothing, BlendsTheSameSurfaceWithConfidenceCb) {
+  const MrCamera camera = small_camera();
+  const GBuffer g = wall(2.f, camera);
+  DifferentialImages first = indirect(0.5f);
+  const TemporalHistory history = smooth_indirect(first, g, camera, nullptr);
+  EXPECT_EQ(first.real(3, 3), (Float3{0.5f, 0.5f, 0.5f})) << "the first frame is left alone";
+  DifferentialImages second = indirect(0.6f);
+  (void)smooth_indirect(second, g, camera, &history);
+  // Same surface: eps_pos = eps_n = 0, eps_ill = 0.1^3 * 0.025: c ~ 0.9.
+  EXPECT_NEAR(second.indirect_real(3, 3).x, 0.9f * 0.5f + 0.1f * 0.6f, 1e-4f);
+  EXPECT_NEAR(second.real(3, 3).x, second.indirect_real(3, 3).x, 1e-6f) << "the total follows its indirect part";
+}
+
+TEST(TemporalSmoothing, TakesTheNewValueAtDisocclusionsAndWhereRealAndVirtualSwap) {
+  const MrCamera camera = small_camera();
+  DifferentialImages first = indirect(0.5f);
+  const TemporalHistory history = smooth_indirect(first, wall(2.f, camera), camera, nullptr);
+  DifferentialImages moved = indirect(0.8f);
+  (void)smooth_indirect(moved, wall(2.3f, camera), camera, &history);  // 30 cm further: another surface
+  EXPECT_FLOAT_EQ(moved.indirect_real(3, 3).x, 0.8f);
+  GBuffer now_virtual = wall(2.f, camera);
+  now_virtual.virtual_surface(3, 3) = 1;  // a virtual object moved in front of this pixel
+  DifferentialImages covered = indirect(0.8f);
+  (void)smooth_indirect(covered, now_virtual, camera, &history);
+  EXPECT_FLOAT_EQ(covered.indirect_real_virtual(3, 3).x, 0.8f);
+  EXPECT_LT(covered.indirect_real_virtual(3, 4).x, 0.6f) << "its neighbour still blends";
+}
+
+/// Synthetic frames from a static camera with fresh depth noise every frame (as a Kinect gives).
+class NoisyFrameStage final : public Stage {
+ public:
+  NoisyFrameStage(PinholeIntrinsics intrinsics, Pose pose)
+      : intrinsics_(intrinsics), pose_(pose), truth_(synth::render_frame(synth::default_indoor_scene(), intrinsics, pose)) {}
+  [[nodiscard]] std::string name() const override { return "noisy_frame"; }
+  void declare(StageBuilder& builder) override {
+    frame_ = builder.write<FrameInfo>("frame");
+    color_ = builder.write<ColorImage>("color");
+    positions_ = builder.write<PositionMap>("positions");
+    normals_ = builder.write<NormalMap>("normals");
+  }
+  void run(StageContext& context) override {
+    std::mt19937 random(static_cast<unsigned>(context.frame_index()) + 1u);
+    DepthMap depth = truth_.depth;
+    for (float& z : depth.pixels())
+      if (z > 0.f) z += std::normal_distribution<float>(0.f, 0.0015f * z * z)(random);
+    context.get(frame_) = FrameInfo{context.frame_index(), 0.0, pose_, intrinsics_};
+    context.get(color_) = synth::encode_color(truth_.radiance);
+    context.get(positions_) = positions_from_depth(depth, intrinsics_);
+    context.get(normals_) = truth_.normals;
+  }
+
+ private:
+  PinholeIntrinsics intrinsics_;
+  Pose pose_;
+  synth::RenderedFrame truth_;
+  Write<FrameInfo> frame_;
+  Write<ColorImage> color_;
+  Write<PositionMap> positions_;
+  Write<NormalMap> normals_;
+};
+
+class TemporalSmoothingStageTest : public relight::test::VulkanTest {};
+
+/// Mean frame-to-frame change of the indirect light (real pixels, frames 4-8) of the DIR stage.
+double flicker(vk::VulkanContext& context, bool smoothing) {
+  const PinholeIntrinsics intrinsics{131.25, 131.25, 79.5, 59.5, 160, 120};
+  FrameGraph graph(&context.transfer());
+  graph.emplace<NoisyFrameStage>(intrinsics, synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75}));
+  DirSceneContent content;
+  content.lights = scene_from_synth(synth::default_indoor_scene()).lights;
+  content.objects.emplace_back(make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
+  DirStageOptions options;
+  options.renderer.shadow_tile = 256;
+  options.renderer.ism.tile = 32;
+  options.temporal_smoothing = smoothing;
+  graph.emplace<DirStage>(&context, std::move(content), options);
+  graph.keep("L_rv_indirect");
+  graph.compile();
+  RadianceImage previous;
+  double change = 0.0;
+  int samples = 0;
+  for (int frame = 0; frame < 9; ++frame) {
+    EXPECT_TRUE(graph.run_frame());
+    const RadianceImage& now = *graph.find<RadianceImage>("L_rv_indirect");
+    const CoverageImage& coverage = *graph.find<CoverageImage>("virtual_coverage");
+    if (frame >= 4)  // past the first blends
+      for (std::size_t i = 0; i < now.size(); ++i)
+        if (coverage.pixels()[i] == 0.f) {
+          change += length(now.pixels()[i] - previous.pixels()[i]);
+          ++samples;
+        }
+    previous = now;
+  }
+  return change / std::max(samples, 1);
+}
+
+TEST_F(TemporalSmoothingStageTest, CutsTheFlickerOfIndirectLightOnNoisyDepth) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const double without = flicker(context, false);
+  const double with = flicker(context, true);
+  EXPECT_GT(without, 0.0) << "the noise moves the VPLs";
+  // Measured: 44 % less. Not the 50 % hoped for: Kinect-like depth noise (sigma ~ 0.0015 z^2)
+  // alone gives eps_pos ~ 0.3-0.4 with the paper's w_p, so the confidence stays near 0.55
+  // instead of c_B = 0.9.
+  EXPECT_LT(with, 0.65 * without) << "with " << with << ", without " << without;
+}
+
+}  // namespace
+}  // namespace relight::render
