@@ -5,6 +5,7 @@
 #include <array>
 #include <numbers>
 #include <span>
+#include <vector>
 
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
@@ -12,8 +13,6 @@
 namespace relight::brdf {
 
 namespace {
-
-float luminance(const Eigen::Vector3f& v) { return 0.2126f * v.x() + 0.7152f * v.y() + 0.0722f * v.z(); }
 
 /// D (shading.h) of one row, evaluated on structure-of-arrays columns so that the square roots
 /// and divisions run vectorised; the same expression as diffuse_shading().
@@ -68,9 +67,7 @@ class RowShading {
     }
   }
 
-  [[nodiscard]] Eigen::Vector3f at(int column) const {
-    return {shading_[0][column], shading_[1][column], shading_[2][column]};
-  }
+  [[nodiscard]] const std::array<Eigen::ArrayXf, 3>& shading() const { return shading_; }
   /// The largest <omega_o . r_l> over the lights facing the pixel (-1 when none does).
   [[nodiscard]] float mirror(int column) const { return mirror_[column]; }
 
@@ -80,8 +77,42 @@ class RowShading {
   std::array<Eigen::ArrayXf, 3> shading_;
 };
 
-template <class Linear>
-void estimate(int width, int height, Linear&& linear_at, const PositionMap& positions, const NormalMap& normals,
+/// k_d and validity of one row from its linear colour (structure of arrays) and shading.
+class RowReflectance {
+ public:
+  explicit RowReflectance(int width) : geometry_(static_cast<std::size_t>(width)) {
+    for (Eigen::ArrayXf& a : colour_) a.resize(width);
+    for (Eigen::ArrayXf& a : kd_) a.resize(width);
+  }
+  std::array<Eigen::ArrayXf, 3>& colour() { return colour_; }
+
+  void compute(int r, const PositionMap& positions, const NormalMap& normals, const RowShading& shading,
+               const DiffuseOptions& options, RadianceImage& kd, Mask& valid) {
+    const int width = static_cast<int>(geometry_.size());
+    for (int c = 0; c < width; ++c) {
+      geometry_[static_cast<std::size_t>(c)] = is_valid_normal(normals(r, c)) && is_valid_depth(positions(r, c).z);
+    }
+    const auto& d = shading.shading();
+    const Eigen::ArrayXf lum_colour = 0.2126f * colour_[0] + 0.7152f * colour_[1] + 0.0722f * colour_[2];
+    const Eigen::ArrayXf lum_shading = 0.2126f * d[0] + 0.7152f * d[1] + 0.0722f * d[2];
+    const auto lit = (lum_colour >= options.min_brightness && lum_shading >= options.min_shading &&
+                      d[0].min(d[1]).min(d[2]) > 0.f).eval();
+    for (std::size_t ch = 0; ch < 3; ++ch) kd_[ch] = (colour_[ch] / d[ch]).max(0.f).min(options.max_kd);
+    for (int c = 0; c < width; ++c) {
+      const bool ok = geometry_[static_cast<std::size_t>(c)] && lit[c];
+      kd(r, c) = ok ? Float3{kd_[0][c], kd_[1][c], kd_[2][c]} : Float3{};
+      valid(r, c) = !ok ? 0 : shading.mirror(c) > options.lobe_cos_min ? 2 : 1;
+    }
+  }
+
+ private:
+  std::vector<std::uint8_t> geometry_;
+  std::array<Eigen::ArrayXf, 3> colour_, kd_;
+};
+
+/// `fill_colour(r, colour)` writes row r's linear RGB into the three arrays.
+template <class FillColour>
+void estimate(int width, int height, FillColour&& fill_colour, const PositionMap& positions, const NormalMap& normals,
               const ShadingLights& lights, const DiffuseOptions& options, RadianceImage& kd, Mask& valid) {
   if (positions.width() != width || positions.height() != height || !positions.same_shape(normals)) {
     throw Error("brdf diffuse: colour, positions and normals must have the same size");
@@ -90,21 +121,11 @@ void estimate(int width, int height, Linear&& linear_at, const PositionMap& posi
   valid.resize(width, height);
   parallel_rows(height, options.threads, [&](int begin, int end) {
     RowShading shading(width);
+    RowReflectance reflectance(width);
     for (int r = begin; r < end; ++r) {
       shading.compute(positions.row(r), normals.row(r), lights);
-      for (int c = 0; c < width; ++c) {
-        kd(r, c) = {};
-        valid(r, c) = 0;
-        const Float3 p = positions(r, c), n = normals(r, c);
-        if (!is_valid_normal(n) || !is_valid_depth(p.z)) continue;
-        const Eigen::Vector3f colour = linear_at(r, c);
-        if (luminance(colour) < options.min_brightness) continue;
-        const Eigen::Vector3f d = shading.at(c);
-        if (luminance(d) < options.min_shading || d.minCoeff() <= 0.f) continue;
-        const Eigen::Vector3f k = colour.cwiseQuotient(d).cwiseMax(0.f).cwiseMin(options.max_kd);
-        kd(r, c) = {k.x(), k.y(), k.z()};
-        valid(r, c) = shading.mirror(c) > options.lobe_cos_min ? 2 : 1;
-      }
+      fill_colour(r, reflectance.colour());
+      reflectance.compute(r, positions, normals, shading, options, kd, valid);
     }
   }, 8);
 }
@@ -113,11 +134,17 @@ void estimate(int width, int height, Linear&& linear_at, const PositionMap& posi
 
 void estimate_diffuse(const ColorImage& color, const PositionMap& positions, const NormalMap& normals,
                       const ShadingLights& lights, const DiffuseOptions& options, RadianceImage& kd, Mask& valid) {
+  const std::array<float, 256>& table = srgb8_linear_table();
   estimate(
       color.width(), color.height(),
-      [&](int r, int c) {
-        const Rgb8 v = color(r, c);
-        return Eigen::Vector3f(srgb8_to_linear(v.r), srgb8_to_linear(v.g), srgb8_to_linear(v.b));
+      [&](int r, std::array<Eigen::ArrayXf, 3>& out) {
+        const auto row = color.row(r);
+        for (std::size_t c = 0; c < row.size(); ++c) {
+          const auto i = static_cast<Eigen::Index>(c);
+          out[0][i] = table[row[c].r];
+          out[1][i] = table[row[c].g];
+          out[2][i] = table[row[c].b];
+        }
       },
       positions, normals, lights, options, kd, valid);
 }
@@ -126,9 +153,14 @@ void estimate_diffuse(const RadianceImage& linear, const PositionMap& positions,
                       const ShadingLights& lights, const DiffuseOptions& options, RadianceImage& kd, Mask& valid) {
   estimate(
       linear.width(), linear.height(),
-      [&](int r, int c) {
-        const Float3 v = linear(r, c);
-        return Eigen::Vector3f(v.x, v.y, v.z);
+      [&](int r, std::array<Eigen::ArrayXf, 3>& out) {
+        const auto row = linear.row(r);
+        for (std::size_t c = 0; c < row.size(); ++c) {
+          const auto i = static_cast<Eigen::Index>(c);
+          out[0][i] = row[c].x;
+          out[1][i] = row[c].y;
+          out[2][i] = row[c].z;
+        }
       },
       positions, normals, lights, options, kd, valid);
 }

@@ -58,7 +58,9 @@ Eigen::Vector3f phong_radiance(const ShadingLights& lights, const Eigen::Vector3
   return radiance;
 }
 
-float srgb8_to_linear(std::uint8_t value) {
+float srgb8_to_linear(std::uint8_t value) { return srgb8_linear_table()[value]; }
+
+const std::array<float, 256>& srgb8_linear_table() {
   static const std::array<float, 256> table = [] {
     std::array<float, 256> t{};
     for (int i = 0; i < 256; ++i) {
@@ -68,7 +70,7 @@ float srgb8_to_linear(std::uint8_t value) {
     }
     return t;
   }();
-  return table[value];
+  return table;
 }
 
 RadianceImage linearize(const ColorImage& color) {

@@ -18,6 +18,7 @@
 // Everything here works in the camera frame (x right, y down, z forward): normals and positions
 // come from the reconstruction, lights are moved into the camera frame once per frame.
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "relight/core/image.h"
@@ -64,6 +65,8 @@ struct LightAtPoint {
 
 /// sRGB (IEC 61966-2-1) 8-bit value -> linear, through a 256-entry table.
 [[nodiscard]] float srgb8_to_linear(std::uint8_t value);
+/// That table, for loops over many pixels.
+[[nodiscard]] const std::array<float, 256>& srgb8_linear_table();
 /// The camera image as linear RGB (the inverse of synth::encode_color with exposure 1).
 [[nodiscard]] RadianceImage linearize(const ColorImage& color);
 
