@@ -82,18 +82,23 @@ class KMeansEngine {
   virtual void read_labels(std::vector<std::uint8_t>& labels) = 0;
 };
 
-/// The CPU engine: points split into chunks over threads, assigned in vectorised blocks of 256,
-/// integer sums per chunk added up.
+/// The CPU engine: points split into chunks of 8192 over TBB workers, assigned and summed in
+/// vectorised blocks of 256, integer sums per chunk added up.
 class KMeansCpu final : public KMeansEngine {
  public:
-  explicit KMeansCpu(int threads = 0) : threads_(threads) {}
+  explicit KMeansCpu(int threads = 0);
+  ~KMeansCpu() override;
+  KMeansCpu(KMeansCpu&&) noexcept;
+  KMeansCpu& operator=(KMeansCpu&&) noexcept;
   void set_points(std::span<const Float3> points) override;
   void use_first(std::size_t count) override { active_ = std::min(count, xs_.size()); }
   ClusterSums step(std::span<const Eigen::Vector3f> centres) override;
   void read_labels(std::vector<std::uint8_t>& labels) override { labels = labels_; }
 
  private:
+  struct Arena;  // the TBB task arena of `threads_` workers (kept out of this header)
   int threads_;
+  std::unique_ptr<Arena> arena_;
   std::size_t active_ = 0;                   // points that step() works on
   std::vector<float> xs_, ys_, zs_;           // points, structure of arrays
   std::vector<std::uint32_t> qx_, qy_, qz_;  // their fixed-point values (brdf_shared.h)
