@@ -5,7 +5,7 @@
 
 #include "relight/brdf/kmeans_vk.h"
 #include "relight/core/error.h"
-#include "relight/core/parallel.h"
+#include "parallel_tbb.h"
 
 namespace relight::brdf {
 
@@ -61,8 +61,8 @@ void fit_materials(const ColorImage& color, const Mask* highlights, const Positi
   const int clusters = static_cast<int>(materials.clusters.size());
   std::vector<std::vector<SpecularSample>> samples =
       select_cluster_samples(color, positions, normals, materials.ids, clusters, highlights, options.max_samples);
-  parallel_rows(
-      clusters, options.threads,
+  detail::parallel_ranges(
+      clusters, options.threads, 1,
       [&](int begin, int end) {
         for (int k = begin; k < end; ++k) {
           MaterialParams& m = materials.clusters[static_cast<std::size_t>(k)];
@@ -80,8 +80,7 @@ void fit_materials(const ColorImage& color, const Mask* highlights, const Positi
           m.n = fit.n;
           m.fit_rms = static_cast<float>(fit.rms);
         }
-      },
-      1);
+      });
 }
 
 void estimate_brdf(const ColorImage& color, const PositionMap& positions, const NormalMap& normals,
@@ -100,7 +99,7 @@ void estimate_brdf(const ColorImage& color, const PositionMap& positions, const 
 RadianceImage render_materials(const Materials& materials, const PositionMap& positions, const NormalMap& normals,
                                const ShadingLights& lights) {
   RadianceImage out(materials.ids.width(), materials.ids.height());
-  parallel_for_each_row(out.height(), 0, [&](int r) {
+  detail::parallel_each_row(out.height(), 0, [&](int r) {
     for (int c = 0; c < out.width(); ++c) {
       const int id = materials.ids(r, c);
       if (id == 0) continue;
