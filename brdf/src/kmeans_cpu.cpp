@@ -89,15 +89,17 @@ constexpr int kBlock = 256;
 __attribute__((target_clones("avx2", "default"))) void assign_block(
     const float* x, const float* y, const float* z, int count, const float* cx, const float* cy, const float* cz,
     int clusters, std::uint8_t* label, std::uint32_t* distance) {
+  // The running argmin in 32-bit lanes like the distances, so that the selects vectorise
+  // without packing masks to bytes.
   float best[kBlock];
-  std::uint8_t arg[kBlock];
+  std::int32_t arg[kBlock];
   for (int i = 0; i < count; ++i) {
     best[i] = std::numeric_limits<float>::infinity();
     arg[i] = 0;
   }
   for (int k = 0; k < clusters; ++k) {
     const float ax = cx[k], ay = cy[k], az = cz[k];
-    const auto kk = static_cast<std::uint8_t>(k);
+    const std::int32_t kk = k;
     for (int i = 0; i < count; ++i) {
       const float dx = x[i] - ax, dy = y[i] - ay, dz = z[i] - az;
       const float d = (dx * dx + dy * dy) + dz * dz;
@@ -107,7 +109,7 @@ __attribute__((target_clones("avx2", "default"))) void assign_block(
     }
   }
   for (int i = 0; i < count; ++i) {
-    label[i] = arg[i];
+    label[i] = static_cast<std::uint8_t>(arg[i]);
     distance[i] = static_cast<std::uint32_t>(best[i] * kDistanceScale + 0.5f);
   }
 }
