@@ -298,35 +298,54 @@ std::vector<std::vector<SpecularSample>> select_cluster_samples(const ColorImage
     throw Error("brdf specular: colour, positions, normals and cluster ids must have the same size");
   }
   const auto count = static_cast<std::size_t>(std::max(0, clusters));
-  std::vector<std::vector<std::uint32_t>> plain(count), bright(count);
-  for (std::size_t i = 0; i < ids.size(); ++i) {
+  // Two passes instead of lists of every pixel: the first counts each cluster's usable pixels
+  // (bright: in the highlight mask; plain: the rest), the second picks the strided ones.
+  auto usable = [&](std::size_t i) -> int {  // 0: skip, 1: plain, 2: bright
     const std::uint16_t label = ids.pixels()[i];
-    if (label == 0 || label > count) continue;
+    if (label == 0 || label > count) return 0;
     const Rgb8 c = color.pixels()[i];
-    if (std::max({c.r, c.g, c.b}) >= 254) continue;
-    if (!is_valid_normal(normals.pixels()[i]) || !is_valid_depth(positions.pixels()[i].z)) continue;
-    (highlights && highlights->pixels()[i] ? bright : plain)[label - 1u].push_back(static_cast<std::uint32_t>(i));
+    if (std::max({c.r, c.g, c.b}) >= 254) return 0;
+    if (!is_valid_normal(normals.pixels()[i]) || !is_valid_depth(positions.pixels()[i].z)) return 0;
+    return highlights && highlights->pixels()[i] ? 2 : 1;
+  };
+  struct Stride {
+    std::size_t size = 0, take = 0, seen = 0, taken = 0;
+    // Picks element t * size / take for t < take (all of them when take >= size).
+    [[nodiscard]] bool next() {
+      const bool pick = taken < take && (take >= size || seen == taken * size / take);
+      ++seen;
+      taken += pick ? 1 : 0;
+      return pick;
+    }
+  };
+  std::vector<Stride> plain(count), bright(count);
+  std::vector<std::uint8_t> kind(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    kind[i] = static_cast<std::uint8_t>(usable(i));
+    if (kind[i] == 0) continue;
+    ++(kind[i] == 2 ? bright : plain)[ids.pixels()[i] - 1u].size;
   }
   const auto budget = static_cast<std::size_t>(std::max(0, max_samples));
-  std::vector<std::vector<SpecularSample>> out(count);
-  std::vector<std::uint32_t> chosen;
   for (std::size_t k = 0; k < count; ++k) {
-    chosen.clear();
-    auto take_strided = [&](const std::vector<std::uint32_t>& from, std::size_t take) {
-      if (from.size() <= take) {
-        chosen.insert(chosen.end(), from.begin(), from.end());
-        return;
+    bright[k].take = std::min(bright[k].size, budget / 2);
+    plain[k].take = std::min(plain[k].size, budget - bright[k].take);
+  }
+  std::vector<std::vector<std::uint32_t>> chosen_bright(count), chosen_plain(count);
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (kind[i] == 0) continue;
+    const std::size_t k = ids.pixels()[i] - 1u;
+    if ((kind[i] == 2 ? bright : plain)[k].next()) (kind[i] == 2 ? chosen_bright : chosen_plain)[k].push_back(static_cast<std::uint32_t>(i));
+  }
+  std::vector<std::vector<SpecularSample>> out(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    out[k].reserve(chosen_bright[k].size() + chosen_plain[k].size());
+    for (const auto* list : {&chosen_bright[k], &chosen_plain[k]}) {
+      for (const std::uint32_t i : *list) {
+        const Rgb8 c = color.pixels()[i];
+        const Float3 p = positions.pixels()[i], n = normals.pixels()[i];
+        out[k].push_back(
+            {{srgb8_to_linear(c.r), srgb8_to_linear(c.g), srgb8_to_linear(c.b)}, {p.x, p.y, p.z}, {n.x, n.y, n.z}});
       }
-      for (std::size_t t = 0; t < take; ++t) chosen.push_back(from[t * from.size() / take]);
-    };
-    take_strided(bright[k], budget / 2);
-    take_strided(plain[k], budget - chosen.size());
-    out[k].reserve(chosen.size());
-    for (const std::uint32_t i : chosen) {
-      const Rgb8 c = color.pixels()[i];
-      const Float3 p = positions.pixels()[i], n = normals.pixels()[i];
-      out[k].push_back(
-          {{srgb8_to_linear(c.r), srgb8_to_linear(c.g), srgb8_to_linear(c.b)}, {p.x, p.y, p.z}, {n.x, n.y, n.z}});
     }
   }
   return out;
