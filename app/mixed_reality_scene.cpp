@@ -50,10 +50,10 @@ LightSet real_light_set(bool synthetic, const fs::path& sequence, const fs::path
   if (!synthetic || !fs::is_regular_file(probe))
     throw Error(sequence.string() + " has no light probe: give its lights with --lights FILE (from `relight lights`)");
   // The product's own path: lights importance-sampled from the sequence's probe (sky, walls and
-  // the lamps as directional lights), as `relight lights PROBE --n 16` would give.
+  // the lamps as directional lights), as `relight lights PROBE --n 8` would give.
   const RadianceImage image = read_radiance(probe);
   LightExtractionOptions options;
-  options.lights = 16;
+  options.lights = 8;
   options.calibration = ProbeCalibration::centred_fisheye(image.width(), image.height());
   try {
     return extract_lights(image, options);

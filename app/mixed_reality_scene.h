@@ -24,7 +24,7 @@ inline constexpr const char* kDefaultSynthPlacement = "0.35,-0.2,0.75,30";
 [[nodiscard]] render::MrLight parse_virtual_light(const std::string& text);
 
 /// The measured lights of a sequence: the lights JSON of `relight lights` when given, else for a
-/// synthetic sequence 16 lights extracted from its probe.hdr. Throws relight::Error when there
+/// synthetic sequence 8 lights extracted from its probe.hdr. Throws relight::Error when there
 /// is neither.
 [[nodiscard]] LightSet real_light_set(bool synthetic, const std::filesystem::path& sequence,
                                       const std::filesystem::path& lights_file);

@@ -140,6 +140,9 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.count = options.vpls;
   dir.tone_map.exposure = options.exposure;
   dir.materials_buffer = "materials";
+  // The measured lights are several soft directional lights (8 from a probe): 256 texels per view
+  // keep their shadows, at a quarter of the rasterisation and memory of 512.
+  dir.renderer.shadow_tile = 256;
   graph.emplace<render::DirStage>(pipeline.vulkan.get(), std::move(content), dir);
   graph.keep("composite");
   if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", "composite");

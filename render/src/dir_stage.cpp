@@ -77,7 +77,7 @@ void DirStage::run(StageContext& context) {
   build_scene(positions, context.get(normals_), camera_to_world,
               options_.materials_buffer.empty() ? nullptr : &context.get(materials_));
 
-  const std::vector<Vpl> vpls = generate_vpls(scene_, RayTracer(scene_), options_.vpls);
+  const std::vector<Vpl> vpls = generate_vpls(scene_, RayTracer(scene_, RayTracer::Build::Fast), options_.vpls);
   vpl_count_ = vpls.size();
   MrCamera camera{frame.intrinsics, camera_to_world};
   camera.intrinsics.width = width;

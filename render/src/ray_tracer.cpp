@@ -88,7 +88,7 @@ struct RayTracer::Impl {
   [[nodiscard]] const LayerScene& layer(Layer which) const { return which == Layer::Real ? real : virtual_objects; }
 };
 
-RayTracer::RayTracer(const MrScene& scene) : impl_(std::make_unique<Impl>()) {
+RayTracer::RayTracer(const MrScene& scene, Build build) : impl_(std::make_unique<Impl>()) {
   scene.validate();
   impl_->scene = scene;
   impl_->device.reset(rtcNewDevice(nullptr));
@@ -97,7 +97,7 @@ RayTracer::RayTracer(const MrScene& scene) : impl_(std::make_unique<Impl>()) {
   for (LayerScene* layer : {&impl_->real, &impl_->virtual_objects}) {
     layer->scene.reset(rtcNewScene(device));
     check(device, "creating a scene");
-    rtcSetSceneBuildQuality(layer->scene.get(), RTC_BUILD_QUALITY_HIGH);
+    rtcSetSceneBuildQuality(layer->scene.get(), build == Build::High ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_LOW);
   }
   for (const TriangleMesh& mesh : impl_->scene.meshes)
     attach_mesh(device, mesh.real ? impl_->real : impl_->virtual_objects, mesh);

@@ -22,7 +22,7 @@ float emission_solid_angle(const MrLight& light) {
   return light.kind == LightKind::Spot ? 2.f * kPi * (1.f - light.cos_outer) : 4.f * kPi;
 }
 
-bool emits_vpls(const MrLight& light) { return light.kind != LightKind::Directional; }
+bool emits_vpls(const MrLight&) { return true; }
 
 struct LightSample {
   Vec3 direction;
@@ -81,6 +81,33 @@ BoundingSphere virtual_bounds(const MrScene& scene) {
       for (const Vec3& p : mesh.positions) sphere.radius = std::max(sphere.radius, (p - sphere.centre).norm());
   return sphere;
 }
+
+BoundingSphere scene_bounds(const MrScene& scene) {
+  Eigen::AlignedBox3f box;
+  for (const TriangleMesh& mesh : scene.meshes)
+    for (const Vec3& p : mesh.positions) box.extend(p);
+  BoundingSphere sphere;
+  if (box.isEmpty()) return sphere;
+  sphere.centre = box.center();
+  sphere.radius = 0.5f * box.diagonal().norm() * 1.01f + 1e-3f;
+  return sphere;
+}
+
+/// Where a directional light's parallel rays start: a disk facing the light, outside the scene.
+struct Disk {
+  Vec3 centre, t, b;
+  float radius = 0.f;
+
+  Disk(const Vec3& centre_, const Vec3& towards_light, float radius_) : centre(centre_), radius(radius_) {
+    orthonormal_basis(towards_light, t, b);
+  }
+  [[nodiscard]] float area() const { return kPi * radius * radius; }
+  [[nodiscard]] Vec3 sample(float u1, float u2) const {
+    const float r = radius * std::sqrt(u1), phi = 2.f * kPi * u2;
+    return centre + r * (std::cos(phi) * t + std::sin(phi) * b);
+  }
+  [[nodiscard]] bool contains(const Vec3& p) const { return (p - centre).squaredNorm() < radius * radius; }
+};
 
 std::optional<Cone> cone_towards(const BoundingSphere& sphere, const Vec3& from) {
   if (sphere.radius < 0.f) return std::nullopt;
@@ -154,10 +181,15 @@ class VplTracer {
 std::vector<int> light_budget(const MrScene& scene, const VplOptions& options) {
   std::vector<double> weight;
   double total = 0.0;
+  const BoundingSphere bounds = scene_bounds(scene);
   for (const MrLight& light : scene.lights) {
     double w = 0.0;
+    // Power: intensity times solid angle, or for a directional light irradiance times the area
+    // of the scene's cross-section.
+    const float extent = light.kind == LightKind::Directional ? kPi * std::max(bounds.radius, 0.f) * std::max(bounds.radius, 0.f)
+                                                              : emission_solid_angle(light);
     if (emits_vpls(light))
-      w = options.budget == VplBudget::Equal ? 1.0 : std::max(0.f, luminance(light.intensity)) * emission_solid_angle(light);
+      w = options.budget == VplBudget::Equal ? 1.0 : std::max(0.f, luminance(light.intensity)) * extent;
     weight.push_back(w);
     total += w;
   }
@@ -177,6 +209,34 @@ std::vector<int> light_budget(const MrScene& scene, const VplOptions& options) {
   return count;
 }
 
+/// A directional light's n samples: parallel rays from a disk facing the light that covers the
+/// scene (flux E area / n each), with the virtual-focus share drawn from the smaller disk over
+/// the virtual objects' bounding sphere and the rest rejected there (as for the cone above).
+void emit_directional(const MrLight& light, std::size_t index, int n, const BoundingSphere& bounds,
+                      const BoundingSphere& virtual_sphere, const VplOptions& options, VplTracer& tracer) {
+  if (n <= 0 || bounds.radius <= 0.f) return;
+  const Vec3 towards_light = light.direction.normalized();
+  const Vec3 plane_point = bounds.centre + 2.f * bounds.radius * towards_light;
+  const Disk scene_disk(plane_point, towards_light, bounds.radius);
+  std::optional<Disk> focus;
+  if (options.virtual_share > 0.f && virtual_sphere.radius > 0.f && n >= 2)
+    focus.emplace(virtual_sphere.centre + towards_light * (plane_point - virtual_sphere.centre).dot(towards_light),
+                  towards_light, virtual_sphere.radius);
+  const int n_focus = focus ? std::max(1, static_cast<int>(std::lround(options.virtual_share * n))) : 0;
+  const int n_rest = n - n_focus;
+  for (int i = 0; i < n; ++i) {
+    Pcg32 rng = Pcg32::for_sample(options.seed, index, static_cast<std::uint64_t>(i));
+    const bool in_focus = i < n_focus;
+    const Disk& disk = in_focus ? *focus : scene_disk;
+    const int stratum_count = in_focus ? n_focus : n_rest;
+    const float u1 = (static_cast<float>(in_focus ? i : i - n_focus) + rng.uniform()) / static_cast<float>(stratum_count);
+    const Vec3 origin = disk.sample(u1, rng.uniform());
+    if (!in_focus && focus && focus->contains(origin)) continue;  // the focus stratum covers it
+    tracer.emit(origin, -towards_light, light.intensity * (disk.area() / static_cast<float>(stratum_count)), true,
+                light.real, 1, rng);
+  }
+}
+
 }  // namespace
 
 std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options) {
@@ -187,8 +247,13 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
   if (options.virtual_share < 0.f || options.virtual_share >= 1.f) throw Error("the virtual VPL share must be in [0, 1)");
   const std::vector<int> budget = light_budget(scene, options);
   const BoundingSphere virtual_sphere = virtual_bounds(scene);
+  const BoundingSphere bounds = scene_bounds(scene);
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     const MrLight& light = scene.lights[l];
+    if (light.kind == LightKind::Directional) {
+      emit_directional(light, l, budget[l], bounds, virtual_sphere, options, vpl_tracer);
+      continue;
+    }
     const std::optional<Cone> cone = options.virtual_share > 0.f ? cone_towards(virtual_sphere, light.position) : std::nullopt;
     const int n = budget[l];
     const int n_cone = cone && n >= 2 ? std::max(1, static_cast<int>(std::lround(options.virtual_share * n))) : 0;

@@ -162,6 +162,29 @@ TEST(Vpls, FirstBounceFluxAddsUpToTheLightsPowerAndFollowsTheBudget) {
   EXPECT_THROW((void)generate_vpls(scene, tracer, VplOptions{-1}), Error);
 }
 
+TEST(Vpls, DirectionalLightDeliversItsIrradianceTimesTheLitArea) {
+  MrScene scene = floor_scene(Eigen::Vector3f::Constant(0.8f), {0.f, 0.f, 2.f}, 0.f);
+  scene.lights.clear();
+  MrLight sun;
+  sun.kind = LightKind::Directional;
+  sun.direction = {0.f, 0.f, 1.f};
+  sun.intensity = {2.f, 1.f, 0.5f};  // W/m^2 on a surface facing it
+  scene.lights.push_back(sun);
+  const RayTracer tracer(scene);
+  VplOptions options;
+  options.count = 4000;
+  options.virtual_share = 0.f;
+  Eigen::Vector3d flux = Eigen::Vector3d::Zero();
+  for (const Vpl& vpl : generate_vpls(scene, tracer, options)) {
+    EXPECT_NEAR(vpl.position.z(), 0.f, 1e-4f);
+    EXPECT_NEAR(vpl.incident.z(), 1.f, 1e-4f) << "the light came from above";
+    flux += vpl.flux.cast<double>();
+  }
+  // The 4 m x 4 m floor intercepts irradiance x 16 m^2.
+  EXPECT_NEAR(flux.x(), 32.0, 32.0 * 0.03);
+  EXPECT_NEAR(flux.z(), 8.0, 8.0 * 0.03);
+}
+
 TEST(Vpls, VirtualFocusPutsManyMoreVplsOnVirtualObjectsWithoutChangingTheirFlux) {
   const MrScene scene = cube_scene();
   const RayTracer tracer(scene);

@@ -59,7 +59,9 @@ struct VplOptions {
   std::uint64_t seed = 1;
 };
 
-/// VPLs of the point and spot lights of `scene` (directional lights light directly only).
+/// VPLs of every light of `scene`. A directional light (the environment lights of the light-
+/// extraction stage) shoots parallel rays from a disk facing it that covers the scene's bounding
+/// sphere, each carrying irradiance x disk area / samples.
 [[nodiscard]] std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options);
 
 }  // namespace relight::render
