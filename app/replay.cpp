@@ -24,6 +24,7 @@
 #include "relight/vk/backend.h"
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
+#include "relight/brdf/brdf_preview.h"
 #include "relight/brdf/brdf_stages.h"
 #include "relight/render/dir_stage.h"
 #include "relight/render/scene_lights.h"
@@ -136,6 +137,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   FrameGraph& graph = *pipeline.graph;
   graph.emplace<ConstantStage<LightSet>>("lights", measured);
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
+  graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
   render::DirStageOptions dir;
   dir.vpls.count = options.vpls;
   dir.tone_map.exposure = options.exposure;
@@ -194,7 +196,10 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
     writer->add_depth("depth_smoothed");
     if (method2) writer->add_depth("depth_filtered");
     writer->add_normals("normals");
-    if (pipeline.renders) writer->add_color("composite");
+    if (pipeline.renders) {
+      writer->add_color("composite");
+      writer->add_color("brdf_preview");
+    }
     if (pipeline.renders && options.write_buffers) {
       writer->add_radiance("L_rv");
       writer->add_radiance("L_r");
