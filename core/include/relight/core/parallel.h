@@ -1,8 +1,8 @@
 #pragma once
-// Row-parallel loops for per-pixel CPU stages and the synthetic renderer. Chunks of `grain`
-// rows are handed out through an atomic counter, so uneven rows (a ray caster's sky against its
-// table) balance across threads; plain std::threads are enough at this size. The result must
-// not depend on the schedule: each row (or chunk) writes only its own outputs.
+// Row-parallel loops for per-pixel CPU stages and the synthetic renderer, on TBB's thread pool:
+// chunks of `grain` rows are scheduled by work stealing, so uneven rows (a ray caster's sky
+// against its table) balance across threads. The result must not depend on the schedule: each
+// row (or chunk) writes only its own outputs.
 #include <functional>
 
 namespace relight {
@@ -11,9 +11,9 @@ namespace relight {
 [[nodiscard]] int worker_count(int requested);
 
 /// Calls work(row_begin, row_end) for disjoint ranges covering [0, rows), on up to `threads`
-/// threads (0 = worker_count(0)); the calling thread works too. With fewer than two chunks it
-/// all runs on the calling thread. The first exception thrown by `work` is rethrown here after
-/// every thread has stopped (the other threads stop taking new chunks).
+/// threads (0 = worker_count(0)); the calling thread works too. With one thread or fewer than
+/// two chunks it all runs on the calling thread. An exception thrown by `work` is rethrown here
+/// once the other chunks have stopped (chunks not yet started are cancelled).
 void parallel_rows(int rows, int threads, const std::function<void(int, int)>& work, int grain = 16);
 
 /// parallel_rows calling body(row) once per row.
