@@ -1,5 +1,7 @@
 #include "relight/render/mr_scene.h"
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 
 #include "relight/core/error.h"
@@ -43,6 +45,17 @@ void MrScene::validate() const {
     if (!material.kd.allFinite() || !std::isfinite(material.ks) || !std::isfinite(material.n) || material.n < 0.f ||
         !material.emission.allFinite())
       throw Error("material '" + material.name + "' has invalid Phong parameters");
+}
+
+BoundingSphere bounding_sphere(const MrScene& scene) {
+  Eigen::AlignedBox3f box;
+  for (const TriangleMesh& mesh : scene.meshes)
+    for (const Eigen::Vector3f& p : mesh.positions) box.extend(p);
+  BoundingSphere sphere;
+  if (box.isEmpty()) return sphere;
+  sphere.centre = box.center();
+  sphere.radius = 0.5f * box.diagonal().norm() * 1.01f + 1e-3f;
+  return sphere;
 }
 
 }  // namespace relight::render

@@ -57,15 +57,6 @@ ShadowView orthographic_view(const Vec3& towards_light, const Vec3& centre, floa
   return {m, Eigen::Vector4f(u.x(), u.y(), u.z(), 0.f), 2.f * radius / static_cast<float>(tile)};
 }
 
-/// Centre and radius of a sphere around every vertex of the scene.
-std::pair<Vec3, float> bounding_sphere(const MrScene& scene) {
-  Eigen::AlignedBox3f box;
-  for (const TriangleMesh& mesh : scene.meshes)
-    for (const Vec3& p : mesh.positions) box.extend(p);
-  if (box.isEmpty()) return {Vec3::Zero(), 1.f};
-  return {box.center(), std::max(0.5f * box.diagonal().norm() * 1.01f, 1e-3f)};
-}
-
 int cube_face(const Vec3& from_light) {
   int axis = 0;
   from_light.cwiseAbs().maxCoeff(&axis);
@@ -78,7 +69,9 @@ ShadowLayout plan_shadow_views(const MrScene& scene, int tile) {
   if (tile < 16) throw Error("the shadow-map tile must be at least 16 texels");
   ShadowLayout layout;
   layout.tile = tile;
-  const auto [centre, radius] = bounding_sphere(scene);
+  const BoundingSphere bounds = bounding_sphere(scene);
+  const Vec3 centre = bounds.radius > 0.f ? bounds.centre : Vec3::Zero();
+  const float radius = bounds.radius > 0.f ? bounds.radius : 1.f;
   for (const MrLight& light : scene.lights) {
     const auto first = static_cast<std::uint32_t>(layout.views.size());
     const float spot_half_angle = std::acos(std::clamp(light.cos_outer, -1.f, 1.f)) * 1.02f;

@@ -63,11 +63,6 @@ struct Cone {
   }
 };
 
-struct BoundingSphere {
-  Vec3 centre = Vec3::Zero();
-  float radius = -1.f;  ///< negative: no virtual geometry
-};
-
 BoundingSphere virtual_bounds(const MrScene& scene) {
   Eigen::AlignedBox3f box;
   for (const TriangleMesh& mesh : scene.meshes)
@@ -79,17 +74,6 @@ BoundingSphere virtual_bounds(const MrScene& scene) {
   for (const TriangleMesh& mesh : scene.meshes)
     if (!mesh.real)
       for (const Vec3& p : mesh.positions) sphere.radius = std::max(sphere.radius, (p - sphere.centre).norm());
-  return sphere;
-}
-
-BoundingSphere scene_bounds(const MrScene& scene) {
-  Eigen::AlignedBox3f box;
-  for (const TriangleMesh& mesh : scene.meshes)
-    for (const Vec3& p : mesh.positions) box.extend(p);
-  BoundingSphere sphere;
-  if (box.isEmpty()) return sphere;
-  sphere.centre = box.center();
-  sphere.radius = 0.5f * box.diagonal().norm() * 1.01f + 1e-3f;
   return sphere;
 }
 
@@ -178,10 +162,9 @@ class VplTracer {
 };
 
 /// Light samples per light: equal shares, or shares by emitted power (luminance x solid angle).
-std::vector<int> light_budget(const MrScene& scene, const VplOptions& options) {
+std::vector<int> light_budget(const MrScene& scene, const BoundingSphere& bounds, const VplOptions& options) {
   std::vector<double> weight;
   double total = 0.0;
-  const BoundingSphere bounds = scene_bounds(scene);
   for (const MrLight& light : scene.lights) {
     double w = 0.0;
     // Power: intensity times solid angle, or for a directional light irradiance times the area
@@ -245,9 +228,9 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
   std::vector<Vpl> vpls;
   VplTracer vpl_tracer(scene, tracer, options, vpls);
   if (options.virtual_share < 0.f || options.virtual_share >= 1.f) throw Error("the virtual VPL share must be in [0, 1)");
-  const std::vector<int> budget = light_budget(scene, options);
+  const BoundingSphere bounds = bounding_sphere(scene);
+  const std::vector<int> budget = light_budget(scene, bounds, options);
   const BoundingSphere virtual_sphere = virtual_bounds(scene);
-  const BoundingSphere bounds = scene_bounds(scene);
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     const MrLight& light = scene.lights[l];
     if (light.kind == LightKind::Directional) {

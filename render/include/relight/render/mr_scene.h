@@ -65,6 +65,17 @@ struct Environment {
   Eigen::Vector3f radiance{0.f, 0.f, 0.f};
 };
 
+/// A sphere around geometry; radius < 0 when there is none.
+struct BoundingSphere {
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();
+  float radius = -1.f;
+};
+
+struct MrScene;
+
+/// A sphere around every vertex of `scene` (the box's half diagonal, 1 % + 1 mm larger).
+[[nodiscard]] BoundingSphere bounding_sphere(const MrScene& scene);
+
 struct MrScene {
   std::vector<PhongMaterial> materials;
   std::vector<TriangleMesh> meshes;
