@@ -83,7 +83,7 @@ void DirStage::run(StageContext& context) {
   camera.intrinsics.width = width;
   camera.intrinsics.height = height;
   DifferentialImages images;
-  GBuffer gbuffer;
+  GBuffer cpu_gbuffer;
   if (context_) {
     if (!renderer_ || renderer_size_ != std::pair{width, height}) {
       renderer_ = std::make_unique<DirRendererVk>(*context_, width, height);
@@ -91,12 +91,12 @@ void DirStage::run(StageContext& context) {
     }
     renderer_->set_scene(scene_, options_.renderer);
     images = renderer_->render(camera, vpls, options_.renderer);
-    if (options_.temporal_smoothing) gbuffer = renderer_->last_gbuffer();
   } else {
-    images = render_dir_cpu(scene_, camera, vpls, options_.renderer, &gbuffer);
+    images = render_dir_cpu(scene_, camera, vpls, options_.renderer, &cpu_gbuffer);
   }
   if (options_.temporal_smoothing)
-    history_ = smooth_indirect(images, gbuffer, camera, history_ ? &*history_ : nullptr, options_.temporal);
+    history_ = smooth_indirect(images, context_ ? renderer_->last_gbuffer() : cpu_gbuffer, camera,
+                               history_ ? &*history_ : nullptr, options_.temporal);
   context.get(composite_) =
       differential_composite(color, images.real_virtual, images.real, images.virtual_coverage, options_.tone_map);
   context.get(real_virtual_) = std::move(images.real_virtual);

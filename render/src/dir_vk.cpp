@@ -136,6 +136,7 @@ struct DirRendererVk::Impl {
   DirVkTimings timings;
   std::uint32_t vpl_count = 0;
   std::vector<float> cpu_ism_atlas;  // of the last render when it shaded on the CPU
+  std::optional<GBuffer> last_gbuffer;  // read back on demand, dropped by the next render
 };
 
 DirRendererVk::DirRendererVk(vk::VulkanContext& context, int width, int height) {
@@ -167,6 +168,7 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
   if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
   d.upload(d.vpls, pack_vpls(vpls));
   d.vpl_count = static_cast<std::uint32_t>(vpls.size());
+  d.last_gbuffer.reset();
 
   const Eigen::Vector3f centre = camera.camera_to_world.translation().cast<float>();
   const Eigen::Vector3f environment = d.scene->environment.radiance;
@@ -252,10 +254,14 @@ const DirVkTimings& DirRendererVk::last_timings() const { return impl_->timings;
 const ShadowLayout& DirRendererVk::shadow_layout() const { return impl_->layout; }
 const IsmPointPools& DirRendererVk::ism_points() const { return impl_->points; }
 
-GBuffer DirRendererVk::last_gbuffer() const {
-  std::vector<float> data(impl_->gbuffer_buffer.size_bytes() / sizeof(float));
-  impl_->context.transfer().download(impl_->gbuffer_buffer, std::as_writable_bytes(std::span(data)));
-  return GBufferVk::unpack(data, impl_->width, impl_->height);
+const GBuffer& DirRendererVk::last_gbuffer() const {
+  // Read back once per render: the CPU backend shades from it and the DIR stage smooths with it.
+  if (!impl_->last_gbuffer) {
+    std::vector<float> data(impl_->gbuffer_buffer.size_bytes() / sizeof(float));
+    impl_->context.transfer().download(impl_->gbuffer_buffer, std::as_writable_bytes(std::span(data)));
+    impl_->last_gbuffer = GBufferVk::unpack(data, impl_->width, impl_->height);
+  }
+  return *impl_->last_gbuffer;
 }
 
 std::vector<float> DirRendererVk::last_shadow_atlas() const {

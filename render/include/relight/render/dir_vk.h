@@ -76,7 +76,8 @@ class DirRendererVk {
   [[nodiscard]] const DirVkTimings& last_timings() const;
 
   // The intermediate results of the last render, read back (for tests and debugging views).
-  [[nodiscard]] GBuffer last_gbuffer() const;
+  /// The G-buffer of the last render; valid until the next render.
+  [[nodiscard]] const GBuffer& last_gbuffer() const;
   [[nodiscard]] std::vector<float> last_shadow_atlas() const;
   [[nodiscard]] std::vector<float> last_ism_atlas() const;
   [[nodiscard]] const ShadowLayout& shadow_layout() const;
