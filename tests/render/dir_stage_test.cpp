@@ -11,39 +11,11 @@
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
+#include "synthetic_frame_stage.h"
 #include "relight/vk/transfer.h"
 
 namespace relight::render {
 namespace {
-
-/// Writes one synthetic frame as the reconstruct stages would: colour, camera-frame positions
-/// and normals, and the pose.
-class SyntheticFrameStage final : public Stage {
- public:
-  SyntheticFrameStage(PinholeIntrinsics intrinsics, Pose pose) : intrinsics_(intrinsics), pose_(pose) {}
-  [[nodiscard]] std::string name() const override { return "synthetic_frame"; }
-  void declare(StageBuilder& builder) override {
-    frame_ = builder.write<FrameInfo>("frame");
-    color_ = builder.write<ColorImage>("color");
-    positions_ = builder.write<PositionMap>("positions");
-    normals_ = builder.write<NormalMap>("normals");
-  }
-  void run(StageContext& context) override {
-    const synth::RenderedFrame truth = synth::render_frame(synth::default_indoor_scene(), intrinsics_, pose_);
-    context.get(frame_) = FrameInfo{0, 0.0, pose_, intrinsics_};
-    context.get(color_) = synth::encode_color(truth.radiance);
-    context.get(positions_) = positions_from_depth(truth.depth, intrinsics_);
-    context.get(normals_) = truth.normals;
-  }
-
- private:
-  PinholeIntrinsics intrinsics_;
-  Pose pose_;
-  Write<FrameInfo> frame_;
-  Write<ColorImage> color_;
-  Write<PositionMap> positions_;
-  Write<NormalMap> normals_;
-};
 
 class DirStageTest : public relight::test::VulkanTest {};
 
@@ -56,7 +28,7 @@ struct StageRun {
 StageRun run_stage(vk::VulkanContext* context) {
   const PinholeIntrinsics intrinsics{131.25, 131.25, 79.5, 59.5, 160, 120};
   FrameGraph graph(context ? &context->transfer() : nullptr);
-  graph.emplace<SyntheticFrameStage>(intrinsics, synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75}));
+  graph.emplace<test::SyntheticFrameStage>(intrinsics, synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75}));
   DirSceneContent content;
   content.lights = scene_from_synth(synth::default_indoor_scene()).lights;
   content.objects.emplace_back(make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));

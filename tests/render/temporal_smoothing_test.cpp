@@ -5,8 +5,6 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include "../reconstruct/vulkan_test_env.h"
 #include "relight/render/dir_stage.h"
 #include "relight/render/procedural_models.h"
@@ -15,6 +13,7 @@
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
+#include "synthetic_frame_stage.h"
 
 namespace relight::render {
 namespace {
@@ -77,46 +76,14 @@ TEST(TemporalSmoothing, TakesTheNewValueAtDisocclusionsAndWhereRealAndVirtualSwa
   EXPECT_LT(covered.indirect_real_virtual(3, 4).x, 0.6f) << "its neighbour still blends";
 }
 
-/// Synthetic frames from a static camera with fresh depth noise every frame (as a Kinect gives).
-class NoisyFrameStage final : public Stage {
- public:
-  NoisyFrameStage(PinholeIntrinsics intrinsics, Pose pose)
-      : intrinsics_(intrinsics), pose_(pose), truth_(synth::render_frame(synth::default_indoor_scene(), intrinsics, pose)) {}
-  [[nodiscard]] std::string name() const override { return "noisy_frame"; }
-  void declare(StageBuilder& builder) override {
-    frame_ = builder.write<FrameInfo>("frame");
-    color_ = builder.write<ColorImage>("color");
-    positions_ = builder.write<PositionMap>("positions");
-    normals_ = builder.write<NormalMap>("normals");
-  }
-  void run(StageContext& context) override {
-    std::mt19937 random(static_cast<unsigned>(context.frame_index()) + 1u);
-    DepthMap depth = truth_.depth;
-    for (float& z : depth.pixels())
-      if (z > 0.f) z += std::normal_distribution<float>(0.f, 0.0015f * z * z)(random);
-    context.get(frame_) = FrameInfo{context.frame_index(), 0.0, pose_, intrinsics_};
-    context.get(color_) = synth::encode_color(truth_.radiance);
-    context.get(positions_) = positions_from_depth(depth, intrinsics_);
-    context.get(normals_) = truth_.normals;
-  }
-
- private:
-  PinholeIntrinsics intrinsics_;
-  Pose pose_;
-  synth::RenderedFrame truth_;
-  Write<FrameInfo> frame_;
-  Write<ColorImage> color_;
-  Write<PositionMap> positions_;
-  Write<NormalMap> normals_;
-};
-
 class TemporalSmoothingStageTest : public relight::test::VulkanTest {};
 
 /// Mean frame-to-frame change of the indirect light (real pixels, frames 4-8) of the DIR stage.
 double flicker(vk::VulkanContext& context, bool smoothing) {
   const PinholeIntrinsics intrinsics{131.25, 131.25, 79.5, 59.5, 160, 120};
   FrameGraph graph(&context.transfer());
-  graph.emplace<NoisyFrameStage>(intrinsics, synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75}));
+  // A static camera with fresh Kinect-like depth noise every frame.
+  graph.emplace<test::SyntheticFrameStage>(intrinsics, synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75}), 0.0015f);
   DirSceneContent content;
   content.lights = scene_from_synth(synth::default_indoor_scene()).lights;
   content.objects.emplace_back(make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));

@@ -1,0 +1,52 @@
+#pragma once
+// A source stage for the DIR-stage tests: one view of the synthetic scene, written every frame
+// as the reconstruct stages would - colour, camera-frame positions and normals, and the pose -
+// optionally with fresh Kinect-like depth noise (sigma = depth_noise * z^2) in every frame.
+#include <random>
+
+#include "relight/core/frame_graph.h"
+#include "relight/core/rgbd_frame.h"
+#include "relight/render/depth_mesh.h"
+#include "relight/synth/raycast.h"
+
+namespace relight::render::test {
+
+class SyntheticFrameStage final : public Stage {
+ public:
+  SyntheticFrameStage(PinholeIntrinsics intrinsics, Pose pose, float depth_noise = 0.f)
+      : intrinsics_(intrinsics),
+        pose_(pose),
+        depth_noise_(depth_noise),
+        truth_(synth::render_frame(synth::default_indoor_scene(), intrinsics, pose)) {}
+  [[nodiscard]] std::string name() const override { return "synthetic_frame"; }
+  void declare(StageBuilder& builder) override {
+    frame_ = builder.write<FrameInfo>("frame");
+    color_ = builder.write<ColorImage>("color");
+    positions_ = builder.write<PositionMap>("positions");
+    normals_ = builder.write<NormalMap>("normals");
+  }
+  void run(StageContext& context) override {
+    DepthMap depth = truth_.depth;
+    if (depth_noise_ > 0.f) {
+      std::mt19937 random(static_cast<unsigned>(context.frame_index()) + 1u);
+      for (float& z : depth.pixels())
+        if (z > 0.f) z += std::normal_distribution<float>(0.f, depth_noise_ * z * z)(random);
+    }
+    context.get(frame_) = FrameInfo{context.frame_index(), 0.0, pose_, intrinsics_};
+    context.get(color_) = synth::encode_color(truth_.radiance);
+    context.get(positions_) = positions_from_depth(depth, intrinsics_);
+    context.get(normals_) = truth_.normals;
+  }
+
+ private:
+  PinholeIntrinsics intrinsics_;
+  Pose pose_;
+  float depth_noise_;
+  synth::RenderedFrame truth_;
+  Write<FrameInfo> frame_;
+  Write<ColorImage> color_;
+  Write<PositionMap> positions_;
+  Write<NormalMap> normals_;
+};
+
+}  // namespace relight::render::test
