@@ -223,6 +223,11 @@ RgbdFrame TumSequence::load(std::size_t i) const {
                 std::to_string(frame.depth.height()) + " but its colour image is " + std::to_string(frame.color.width()) +
                 "x" + std::to_string(frame.color.height()));
   }
+  // A frame without any depth has no geometry to reconstruct or render into; most likely a
+  // sensor that was covered or a file written by mistake.
+  if (std::none_of(frame.depth.pixels().begin(), frame.depth.pixels().end(), is_valid_depth)) {
+    throw Error(entry.depth_file.string() + ": no valid depth (every pixel is 0)");
+  }
   if (frame.depth.width() != intrinsics_.width || frame.depth.height() != intrinsics_.height) {
     throw Error(entry.depth_file.string() + ": image size " + std::to_string(frame.depth.width()) + "x" +
                 std::to_string(frame.depth.height()) + " does not match the intrinsics (" +

@@ -182,6 +182,12 @@ TEST_F(DamagedSequence, EightBitDepth) {
   EXPECT_NE(message.find("8-bit"), std::string::npos) << message;
 }
 
+TEST_F(DamagedSequence, DepthWithoutAnyValidPixel) {
+  write_depth_png(folder_ / "depth" / "1305031229.564442.png", DepthMap(640, 480, 0.f), 5000.0);
+  const std::string message = open_error();
+  EXPECT_NE(message.find("1305031229.564442.png: no valid depth"), std::string::npos) << message;
+}
+
 TEST_F(DamagedSequence, NothingAssociates) {
   replace_line("depth.txt", 4, "1305031200.0 depth/1305031229.528784.png");
   replace_line("depth.txt", 5, "1305031200.1 depth/1305031229.564442.png");

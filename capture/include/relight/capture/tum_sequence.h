@@ -11,8 +11,8 @@
 // Intrinsics, first that applies: TumOptions::intrinsics, "intrinsics" in scene.json beside the
 // lists (relight synth writes it), the folder name (freiburg1/2/3 presets), Kinect v1 defaults.
 //
-// Every problem (missing folder or list, malformed or unsorted line, missing/corrupt/8-bit image)
-// throws relight::Error naming the file and line.
+// Every problem (missing folder or list, malformed or unsorted line, missing/corrupt/8-bit image,
+// a depth image without one valid pixel) throws relight::Error naming the file and line.
 #include <filesystem>
 #include <functional>
 #include <optional>

@@ -1,0 +1,56 @@
+#pragma once
+// The good inputs that the robustness rows break: a copy of the committed TUM slice (4 frames,
+// 640x480), a small synthetic sequence made once per test run, and file surgery on them.
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bounded_run.h"
+#include "relight/core/atomic_file.h"
+#include "temp_dir.h"
+
+namespace relight::robustness {
+
+inline const std::filesystem::path kData = RELIGHT_TEST_DATA;
+
+/// data/tum_fr1_rpy copied to `folder` (which must not exist yet).
+inline std::filesystem::path copy_of_sample(const std::filesystem::path& folder) {
+  std::filesystem::copy(kData / "tum_fr1_rpy", folder, std::filesystem::copy_options::recursive);
+  return folder;
+}
+
+/// The sample's frame files in list order (rgb/... or depth/...).
+inline std::vector<std::filesystem::path> sample_files(const std::filesystem::path& folder, const std::string& kind) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder / kind)) files.push_back(entry.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+/// A 2-frame `relight synth` sequence (static camera, exact depth, with probe.hdr, scene.json and
+/// its AprilTag), made once; tests copy it before changing anything.
+inline const std::filesystem::path& synthetic_sequence() {
+  static TempDir dir;
+  static const std::filesystem::path sequence = [] {
+    const auto path = dir.path() / "synth";
+    const auto made = run_relight(
+        {"synth", "--quiet", "--frames", "2", "--trajectory", "static", "--noise", "none", "--no-gt", "--out", path.string()});
+    if (made.exit_code != 0) throw std::runtime_error("relight synth failed: " + made.err);
+    return path;
+  }();
+  return sequence;
+}
+
+inline std::filesystem::path copy_of_synthetic(const std::filesystem::path& folder) {
+  std::filesystem::copy(synthetic_sequence(), folder, std::filesystem::copy_options::recursive);
+  return folder;
+}
+
+/// Keeps the first `fraction` of the file's bytes.
+inline void truncate_file(const std::filesystem::path& file, double fraction) {
+  const std::string bytes = read_text_file(file);
+  write_file_atomically(file, std::string_view(bytes).substr(0, static_cast<std::size_t>(bytes.size() * fraction)));
+}
+
+}  // namespace relight::robustness
