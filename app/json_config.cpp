@@ -11,7 +11,7 @@ std::string scalar_text(const nlohmann::json& value) {
   if (value.is_string()) return value.get<std::string>();
   if (value.is_boolean()) return value.get<bool>() ? "true" : "false";
   if (value.is_number() || value.is_null()) return value.dump();
-  throw CLI::ConversionError("config value " + value.dump() + " must be a string, number, boolean or array of those");
+  throw CLI::ConfigError("value " + value.dump() + " must be a string, number, boolean or array of those");
 }
 
 void flatten(const nlohmann::json& object, std::vector<std::string>& parents, std::vector<CLI::ConfigItem>& items) {
@@ -56,9 +56,9 @@ std::vector<CLI::ConfigItem> JsonConfig::from_config(std::istream& input) const 
   try {
     json = nlohmann::json::parse(input);
   } catch (const nlohmann::json::exception& e) {
-    throw CLI::ConversionError(std::string("config file is not valid JSON: ") + e.what());
+    throw CLI::ConfigError(std::string("not valid JSON: ") + e.what());
   }
-  if (!json.is_object()) throw CLI::ConversionError("config file must hold a JSON object");
+  if (!json.is_object()) throw CLI::ConfigError("must hold a JSON object");
   std::vector<CLI::ConfigItem> items;
   std::vector<std::string> parents;
   const auto selected = root_->get_subcommands();
