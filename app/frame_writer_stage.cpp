@@ -8,9 +8,7 @@
 namespace relight::app {
 
 void FrameWriterStage::declare(StageBuilder& builder) {
-  for (const auto& name : color_names_) colors_.push_back(builder.read<ColorImage>(name));
-  for (const auto& name : depth_names_) depths_.push_back(builder.read<DepthMap>(name));
-  for (const auto& name : normal_names_) normals_.push_back(builder.read<NormalMap>(name));
+  previews_.declare(builder);
   for (const auto& name : radiance_names_) radiances_.push_back(builder.read<RadianceImage>(name));
 }
 
@@ -27,15 +25,9 @@ void FrameWriterStage::run(StageContext& context) {
     std::filesystem::create_directories(folder_, ec);
     if (ec) throw Error("cannot create " + folder_.string() + ": " + ec.message());
   }
-  for (std::size_t i = 0; i < colors_.size(); ++i) {
-    write_color(file_for(context.frame_index(), color_names_[i]), context.get(colors_[i]));
-  }
-  for (std::size_t i = 0; i < depths_.size(); ++i) {
-    write_color(file_for(context.frame_index(), depth_names_[i]), depth_preview(context.get(depths_[i])));
-  }
-  for (std::size_t i = 0; i < normals_.size(); ++i) {
-    write_color(file_for(context.frame_index(), normal_names_[i]), normal_preview(context.get(normals_[i])));
-  }
+  previews_.for_each(context, [&](const std::string& buffer, const ColorImage& picture) {
+    write_color(file_for(context.frame_index(), buffer), picture);
+  });
   for (std::size_t i = 0; i < radiances_.size(); ++i) {
     write_radiance(file_for(context.frame_index(), radiance_names_[i], ".exr"), context.get(radiances_[i]));
   }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "buffer_previews.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
 
@@ -15,10 +16,10 @@ namespace relight::app {
 class FrameWriterStage final : public Stage {
  public:
   explicit FrameWriterStage(std::filesystem::path folder) : folder_(std::move(folder)) {}
-  void add_color(std::string buffer) { color_names_.push_back(std::move(buffer)); }
-  void add_depth(std::string buffer) { depth_names_.push_back(std::move(buffer)); }
+  void add_color(std::string buffer) { previews_.add(std::move(buffer), BufferPreviews::Kind::Color); }
+  void add_depth(std::string buffer) { previews_.add(std::move(buffer), BufferPreviews::Kind::Depth); }
   /// A NormalMap, written as relight::normal_preview's colour coding.
-  void add_normals(std::string buffer) { normal_names_.push_back(std::move(buffer)); }
+  void add_normals(std::string buffer) { previews_.add(std::move(buffer), BufferPreviews::Kind::Normals); }
   /// A RadianceImage, written as OpenEXR (linear, full range).
   void add_radiance(std::string buffer) { radiance_names_.push_back(std::move(buffer)); }
 
@@ -32,12 +33,7 @@ class FrameWriterStage final : public Stage {
                                                const char* extension = ".png") const;
 
   std::filesystem::path folder_;
-  std::vector<std::string> color_names_;
-  std::vector<std::string> depth_names_;
-  std::vector<Read<ColorImage>> colors_;
-  std::vector<Read<DepthMap>> depths_;
-  std::vector<std::string> normal_names_;
-  std::vector<Read<NormalMap>> normals_;
+  BufferPreviews previews_;
   std::vector<std::string> radiance_names_;
   std::vector<Read<RadianceImage>> radiances_;
 };

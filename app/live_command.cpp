@@ -130,7 +130,7 @@ int run_live(const LiveOptions& options) {
   report["dropped_frames"] = dropped;
   report["stopped_by"] = !failure.empty() ? "error: " + failure : InterruptGuard::interrupted() ? "interrupt" : "end";
   if (pipeline.markers) report["marker_pose"] = pipeline.markers->summary();
-  write_file_atomically(options.replay.out / "report.json", report.dump(2) + "\n");
+  write_reports(options.replay.out, "relight live: " + description, graph, report, pipeline.report);
   if (!quiet) {
     std::cerr << "relight live: " << graph.frames_run() << " frames in " << seconds << " s ("
               << (seconds > 0 ? static_cast<double>(graph.frames_run()) / seconds : 0.0) << " fps), " << dropped

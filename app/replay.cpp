@@ -29,6 +29,7 @@
 #include "relight/render/dir_stage.h"
 #include "relight/render/scene_lights.h"
 #include "report.h"
+#include "report_collector_stage.h"
 #include "video_writer_stage.h"
 
 namespace relight::app {
@@ -158,6 +159,22 @@ void add_marker_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
   pipeline.markers = &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt");
 }
 
+void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, bool method2) {
+  using Kind = BufferPreviews::Kind;
+  auto collector = std::make_unique<ReportCollectorStage>(total_frames);
+  collector->add_picture("color", Kind::Color);
+  collector->add_picture(method2 ? "depth_filtered" : "depth_smoothed", Kind::Depth);
+  collector->add_picture("normals", Kind::Normals);
+  if (pipeline.renders) {
+    collector->add_picture("brdf_preview", Kind::Color);
+    collector->add_picture("composite", Kind::Color);
+    collector->collect_materials("materials");
+    collector->collect_lights("lights");
+  }
+  pipeline.report = collector.get();
+  pipeline.graph->add(std::move(collector));
+}
+
 }  // namespace
 
 ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options) {
@@ -175,6 +192,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
                                       : " (no Vulkan device in use)");
 
   FrameGraph& graph = *pipeline.graph;
+  const std::int64_t total_frames = source->size_hint();
   graph.emplace<SourceStage>(std::move(source));
   graph.add(make_depth_box_filter_stage(per_pixel, pipeline.vulkan.get()));
   // Geometry (positions + normals) runs on the CPU: its Vulkan versions are not written yet.
@@ -206,6 +224,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
     }
     graph.add(std::move(writer));
   }
+  add_report_collector(pipeline, total_frames, method2);
   return pipeline;
 }
 
@@ -234,10 +253,10 @@ int run_replay(const ReplayOptions& options) {
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
   if (pipeline.markers) report["marker_pose"] = pipeline.markers->summary();
-  write_file_atomically(options.out / "report.json", report.dump(2) + "\n");
+  write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
   if (!options.quiet) {
     std::cerr << "relight replay: " << graph.frames_run() << " frames in " << seconds << " s; results in "
-              << options.out.string() << " (report.json, graph.dot, frames/"
+              << options.out.string() << " (report.html, report.json, graph.dot, frames/"
               << (pipeline.renders && options.video ? ", composite.mp4" : "") << ")\n";
   }
   return 0;

@@ -15,6 +15,7 @@ class VulkanContext;
 namespace relight::app {
 
 class MarkerTrajectoryStage;
+class ReportCollectorStage;
 
 struct ReplayOptions {
   std::filesystem::path sequence;  ///< empty: the embedded sample (data/tum_fr1_rpy)
@@ -49,6 +50,7 @@ struct ReplayPipeline {
   std::string compute;  ///< one line: which backend runs the per-pixel stages, on which device
   app::MarkerTrajectoryStage* markers = nullptr;  ///< set when the marker pose runs
   bool renders = false;                           ///< the DIR stage is in the graph
+  app::ReportCollectorStage* report = nullptr;    ///< gathers report.html's pictures, materials, lights
   ReplayPipeline();
   ~ReplayPipeline();
   ReplayPipeline(ReplayPipeline&&) noexcept;

@@ -4,6 +4,10 @@
 #include <cmath>
 #include <numeric>
 
+#include "html_report.h"
+#include "relight/core/atomic_file.h"
+#include "report_collector_stage.h"
+
 namespace relight::app {
 
 MsSummary summarize(std::vector<double> ms) {
@@ -42,6 +46,14 @@ nlohmann::ordered_json timing_report(const FrameGraph& graph, double total_secon
     stages.push_back(std::move(stage));
   }
   return report;
+}
+
+void write_reports(const std::filesystem::path& folder, const std::string& title, const FrameGraph& graph,
+                   const nlohmann::ordered_json& report, const ReportCollectorStage* collector) {
+  write_file_atomically(folder / "report.json", report.dump(2) + "\n");
+  const std::string dot = graph.to_dot();
+  const ReportContent content = collector ? collector->content() : ReportContent{};
+  write_file_atomically(folder / "report.html", html_report(title, report, content, dot, render_dot_svg(dot)));
 }
 
 }  // namespace relight::app

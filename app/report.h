@@ -11,6 +11,13 @@ namespace relight::app {
 
 [[nodiscard]] nlohmann::ordered_json timing_report(const FrameGraph& graph, double total_seconds);
 
+class ReportCollectorStage;
+
+/// Writes DIR/report.json (`report`) and DIR/report.html (the same plus what `collector` gathered,
+/// and the graph drawn by Graphviz when it is installed), each atomically.
+void write_reports(const std::filesystem::path& folder, const std::string& title, const FrameGraph& graph,
+                   const nlohmann::ordered_json& report, const ReportCollectorStage* collector);
+
 /// Summary statistics of a series of milliseconds.
 struct MsSummary {
   double median = 0, mean = 0, p95 = 0, max = 0;

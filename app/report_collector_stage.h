@@ -1,0 +1,52 @@
+#pragma once
+// Sink stage that gathers what report.html shows besides timings: small JPEG pictures of a few
+// frames' buffers (the contact sheet) and the latest estimated materials and lights.
+// Reads: the buffers registered with add_picture(), and optionally a brdf::Materials and a LightSet
+// buffer. Writes nothing; the run reads content() after the last frame.
+// The frames are chosen evenly over a run of known length; for a run of unknown length (live) the
+// first frame and a rolling latest frame (refreshed every 15th frame) are kept.
+#include <optional>
+#include <string>
+
+#include "buffer_previews.h"
+#include "html_report.h"
+#include "relight/brdf/materials.h"
+#include "relight/core/frame_graph.h"
+#include "relight/lights/light_set.h"
+
+namespace relight::app {
+
+class ReportCollectorStage final : public Stage {
+ public:
+  /// total_frames: frames the run will process (0 = unknown); rows: frames on the contact sheet;
+  /// pictures are scaled to thumbnail_height (wide mosaics such as brdf_preview stay readable).
+  ReportCollectorStage(std::int64_t total_frames, int rows = 4, int thumbnail_height = 110);
+
+  void add_picture(std::string buffer, BufferPreviews::Kind kind) { previews_.add(std::move(buffer), kind); }
+  void collect_materials(std::string buffer) { materials_name_ = std::move(buffer); }
+  void collect_lights(std::string buffer) { lights_name_ = std::move(buffer); }
+
+  [[nodiscard]] std::string name() const override { return "report"; }
+  [[nodiscard]] bool has_side_effects() const override { return true; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+  /// Contact sheet, materials and lights gathered so far (timings and graph are the run's to add).
+  [[nodiscard]] const ReportContent& content() const { return content_; }
+
+ private:
+  /// The contact-sheet row the frame goes into, if it is one of the chosen frames.
+  [[nodiscard]] std::optional<std::size_t> row_for(std::int64_t frame) const;
+
+  std::int64_t total_frames_;
+  int rows_;
+  int thumbnail_height_;
+  BufferPreviews previews_;
+  std::string materials_name_;
+  std::string lights_name_;
+  Read<brdf::Materials> materials_;
+  Read<LightSet> lights_;
+  ReportContent content_;
+};
+
+}  // namespace relight::app
