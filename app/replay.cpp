@@ -166,8 +166,8 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
   collector->add_picture(method2 ? "depth_filtered" : "depth_smoothed", Kind::Depth);
   collector->add_picture("normals", Kind::Normals);
   if (pipeline.renders) {
-    collector->add_picture("brdf_preview", Kind::Color);
     collector->add_picture("composite", Kind::Color);
+    collector->add_picture("brdf_preview", Kind::Color);  // a wide mosaic: last, so it wraps alone
     collector->collect_materials("materials");
     collector->collect_lights("lights");
   }
