@@ -180,10 +180,18 @@ class GltfMeshCollector {
     std::vector<std::uint32_t> indices;
     if (primitive.indices >= 0) {
       const AccessorReader reader(gltf_, primitive.indices, file_);
-      for (std::size_t i = 0; i < reader.count(); ++i) indices.push_back(reader.index(i));
+      for (std::size_t i = 0; i < reader.count(); ++i) {
+        indices.push_back(reader.index(i));
+        if (indices.back() >= mesh.positions.size())
+          throw Error(file_ + ": a primitive refers to vertex " + std::to_string(indices.back()) + ", but it has " +
+                      std::to_string(mesh.positions.size()));
+      }
     } else {
       for (std::size_t i = 0; i < mesh.positions.size(); ++i) indices.push_back(static_cast<std::uint32_t>(i));
     }
+    if (primitive.material >= 0 && static_cast<std::size_t>(primitive.material) >= gltf_.materials.size())
+      throw Error(file_ + ": a primitive uses material " + std::to_string(primitive.material) + ", but the file has " +
+                  std::to_string(gltf_.materials.size()));
     const std::uint32_t material = primitive.material >= 0 ? static_cast<std::uint32_t>(primitive.material) : default_material_;
     for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
       mesh.triangles.push_back({indices[i], indices[i + 1], indices[i + 2]});
@@ -199,9 +207,12 @@ class GltfMeshCollector {
   std::uint32_t default_material_;
 };
 
+// tinygltf's JSON errors quote what was last read, which can be a whole base64 buffer.
 std::string first_line(std::string text) {
   text = text.substr(0, text.find('\n'));
   while (!text.empty() && (text.back() == '\r' || text.back() == ' ')) text.pop_back();
+  constexpr std::size_t kLongest = 200;
+  if (text.size() > kLongest) text = text.substr(0, kLongest) + "...";
   return text;
 }
 
@@ -229,6 +240,7 @@ VirtualModel load_gltf(const std::filesystem::path& path) {
   }
   std::erase_if(model.meshes, [](const TriangleMesh& m) { return m.triangles.empty(); });
   if (model.meshes.empty()) throw Error(path.string() + ": the glTF file holds no triangles");
+  check_model(model, path);
   return model;
 }
 

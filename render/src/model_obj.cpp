@@ -24,8 +24,17 @@ PhongMaterial from_mtl(const tinyobj::material_t& m) {
 
 /// One OBJ shape as a mesh; OBJ indexes positions and normals separately, so every distinct
 /// (position, normal) pair becomes one vertex.
-TriangleMesh mesh_from_shape(const tinyobj::shape_t& shape, const tinyobj::attrib_t& attrib,
-                             std::uint32_t default_material) {
+/// A face index (1-based in the file) past the end of its list is an error naming it: tinyobjloader
+/// passes such indices through.
+void check_index(const std::filesystem::path& path, int index, std::size_t available, const char* what) {
+  if (index < 0 || static_cast<std::size_t>(index) >= available) {
+    throw Error(path.string() + ": a face refers to " + what + " " + std::to_string(index + 1) + ", but the file has " +
+                std::to_string(available));
+  }
+}
+
+TriangleMesh mesh_from_shape(const std::filesystem::path& path, const tinyobj::shape_t& shape,
+                             const tinyobj::attrib_t& attrib, std::uint32_t default_material) {
   TriangleMesh mesh;
   mesh.name = shape.name;
   std::map<std::pair<int, int>, std::uint32_t> vertex_of;
@@ -33,6 +42,8 @@ TriangleMesh mesh_from_shape(const tinyobj::shape_t& shape, const tinyobj::attri
   const auto vertex = [&](const tinyobj::index_t& index) {
     const auto key = std::pair{index.vertex_index, index.normal_index};
     if (const auto found = vertex_of.find(key); found != vertex_of.end()) return found->second;
+    check_index(path, index.vertex_index, attrib.vertices.size() / 3, "vertex");
+    if (index.normal_index >= 0) check_index(path, index.normal_index, attrib.normals.size() / 3, "normal");
     const auto v = static_cast<std::size_t>(index.vertex_index);
     mesh.positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1], attrib.vertices[3 * v + 2]);
     if (index.normal_index >= 0) {
@@ -78,10 +89,11 @@ VirtualModel load_obj(const std::filesystem::path& path) {
   model.materials.push_back(PhongMaterial{"default", {0.7f, 0.7f, 0.7f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
   const tinyobj::attrib_t& attrib = reader.GetAttrib();
   for (const tinyobj::shape_t& shape : reader.GetShapes()) {
-    TriangleMesh mesh = mesh_from_shape(shape, attrib, default_material);
+    TriangleMesh mesh = mesh_from_shape(path, shape, attrib, default_material);
     if (!mesh.triangles.empty()) model.meshes.push_back(std::move(mesh));
   }
   if (model.meshes.empty()) throw Error(path.string() + ": the OBJ file holds no triangles");
+  check_model(model, path);
   return model;
 }
 

@@ -44,6 +44,28 @@ Eigen::Affine3d Placement::transform() const {
   return t;
 }
 
+void check_model(const VirtualModel& model, const std::filesystem::path& file) {
+  const auto fail = [&file](const TriangleMesh& mesh, const std::string& why) {
+    throw Error(file.string() + ": " + (mesh.name.empty() ? "" : "mesh '" + mesh.name + "': ") + why);
+  };
+  for (const TriangleMesh& mesh : model.meshes) {
+    for (std::size_t v = 0; v < mesh.positions.size(); ++v)
+      if (!mesh.positions[v].allFinite()) fail(mesh, "vertex " + std::to_string(v + 1) + " is not finite");
+    for (std::size_t v = 0; v < mesh.normals.size(); ++v)
+      if (!mesh.normals[v].allFinite()) fail(mesh, "normal " + std::to_string(v + 1) + " is not finite");
+    if (mesh.triangle_material.size() != mesh.triangles.size()) fail(mesh, "triangles without a material");
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      for (const std::uint32_t index : mesh.triangles[t])
+        if (index >= mesh.positions.size())
+          fail(mesh, "triangle " + std::to_string(t + 1) + " refers to vertex " + std::to_string(index) + ", but the mesh has " +
+                         std::to_string(mesh.positions.size()));
+      if (mesh.triangle_material[t] >= model.materials.size())
+        fail(mesh, "triangle " + std::to_string(t + 1) + " uses material " + std::to_string(mesh.triangle_material[t]) +
+                       ", but the model has " + std::to_string(model.materials.size()));
+    }
+  }
+}
+
 void add_virtual_model(MrScene& scene, const VirtualModel& model, const Placement& placement) {
   const auto first_material = static_cast<std::uint32_t>(scene.materials.size());
   for (const PhongMaterial& m : model.materials) scene.materials.push_back(m);

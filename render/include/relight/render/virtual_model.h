@@ -8,6 +8,7 @@
 // translation. A model's origin should sit at the middle of its base, so that placing it at a
 // point of the table stands it on the table.
 #include <Eigen/Geometry>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,11 @@ void add_virtual_model(MrScene& scene, const VirtualModel& model, const Placemen
 
 /// Axis-aligned bounds of all vertices (for tests and reports).
 [[nodiscard]] Eigen::AlignedBox3f bounds(const VirtualModel& model);
+
+/// Throws relight::Error naming `file` when a mesh has a non-finite position or normal, a triangle
+/// index past its vertices or a material index past the model's materials: what a loader checks
+/// before the model reaches the renderer (which indexes without checking).
+void check_model(const VirtualModel& model, const std::filesystem::path& file);
 
 /// Area-weighted vertex normals from the triangles (for meshes that come without normals).
 void compute_vertex_normals(TriangleMesh& mesh);
