@@ -50,6 +50,25 @@ RadianceImage read_probe(const std::filesystem::path& path, double gamma) {
   return radiance;
 }
 
+// A probe whose image circle is clipped white almost everywhere says nothing about where the
+// light comes from (some clipped pixels - the sun, lamps - are normal). An 8-bit 255 linearises
+// to exactly 1 and nothing else does, so the clipped pixels are those equal to (1, 1, 1).
+void check_not_over_exposed(const RadianceImage& probe, const ProbeGeometry& geometry, const std::filesystem::path& file) {
+  std::size_t seen = 0, clipped = 0;
+  for (int row = 0; row < probe.height(); ++row) {
+    for (int col = 0; col < probe.width(); ++col) {
+      if (geometry.solid_angle(row, col) <= 0.f) continue;
+      const Float3& p = probe(row, col);
+      ++seen;
+      clipped += p.x == 1.f && p.y == 1.f && p.z == 1.f ? 1 : 0;
+    }
+  }
+  if (seen > 0 && static_cast<double>(clipped) >= 0.99 * static_cast<double>(seen)) {
+    throw Error(file.string() + ": " + std::to_string(100 * clipped / seen) +
+                " % of the probe is saturated (255): it is over-exposed, take it with a shorter exposure");
+  }
+}
+
 ProbeCalibration calibration_for(const LightsCommandOptions& command, const RadianceImage& probe) {
   std::string projection = command.projection;
   if (projection == "auto") projection = probe.width() == 2 * probe.height() ? "equirect" : "fisheye";
@@ -81,6 +100,7 @@ int run_lights(const LightsCommandOptions& command) {
   options.seed = command.seed;
   options.calibration = calibration_for(command, probe);
   const ProbeGeometry geometry(options.calibration, probe.width(), probe.height());
+  if (!is_hdr_file(command.probe)) check_not_over_exposed(probe, geometry, command.probe);
   LightSet lights;
   try {
     lights = extract_lights(probe, options);

@@ -183,6 +183,17 @@ RadianceImage read_radiance(const std::filesystem::path& path) {
   RadianceImage image(raw.cols, raw.rows);
   cv::Mat wrapped(raw.rows, raw.cols, CV_32FC3, image.data());
   cv::cvtColor(linear, wrapped, cv::COLOR_BGR2RGB);
+  // An EXR can hold NaN and infinity; every consumer of radiance sums or samples it, where one
+  // such pixel silently poisons the result.
+  for (int row = 0; row < image.height(); ++row) {
+    for (int col = 0; col < image.width(); ++col) {
+      const Float3& p = image(row, col);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+        throw Error(path.string() + ": pixel (" + std::to_string(col) + ", " + std::to_string(row) +
+                    ") is not finite (NaN or infinity)");
+      }
+    }
+  }
   return image;
 }
 

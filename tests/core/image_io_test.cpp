@@ -67,6 +67,19 @@ TEST(ImageIo, ExrRoundTripIsExactForHalfRepresentableValues) {
   EXPECT_TRUE(back == image);
 }
 
+TEST(ImageIo, NonFiniteRadianceIsRejectedWithTheFileAndPixel) {
+  TempDir dir;
+  RadianceImage image(5, 3, Float3{0.5f, 2.f, 1024.f});
+  image(2, 4).y = std::numeric_limits<float>::quiet_NaN();
+  write_radiance(dir.path() / "nan.exr", image);
+  try {
+    (void)read_radiance(dir.path() / "nan.exr");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("nan.exr: pixel (4, 2) is not finite"), std::string::npos) << e.what();
+  }
+}
+
 TEST(ImageIo, EightBitDepthIsRejectedWithTheFileName) {
   TempDir dir;
   const auto path = dir.path() / "eight.png";

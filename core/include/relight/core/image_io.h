@@ -26,7 +26,7 @@ ColorImage read_color(const std::filesystem::path& path);
 void write_color(const std::filesystem::path& path, const ColorImage& image);
 void write_mask(const std::filesystem::path& path, const Mask& mask);
 
-/// Linear HDR radiance: Radiance .hdr or OpenEXR .exr.
+/// Linear HDR radiance: Radiance .hdr or OpenEXR .exr. A NaN or infinite pixel is an error.
 RadianceImage read_radiance(const std::filesystem::path& path);
 void write_radiance(const std::filesystem::path& path, const RadianceImage& image);
 

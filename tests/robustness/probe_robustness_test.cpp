@@ -1,0 +1,91 @@
+// Robustness matrix, light probes: `relight lights` on a probe with NaN / inf pixels, an all-black
+// or all-saturated fisheye, and a synthetic sequence whose own probe is black (replay --object).
+// Each is one error line naming the probe, exit 1, no lights file and no preview.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "inputs.h"
+#include "outcome_checks.h"
+#include "relight/core/image_io.h"
+
+namespace relight::robustness {
+namespace {
+
+class ProbeRobustness : public ::testing::Test {
+ protected:
+  RunOutcome lights(const std::filesystem::path& probe, std::vector<std::string> extra = {}) {
+    std::vector<std::string> arguments{"lights", probe.string(), "--n", "16", "--out", (out / "lights.json").string(),
+                                       "--preview", (out / "lights.png").string(), "--quiet"};
+    arguments.insert(arguments.end(), extra.begin(), extra.end());
+    return run_relight(arguments);
+  }
+  void expect_rejected(const std::filesystem::path& probe, const std::string& reason, std::vector<std::string> extra = {}) {
+    const auto run = lights(probe, std::move(extra));
+    expect_clean_error(run, 1, probe.string() + ": ", out);
+    EXPECT_NE(run.err.find(reason), std::string::npos) << run.err;
+    EXPECT_FALSE(std::filesystem::exists(out / "lights.json"));
+    EXPECT_FALSE(std::filesystem::exists(out / "lights.png"));
+  }
+  /// A bright fisheye probe (a sky above a darker ground) with one pixel set to `bad`.
+  std::filesystem::path exr_probe_with(float bad) {
+    RadianceImage probe(64, 64, Float3{0.5f, 0.6f, 0.8f});
+    for (int row = 40; row < 64; ++row)
+      for (int col = 0; col < 64; ++col) probe(row, col) = Float3{0.1f, 0.1f, 0.1f};
+    probe(20, 30) = Float3{bad, 1.f, 1.f};
+    const auto file = dir.path() / "probe.exr";
+    write_radiance(file, probe);
+    return file;
+  }
+  std::filesystem::path eight_bit_probe(std::uint8_t value) {
+    const auto file = dir.path() / ("probe_" + std::to_string(value) + ".png");
+    write_color(file, ColorImage(96, 96, Rgb8{value, value, value}));
+    return file;
+  }
+  TempDir dir;
+  const std::filesystem::path out = dir.path() / "out";
+  void SetUp() override { std::filesystem::create_directories(out); }
+};
+
+TEST_F(ProbeRobustness, NanInExr) {
+  expect_rejected(exr_probe_with(std::numeric_limits<float>::quiet_NaN()), "not finite");
+}
+
+TEST_F(ProbeRobustness, InfinityInExr) {
+  expect_rejected(exr_probe_with(std::numeric_limits<float>::infinity()), "not finite");
+}
+
+TEST_F(ProbeRobustness, AllBlackFisheye) {
+  expect_rejected(eight_bit_probe(0), "no light", {"--projection", "fisheye"});
+}
+
+TEST_F(ProbeRobustness, AllSaturatedFisheye) {
+  expect_rejected(eight_bit_probe(255), "saturated", {"--projection", "fisheye"});
+}
+
+TEST_F(ProbeRobustness, BlackHdrProbe) {
+  const auto file = dir.path() / "black.hdr";
+  write_radiance(file, RadianceImage(64, 32, Float3{0.f, 0.f, 0.f}));
+  expect_rejected(file, "no light");
+}
+
+TEST_F(ProbeRobustness, TruncatedHdrProbe) {
+  const auto file = dir.path() / "probe.hdr";
+  std::filesystem::copy_file(kData / "probes" / "grace_latlong.hdr", file);
+  truncate_file(file, 0.3);
+  expect_rejected(file, "");
+}
+
+// replay --object on a synthetic sequence takes its lights from the sequence's probe.hdr.
+TEST_F(ProbeRobustness, BlackSequenceProbeWhileRendering) {
+  const auto sequence = copy_of_synthetic(dir.path() / "seq");
+  write_radiance(sequence / "probe.hdr", RadianceImage(64, 64, Float3{0.f, 0.f, 0.f}));
+  const auto run = run_relight({"replay", "--quiet", sequence.string(), "--object",
+                                (kData / "models" / "glossy_pebble.gltf").string(), "--vpls", "8", "--out", out.string()});
+  expect_clean_error(run, 1, (sequence / "probe.hdr").string() + ": ", out);
+  EXPECT_FALSE(std::filesystem::exists(out / "composite.mp4"));
+}
+
+}  // namespace
+}  // namespace relight::robustness
