@@ -219,6 +219,23 @@ TEST(VulkanValidation, ErrorsAreCountedNotJustPrinted) {
   EXPECT_GE(log->errors(), 1);
 }
 
+TEST(VulkanValidation, HeldMessagesAreRecordedOrDroppedOnRelease) {
+  constexpr auto kError = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  ValidationLog log;
+  log.hold();
+  log.record(kError, "held, then recorded (expected)");
+  EXPECT_EQ(log.errors(), 0);
+  log.release(true);
+  EXPECT_EQ(log.errors(), 1);
+  EXPECT_EQ(log.recent_errors().back(), "held, then recorded (expected)");
+  log.hold();
+  log.record(kError, "held, then dropped");
+  log.release(false);
+  log.record(kError, "recorded at once (expected)");
+  EXPECT_EQ(log.errors(), 2);
+  EXPECT_EQ(log.recent_errors().back(), "recorded at once (expected)");
+}
+
 TEST_F(VulkanContextTest, BackendPolicyOnThisDevice) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const Backend per_pixel = choose_backend(StageKind::PerPixel, &context);

@@ -152,7 +152,9 @@ void VulkanContext::create_instance(bool want_validation) {
   if (validation) info.pNext = &messenger_info;
 
   VkInstance instance = VK_NULL_HANDLE;
+  if (validation) validation_log_->hold();
   const VkResult result = vkCreateInstance(&info, nullptr, &instance);
+  if (validation) validation_log_->release(result == VK_SUCCESS);
   if (result == VK_ERROR_INCOMPATIBLE_DRIVER) {
     // What the loader says when it finds no driver at all: say that in words.
     throw VulkanError(result, "no Vulkan driver found (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER); "
@@ -285,7 +287,7 @@ std::unique_ptr<VulkanContext> try_create_vulkan(const VulkanOptions& options, s
     if (why) *why = error.what();
     static std::once_flag said_once;
     std::call_once(said_once, [&] {
-      std::cerr << "relight: no usable Vulkan device, using the CPU path: " << error.what() << '\n';
+      std::cerr << "relight: warning: no usable Vulkan device, using the CPU path: " << error.what() << '\n';
     });
     return nullptr;
   }

@@ -19,6 +19,33 @@ VKAPI_ATTR VkBool32 VKAPI_CALL on_message(VkDebugUtilsMessageSeverityFlagBitsEXT
 }  // namespace
 
 void ValidationLog::record(VkDebugUtilsMessageSeverityFlagBitsEXT severity, const char* message) {
+  {
+    std::lock_guard lock(held_mutex_);
+    if (holding_) {
+      held_.emplace_back(severity, message);
+      return;
+    }
+  }
+  record_now(severity, message);
+}
+
+void ValidationLog::hold() {
+  std::lock_guard lock(held_mutex_);
+  holding_ = true;
+}
+
+void ValidationLog::release(bool record_held) {
+  std::vector<std::pair<VkDebugUtilsMessageSeverityFlagBitsEXT, std::string>> held;
+  {
+    std::lock_guard lock(held_mutex_);
+    holding_ = false;
+    held.swap(held_);
+  }
+  if (!record_held) return;
+  for (const auto& [severity, message] : held) record_now(severity, message);
+}
+
+void ValidationLog::record_now(VkDebugUtilsMessageSeverityFlagBitsEXT severity, const std::string& message) {
   const bool error = severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
   std::cerr << "relight vulkan " << (error ? "validation error: " : "validation warning: ") << message << '\n';
   if (!error) {

@@ -10,6 +10,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace relight::vk {
@@ -26,11 +27,23 @@ class ValidationLog {
   /// Called by the messenger; public so that tests can feed it.
   void record(VkDebugUtilsMessageSeverityFlagBitsEXT severity, const char* message);
 
+  /// While held, messages are kept, neither printed nor counted; release(true) records them as
+  /// they came, release(false) drops them. VulkanContext holds the messages of vkCreateInstance:
+  /// when it fails (no driver at all) the loader's own lines would follow relight's one-line
+  /// note about it, which already says what went wrong.
+  void hold();
+  void release(bool record_held);
+
  private:
+  void record_now(VkDebugUtilsMessageSeverityFlagBitsEXT severity, const std::string& message);
+
   std::atomic<int> errors_{0};
   std::atomic<int> warnings_{0};
   mutable std::mutex mutex_;
   std::vector<std::string> recent_;
+  std::mutex held_mutex_;
+  bool holding_ = false;
+  std::vector<std::pair<VkDebugUtilsMessageSeverityFlagBitsEXT, std::string>> held_;
 };
 
 /// Owns a VkDebugUtilsMessengerEXT that forwards warnings and errors to a ValidationLog. The
