@@ -43,6 +43,11 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  command.add_option("--colormap", options.colormap,
+                     "Map the rendered colours to the camera's: stats (CIELab statistics), sample (colour samples "
+                     "and a fitted 3x4 matrix) or none; composite.mp4 shows the mapped result, frames/ both")
+      ->check(CLI::IsMember({"none", "sample", "stats"}))
+      ->capture_default_str();
   command.add_flag("--buffers", options.write_buffers, "Also write L_rv and L_r per frame (EXR) under frames/");
   command.add_flag("!--no-video", options.video, "Do not write composite.mp4");
 }

@@ -26,7 +26,9 @@
 #include "relight/vk/transfer.h"
 #include "relight/brdf/brdf_preview.h"
 #include "relight/brdf/brdf_stages.h"
+#include "relight/colormap/colormap_stages.h"
 #include "relight/render/dir_stage.h"
+#include "relight/render/mapped_composite_stage.h"
 #include "relight/render/scene_lights.h"
 #include "report.h"
 #include "report_collector_stage.h"
@@ -119,6 +121,30 @@ std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
   return parse_tag_layout(text, scene.string());
 }
 
+colormap::ColorMapMethod color_map_method(const std::string& name) {
+  if (name == "none") return colormap::ColorMapMethod::None;
+  if (name == "sample") return colormap::ColorMapMethod::Sample;
+  if (name == "stats") return colormap::ColorMapMethod::Statistics;
+  throw Error("--colormap '" + name + "' is not one of none, sample, stats");
+}
+
+/// The colour mapping between DIR's L_rv/L_r and the camera, and its composite; returns the name
+/// of the buffer that holds the final picture ("composite" when there is no mapping).
+std::string add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel,
+                              const colormap::ToneMap& tone_map) {
+  const auto method = color_map_method(options.colormap);
+  if (method == colormap::ColorMapMethod::None) return "composite";  // DIR's own composite is unmapped
+  colormap::SampleMappingOptions mapping;
+  mapping.tone_map = tone_map;
+  // A virtual object's hue often matches only one real surface; without the permuted pairs the
+  // 3x4 fit is unconstrained in the other channels (a red object came out white).
+  mapping.channel_swap = true;
+  pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping));
+  pipeline.graph->emplace<render::MappedCompositeStage>();
+  pipeline.graph->keep("composite_mapped");
+  return "composite_mapped";
+}
+
 /// The lights, the BRDF stages (real materials) and the DIR stage with its outputs, when the
 /// options ask for any virtual content.
 void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel) {
@@ -148,7 +174,8 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.renderer.shadow_tile = 256;
   graph.emplace<render::DirStage>(pipeline.vulkan.get(), std::move(content), dir);
   graph.keep("composite");
-  if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", "composite");
+  pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, dir.tone_map);
+  if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", pipeline.final_composite);
   pipeline.renders = true;
 }
 
@@ -167,6 +194,7 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
   collector->add_picture("normals", Kind::Normals);
   if (pipeline.renders) {
     collector->add_picture("composite", Kind::Color);
+    if (pipeline.final_composite != "composite") collector->add_picture(pipeline.final_composite, Kind::Color);
     collector->add_picture("brdf_preview", Kind::Color);  // a wide mosaic: last, so it wraps alone
     collector->collect_materials("materials");
     collector->collect_lights("lights");
@@ -216,6 +244,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
     writer->add_normals("normals");
     if (pipeline.renders) {
       writer->add_color("composite");
+      if (pipeline.final_composite != "composite") writer->add_color(pipeline.final_composite);
       writer->add_color("brdf_preview");
     }
     if (pipeline.renders && options.write_buffers) {

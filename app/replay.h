@@ -39,6 +39,8 @@ struct ReplayOptions {
   int vpls = 64;                               ///< first-bounce light samples per frame
   float exposure = 1.f;                        ///< tone mapping of the rendered light
   bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
+  /// Colour mapping of the rendered light to the camera (colormap/): none | sample | stats.
+  std::string colormap = "stats";
   bool video = true;                           ///< composite.mp4
 };
 
@@ -50,6 +52,8 @@ struct ReplayPipeline {
   std::string compute;  ///< one line: which backend runs the per-pixel stages, on which device
   app::MarkerTrajectoryStage* markers = nullptr;  ///< set when the marker pose runs
   bool renders = false;                           ///< the DIR stage is in the graph
+  /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".
+  std::string final_composite = "composite";
   app::ReportCollectorStage* report = nullptr;    ///< gathers report.html's pictures, materials, lights
   ReplayPipeline();
   ~ReplayPipeline();

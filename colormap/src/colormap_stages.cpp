@@ -29,11 +29,13 @@ void StatisticsColorMapCpuStage::declare(StageBuilder& builder) {
   real_virtual_ = inputs.real_virtual;
   camera_ = inputs.camera;
   delta_ = builder.write<RadianceImage>(buffers_.delta);
+  mapping_ = builder.write<ColorMapping>(buffers_.mapping);
 }
 
 void StatisticsColorMapCpuStage::run(StageContext& context) {
   transfer_ = statistics_color_map(context.get(real_), context.get(real_virtual_), context.get(camera_), tm_,
                                    context.get(delta_));
+  context.get(mapping_) = ColorMapping::of_statistics(transfer_, tm_);
 }
 
 StatisticsColorMapVkStage::StatisticsColorMapVkStage(vk::VulkanContext& context, ToneMap tm, ColorMapBuffers buffers)
@@ -47,6 +49,7 @@ void StatisticsColorMapVkStage::declare(StageBuilder& builder) {
   real_virtual_ = inputs.real_virtual;
   camera_ = inputs.camera;
   delta_ = builder.write<RadianceImage>(buffers_.delta);
+  mapping_ = builder.write<ColorMapping>(buffers_.mapping);
 }
 
 void StatisticsColorMapVkStage::run(StageContext& context) {
@@ -60,6 +63,7 @@ void StatisticsColorMapVkStage::run(StageContext& context) {
   auto& camera = context.device_read<vk::VulkanBuffer>(camera_);
   auto& delta = context.device_write<vk::VulkanBuffer>(delta_, [&](RadianceImage& out) { out.resize(width, height); });
   transfer_ = mapper_.run(real, real_virtual, camera, delta, width, height);
+  context.get(mapping_) = ColorMapping::of_statistics(transfer_, mapper_.tone_map());
   if (const auto ms = mapper_.last_gpu_ms()) context.report_device_ms(*ms);
 }
 
@@ -72,10 +76,13 @@ void SampleColorMapStage::declare(StageBuilder& builder) {
   real_virtual_ = inputs.real_virtual;
   camera_ = inputs.camera;
   delta_ = builder.write<RadianceImage>(buffers_.delta);
+  mapping_ = builder.write<ColorMapping>(buffers_.mapping);
 }
 
 void SampleColorMapStage::run(StageContext& context) {
-  (void)mapper_.map(context.get(real_), context.get(real_virtual_), context.get(camera_), context.get(delta_));
+  const ColorMatrix& coefficients =
+      mapper_.map(context.get(real_), context.get(real_virtual_), context.get(camera_), context.get(delta_));
+  context.get(mapping_) = ColorMapping::of_matrix(coefficients, mapper_.options().tone_map);
 }
 
 IdentityColorMapStage::IdentityColorMapStage(ToneMap tm, ColorMapBuffers buffers)
@@ -85,10 +92,12 @@ void IdentityColorMapStage::declare(StageBuilder& builder) {
   real_ = builder.read<RadianceImage>(buffers_.real);
   real_virtual_ = builder.read<RadianceImage>(buffers_.real_virtual);
   delta_ = builder.write<RadianceImage>(buffers_.delta);
+  mapping_ = builder.write<ColorMapping>(buffers_.mapping);
 }
 
 void IdentityColorMapStage::run(StageContext& context) {
   sample_delta(context.get(real_), context.get(real_virtual_), identity_color_matrix(), tm_, context.get(delta_));
+  context.get(mapping_) = ColorMapping::of_matrix(identity_color_matrix(), tm_);
 }
 
 void ColorMapCompositeStage::declare(StageBuilder& builder) {

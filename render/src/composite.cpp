@@ -5,14 +5,21 @@
 
 namespace relight::render {
 
+namespace {
+
+void require_camera_size(const ColorImage& camera, std::initializer_list<const Image<Float3>*> radiance,
+                         const CoverageImage& coverage) {
+  bool same = camera.same_shape(coverage);
+  for (const auto* image : radiance) same = same && camera.same_shape(*image);
+  if (!same) throw Error("differential composite: the camera image and the rendered images differ in size");
+}
+
+}  // namespace
+
 ColorImage differential_composite(const ColorImage& camera, const RadianceImage& real_virtual,
                                   const RadianceImage& real, const CoverageImage& virtual_coverage,
                                   const colormap::ToneMap& tone_map) {
-  const auto same_size = [&](const auto& image) {
-    return image.width() == camera.width() && image.height() == camera.height();
-  };
-  if (!same_size(real_virtual) || !same_size(real) || !same_size(virtual_coverage))
-    throw Error("differential composite: the camera image and the rendered images differ in size");
+  require_camera_size(camera, {&real_virtual, &real}, virtual_coverage);
   ColorImage out(camera.width(), camera.height());
   for (std::size_t i = 0; i < out.size(); ++i) {
     const Float3 with = colormap::tone_map(real_virtual.pixels()[i], tone_map);
@@ -20,6 +27,25 @@ ColorImage differential_composite(const ColorImage& camera, const RadianceImage&
     const Float3 background = colormap::decode_srgb8(camera.pixels()[i]) + (with - without);
     const float c = virtual_coverage.pixels()[i];
     out.pixels()[i] = colormap::encode_srgb8(c * with + (1.f - c) * background);
+  }
+  return out;
+}
+
+ColorImage mapped_differential_composite(const ColorImage& camera, const RadianceImage& delta,
+                                         const RadianceImage& real_virtual, const CoverageImage& virtual_coverage,
+                                         const colormap::ColorMapping& mapping) {
+  require_camera_size(camera, {&delta, &real_virtual}, virtual_coverage);
+  ColorImage out(camera.width(), camera.height());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const Float3& d = delta.pixels()[i];
+    const float c = virtual_coverage.pixels()[i];
+    if (c == 0.f && d == Float3{}) {
+      out.pixels()[i] = camera.pixels()[i];
+      continue;
+    }
+    Float3 mapped = colormap::decode_srgb8(camera.pixels()[i]) + d;
+    if (c > 0.f) mapped = c * mapping(real_virtual.pixels()[i]) + (1.f - c) * mapped;
+    out.pixels()[i] = colormap::encode_srgb8(mapped);
   }
   return out;
 }

@@ -43,6 +43,21 @@ TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
     for (std::size_t i = 0; i < camera.size(); ++i) changed += camera.pixels()[i] == composite.pixels()[i] ? 0 : 1;
     EXPECT_GT(changed, 200) << "the pebble and its shadow";
     EXPECT_LT(changed, static_cast<int>(camera.size()) / 4);
+    // The colour-mapped composite (--colormap stats by default) changes the same pixels.
+    const ColorImage mapped = read_color(out / "frames" / (std::string(frame) + "_composite_mapped.png"));
+    ASSERT_EQ(mapped.width(), camera.width());
+    int mapped_changed = 0, largest_elsewhere = 0;
+    for (std::size_t i = 0; i < camera.size(); ++i) {
+      const Rgb8 a = camera.pixels()[i], b = mapped.pixels()[i];
+      mapped_changed += a != b ? 1 : 0;
+      if (a == composite.pixels()[i]) {
+        largest_elsewhere = std::max({largest_elsewhere, std::abs(a.r - b.r), std::abs(a.g - b.g), std::abs(a.b - b.b)});
+      }
+    }
+    EXPECT_GT(mapped_changed, 200);
+    // Where the unmapped composite rounds back to the camera pixel, the mapping may scale the tiny
+    // difference across a rounding step, but it adds nothing visible.
+    EXPECT_LE(largest_elsewhere, 4);  // 3 measured
     const RadianceImage lrv = read_radiance(out / "frames" / (std::string(frame) + "_L_rv.exr"));
     EXPECT_EQ(lrv.width(), camera.width());
   }
@@ -51,6 +66,18 @@ TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
   EXPECT_FALSE(std::filesystem::exists(out / "composite.partial.mp4"));
   const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
   EXPECT_NE(report.dump().find("\"dir\""), std::string::npos) << "the DIR stage is timed";
+}
+
+TEST(ReplayRenderCli, ColormapNoneWritesOnlyTheUnmappedComposite) {
+  TempDir dir;
+  const auto out = dir.path() / "out";
+  const auto result = relight("replay --quiet --frames 1 --no-video --colormap none " + two_frame_sequence().string() +
+                              " --object " + (kData / "models" / "glossy_pebble.gltf").string() + " --vpls 16 --out " +
+                              out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000000_composite.png"));
+  EXPECT_FALSE(std::filesystem::exists(out / "frames" / "000000_composite_mapped.png"));
+  EXPECT_EQ(read_text_file(out / "report.json").find("colormap"), std::string::npos);
 }
 
 TEST(ReplayRenderCli, WithoutVirtualContentNothingIsRendered) {
@@ -69,6 +96,7 @@ TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
   expect_one_line_error(relight("replay" + seq + " --object /no/such/model.glb" + out), 1);
   expect_one_line_error(relight("replay" + seq + pebble + pebble + " --place 0,0,1" + out), 1);  // 2 objects, 1 place
   expect_one_line_error(relight("replay" + seq + " --virtual-light 1,2,x,4" + out), 1);
+  expect_one_line_error(relight("replay" + seq + pebble + " --colormap vivid" + out), 2);  // a usage error
   // A recorded sequence needs its lights and a placement.
   expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + " --place 0,0,1" + out), 1);
   expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + out), 1);

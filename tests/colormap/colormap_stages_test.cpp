@@ -65,15 +65,51 @@ TEST(ColorMapStages, EveryMethodRunsInAGraphAndMappingBeatsNone) {
   EXPECT_LT(sample, 3.0);
 }
 
+// The ColorMapping buffer is the tau the stage used: tau(L_rv) - tau(L_r) reproduces delta_L.
+void expect_mapping_reproduces_delta(ColorMapMethod method, Backend backend, vk::VulkanContext* context) {
+  const auto& triple = test::orange_triple();
+  FrameGraph graph(context ? &context->transfer() : nullptr);
+  graph.emplace<TripleSource>(triple);
+  graph.add(make_color_map_stage(method, backend, context));
+  graph.keep("delta_L");
+  graph.keep("color_mapping");
+  graph.compile();
+  ASSERT_TRUE(graph.run_frame());
+  const auto* delta = graph.find<RadianceImage>("delta_L");
+  const auto* mapping = graph.find<ColorMapping>("color_mapping");
+  ASSERT_TRUE(delta && mapping);
+  int checked = 0;
+  for (std::size_t i = 0; i < delta->size(); ++i) {
+    const Float3& r = triple.real.pixels()[i];
+    const Float3& rv = triple.real_virtual.pixels()[i];
+    if (r == rv) continue;
+    const Float3 expected = (*mapping)(rv) - (*mapping)(r);
+    const Float3& actual = delta->pixels()[i];
+    // The stages' Lab conversion uses a fast cube root (about 1e-4 relative).
+    ASSERT_NEAR(actual.x, expected.x, 2e-3) << i;
+    ASSERT_NEAR(actual.y, expected.y, 2e-3) << i;
+    ASSERT_NEAR(actual.z, expected.z, 2e-3) << i;
+    ++checked;
+  }
+  EXPECT_GT(checked, 200);
+}
+
+TEST(ColorMapStages, EveryStageWritesTheMappingItApplied) {
+  expect_mapping_reproduces_delta(ColorMapMethod::None, Backend::Cpu, nullptr);
+  expect_mapping_reproduces_delta(ColorMapMethod::Statistics, Backend::Cpu, nullptr);
+  expect_mapping_reproduces_delta(ColorMapMethod::Sample, Backend::Cpu, nullptr);
+}
+
 TEST(ColorMapStages, StagesDeclareTheDocumentedBuffers) {
   FrameGraph graph;
   graph.emplace<TripleSource>(test::orange_triple());
   graph.emplace<StatisticsColorMapCpuStage>();
   graph.emplace<ColorMapCompositeStage>();
   graph.keep("color_mapped");
+  graph.keep("color_mapping");
   graph.compile();
   const std::string dot = graph.to_dot();
-  for (const char* buffer : {"L_r", "L_rv", "color", "delta_L", "color_mapped"}) {
+  for (const char* buffer : {"L_r", "L_rv", "color", "delta_L", "color_mapping", "color_mapped"}) {
     EXPECT_NE(dot.find(buffer), std::string::npos) << buffer;
   }
 }
@@ -108,6 +144,11 @@ TEST_F(ColorMapStagesVulkan, VulkanStatisticsStageMatchesTheCpuStage) {
   }
   EXPECT_LE(worst, 1);  // float rounding may flip an 8-bit rounding boundary, nothing more
   EXPECT_LT(differing, static_cast<int>(cpu.size()) / 100);
+}
+
+TEST_F(ColorMapStagesVulkan, VulkanStatisticsStageWritesTheMappingItApplied) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  expect_mapping_reproduces_delta(ColorMapMethod::Statistics, Backend::Vulkan, &context);
 }
 
 }  // namespace

@@ -6,12 +6,14 @@
 //   RadianceImage "L_rv"  the same with the virtual objects (differs from L_r exactly on them)
 //   ColorImage    "color" the camera image (8-bit sRGB)
 // and writes
-//   RadianceImage "delta_L" = tau(TM(L_rv)) - tau(TM(L_r)) in camera-linear sRGB.
+//   RadianceImage "delta_L" = tau(TM(L_rv)) - tau(TM(L_r)) in camera-linear sRGB, and
+//   ColorMapping  "color_mapping" = this frame's tau (color_mapping.h).
 // The composite stage reads "color" and "delta_L" and writes ColorImage "color_mapped" =
 // sRGB(L_cam + delta_L). Names are configurable through ColorMapBuffers.
 #include <memory>
 #include <string>
 
+#include "relight/colormap/color_mapping.h"
 #include "relight/colormap/sample_mapping.h"
 #include "relight/colormap/statistics_transfer.h"
 #include "relight/colormap/statistics_transfer_vk.h"
@@ -26,6 +28,7 @@ struct ColorMapBuffers {
   std::string real_virtual = "L_rv";
   std::string camera = "color";
   std::string delta = "delta_L";
+  std::string mapping = "color_mapping";
   std::string mapped = "color_mapped";
 };
 
@@ -44,6 +47,7 @@ class StatisticsColorMapCpuStage final : public Stage {
   Read<RadianceImage> real_, real_virtual_;
   Read<ColorImage> camera_;
   Write<RadianceImage> delta_;
+  Write<ColorMapping> mapping_;
   ReinhardTransfer transfer_;
 };
 
@@ -64,6 +68,7 @@ class StatisticsColorMapVkStage final : public Stage {
   Read<RadianceImage> real_, real_virtual_;
   Read<ColorImage> camera_;
   Write<RadianceImage> delta_;
+  Write<ColorMapping> mapping_;
   ReinhardTransfer transfer_;
 };
 
@@ -82,6 +87,7 @@ class SampleColorMapStage final : public Stage {
   Read<RadianceImage> real_, real_virtual_;
   Read<ColorImage> camera_;
   Write<RadianceImage> delta_;
+  Write<ColorMapping> mapping_;
 };
 
 /// No mapping (the "none" method): delta_L = TM(L_rv) - TM(L_r).
@@ -97,6 +103,7 @@ class IdentityColorMapStage final : public Stage {
   ColorMapBuffers buffers_;
   Read<RadianceImage> real_, real_virtual_;
   Write<RadianceImage> delta_;
+  Write<ColorMapping> mapping_;
 };
 
 /// Eq. 4.29: reads "color" and "delta_L", writes ColorImage "color_mapped".
