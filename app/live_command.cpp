@@ -129,7 +129,10 @@ int run_live(const LiveOptions& options) {
   report["compute"] = pipeline.compute;
   report["dropped_frames"] = dropped;
   report["stopped_by"] = !failure.empty() ? "error: " + failure : InterruptGuard::interrupted() ? "interrupt" : "end";
-  if (pipeline.markers) report["marker_pose"] = pipeline.markers->summary();
+  if (pipeline.markers) {
+    report["marker_pose"] = pipeline.markers->summary();
+    std::cerr << pipeline.markers->no_tag_warning(options.replay.markers);
+  }
   write_reports(options.replay.out, "relight live: " + description, graph, report, pipeline.report);
   if (!quiet) {
     std::cerr << "relight live: " << graph.frames_run() << " frames in " << seconds << " s ("

@@ -60,4 +60,11 @@ nlohmann::ordered_json MarkerTrajectoryStage::summary() const {
   return json;
 }
 
+std::string MarkerTrajectoryStage::no_tag_warning(const std::string& layout) const {
+  const bool seen = std::any_of(entries_.begin(), entries_.end(), [](const Entry& e) { return e.pose.valid; });
+  if (seen || entries_.empty()) return "";
+  return "relight: warning: no tag of the layout " + layout + " was seen in any of the " +
+         std::to_string(entries_.size()) + " frames, so there is no marker pose (wrong layout, tag family or ids?)\n";
+}
+
 }  // namespace relight::app

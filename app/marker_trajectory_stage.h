@@ -26,6 +26,10 @@ class MarkerTrajectoryStage final : public Stage {
 
   /// Frames, frames with a fresh / held pose, and the error against the sequence's poses.
   [[nodiscard]] nlohmann::ordered_json summary() const;
+  /// One warning line, naming the layout, when frames ran but none saw one of its tags: most
+  /// likely a wrong layout (family, ids) or no tag in view. The run itself goes on without a
+  /// marker pose (the trajectory holds no pose). Empty otherwise.
+  [[nodiscard]] std::string no_tag_warning(const std::string& layout) const;
 
  private:
   struct Entry {

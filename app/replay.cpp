@@ -8,6 +8,7 @@
 #include "constant_stage.h"
 #include "frame_range.h"
 #include "frame_writer_stage.h"
+#include "interrupt.h"
 #include "marker_trajectory_stage.h"
 #include "mixed_reality_scene.h"
 #include "relight/capture/marker_pose.h"
@@ -203,6 +204,12 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
   pipeline.graph->add(std::move(collector));
 }
 
+// How warnings name the AprilTag layout in use.
+std::string marker_layout_name(const ReplayOptions& options) {
+  if (options.markers != "auto") return options.markers;
+  return ((options.sequence.empty() ? default_sequence() : options.sequence) / "scene.json").string();
+}
+
 }  // namespace
 
 ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options) {
@@ -258,6 +265,8 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
 }
 
 int run_replay(const ReplayOptions& options) {
+  // Ctrl-C stops after the current frame; the outputs are then finalised as at the end.
+  InterruptGuard interrupt;
   auto source = open_replay_source(options);
   const std::string description = source->describe();
   const std::int64_t total = source->size_hint();
@@ -273,16 +282,27 @@ int run_replay(const ReplayOptions& options) {
 
   ProgressBar progress("replay", total, options.quiet);
   const auto start = std::chrono::steady_clock::now();
-  while (graph.run_frame()) progress.update(graph.frames_run());
+  while (!InterruptGuard::interrupted() && graph.run_frame()) progress.update(graph.frames_run());
   progress.finish();
   graph.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const bool interrupted = InterruptGuard::interrupted();
 
   auto report = timing_report(graph, seconds);
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
-  if (pipeline.markers) report["marker_pose"] = pipeline.markers->summary();
+  report["stopped_by"] = interrupted ? "interrupt" : "end";
+  if (pipeline.markers) {
+    report["marker_pose"] = pipeline.markers->summary();
+    std::cerr << pipeline.markers->no_tag_warning(marker_layout_name(options));
+  }
   write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
+  if (interrupted) {
+    // Not a failure of the input, but the run did not cover it: 128 + SIGINT, as shells report it.
+    std::cerr << "relight: warning: replay interrupted after " << graph.frames_run() << " of " << total
+              << " frames; the outputs in " << options.out.string() << " are complete for those frames\n";
+    return 130;
+  }
   if (!options.quiet) {
     std::cerr << "relight replay: " << graph.frames_run() << " frames in " << seconds << " s; results in "
               << options.out.string() << " (report.html, report.json, graph.dot, frames/"

@@ -3,6 +3,8 @@
 // 640x480), a small synthetic sequence made once per test run, and file surgery on them.
 #include <algorithm>
 #include <filesystem>
+#include <iomanip>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -45,6 +47,24 @@ inline const std::filesystem::path& synthetic_sequence() {
 inline std::filesystem::path copy_of_synthetic(const std::filesystem::path& folder) {
   std::filesystem::copy(synthetic_sequence(), folder, std::filesystem::copy_options::recursive);
   return folder;
+}
+
+/// Rewrites the folder's rgb.txt, depth.txt and groundtruth.txt (when present) to list `frames`
+/// frames at 30 fps that cycle through the images and poses it has: a long sequence, for
+/// interrupting a run in its middle, without more files.
+inline void loop_sequence(const std::filesystem::path& folder, int frames) {
+  for (const char* list : {"rgb.txt", "depth.txt", "groundtruth.txt"}) {
+    if (!std::filesystem::exists(folder / list)) continue;
+    std::vector<std::string> payloads;  // each entry without its timestamp
+    std::istringstream in(read_text_file(folder / list));
+    for (std::string line; std::getline(in, line);) {
+      if (!line.empty() && line[0] != '#') payloads.push_back(line.substr(line.find(' ')));
+    }
+    std::ostringstream out;
+    out << std::fixed << std::setprecision(6);
+    for (int k = 0; k < frames; ++k) out << 1.0 + k / 30.0 << payloads[static_cast<std::size_t>(k) % payloads.size()] << "\n";
+    write_file_atomically(folder / list, out.str());
+  }
 }
 
 /// Keeps the first `fraction` of the file's bytes.
