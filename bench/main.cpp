@@ -1,9 +1,11 @@
-// relight-bench [--list] [--repetitions N] [FILTER]: runs the cases whose name contains FILTER.
+// relight-bench [--list] [--repetitions N] [--report DIR] [FILTER]: runs the cases whose name
+// contains FILTER.
 #include <CLI/CLI.hpp>
 #include <exception>
 #include <iostream>
 
 #include "bench.h"
+#include "bench_report.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"relight-bench: speed and quality of relight's stages against their baselines.\n"
@@ -13,10 +15,13 @@ int main(int argc, char** argv) {
   relight::bench::Options options;
   app.add_flag("--list", list, "List the case names and exit");
   app.add_option("--repetitions", options.repetitions, "Timed repetitions per side")->check(CLI::Range(1, 1000));
+  std::string report;
+  app.add_option("--report", report, "Also write DIR/bench.json and DIR/bench.md (a Markdown table) of the results");
   app.add_option("filter", filter, "Run only cases whose name contains this text");
   CLI11_PARSE(app, argc, argv);
 
   int matched = 0;
+  std::vector<relight::bench::Json> results;
   for (const auto& bench_case : relight::bench::cases()) {
     if (!filter.empty() && bench_case.name.find(filter) == std::string::npos) continue;
     ++matched;
@@ -32,10 +37,19 @@ int main(int argc, char** argv) {
       line["error"] = e.what();
     }
     std::cout << line.dump() << std::endl;
+    results.push_back(std::move(line));
   }
   if (matched == 0) {
     std::cerr << "relight-bench: no case matches '" << filter << "' (see --list)\n";
     return 2;
+  }
+  if (!report.empty() && !list) {
+    try {
+      relight::bench::write_report(report, results);
+    } catch (const std::exception& e) {
+      std::cerr << "relight-bench: error: " << e.what() << "\n";
+      return 1;
+    }
   }
   return 0;
 }
