@@ -57,8 +57,8 @@ void check_model(const VirtualModel& model, const std::filesystem::path& file) {
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       for (const std::uint32_t index : mesh.triangles[t])
         if (index >= mesh.positions.size())
-          fail(mesh, "triangle " + std::to_string(t + 1) + " refers to vertex " + std::to_string(index) + ", but the mesh has " +
-                         std::to_string(mesh.positions.size()));
+          fail(mesh, "triangle " + std::to_string(t + 1) + " refers to vertex " + std::to_string(index) +
+                         ", but the mesh has " + std::to_string(mesh.positions.size()));
       if (mesh.triangle_material[t] >= model.materials.size())
         fail(mesh, "triangle " + std::to_string(t + 1) + " uses material " + std::to_string(mesh.triangle_material[t]) +
                        ", but the model has " + std::to_string(model.materials.size()));

@@ -1,6 +1,7 @@
-// Robustness matrix, light probes: `relight lights` on a probe with NaN / inf pixels, an all-black
-// or all-saturated fisheye, and a synthetic sequence whose own probe is black (replay --object).
-// Each is one error line naming the probe, exit 1, no lights file and no preview.
+// Robustness matrix, light probes and lights: `relight lights` on a probe with NaN / inf pixels,
+// an all-black or all-saturated fisheye; a synthetic sequence whose own probe is black and a
+// broken lights JSON under replay --object. Each is one error line naming the file, exit 1, no
+// lights file and no preview.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -21,7 +22,8 @@ class ProbeRobustness : public ::testing::Test {
     arguments.insert(arguments.end(), extra.begin(), extra.end());
     return run_relight(arguments);
   }
-  void expect_rejected(const std::filesystem::path& probe, const std::string& reason, std::vector<std::string> extra = {}) {
+  void expect_rejected(const std::filesystem::path& probe, const std::string& reason,
+                       std::vector<std::string> extra = {}) {
     const auto run = lights(probe, std::move(extra));
     expect_clean_error(run, 1, probe.string() + ": ", out);
     EXPECT_NE(run.err.find(reason), std::string::npos) << run.err;
@@ -81,10 +83,30 @@ TEST_F(ProbeRobustness, TruncatedHdrProbe) {
 TEST_F(ProbeRobustness, BlackSequenceProbeWhileRendering) {
   const auto sequence = copy_of_synthetic(dir.path() / "seq");
   write_radiance(sequence / "probe.hdr", RadianceImage(64, 64, Float3{0.f, 0.f, 0.f}));
-  const auto run = run_relight({"replay", "--quiet", sequence.string(), "--object",
-                                (kData / "models" / "glossy_pebble.gltf").string(), "--vpls", "8", "--out", out.string()});
+  const auto run =
+      run_relight({"replay", "--quiet", sequence.string(), "--object",
+                   (kData / "models" / "glossy_pebble.gltf").string(), "--vpls", "8", "--out", out.string()});
   expect_clean_error(run, 1, (sequence / "probe.hdr").string() + ": ", out);
   EXPECT_FALSE(std::filesystem::exists(out / "composite.mp4"));
+}
+
+// The lights of a recorded sequence come from a JSON file of `relight lights`: a broken one is
+// named before any frame runs.
+TEST_F(ProbeRobustness, MalformedLightsJson) {
+  const auto sequence = kData / "tum_fr1_rpy";
+  const auto pebble = (kData / "models" / "glossy_pebble.gltf").string();
+  const auto overflowing = dir.path() / "overflowing.json";
+  write_file_atomically(overflowing, std::string_view(R"({"lights": [{"type": "directional", "direction": [0, 0, 1],
+                                                                   "power": [1e999, 1, 1]}]})"));
+  const auto incomplete = dir.path() / "incomplete.json";
+  write_file_atomically(incomplete, std::string_view(R"({"lights": [{"type": "point", "power": [1, 1, 1]}]})"));
+  for (const auto& lights : {overflowing, incomplete}) {
+    SCOPED_TRACE(lights.filename().string());
+    const auto replay_out = dir.path() / ("out_" + lights.stem().string());
+    expect_clean_error(run_relight({"replay", "--quiet", sequence.string(), "--object", pebble, "--place", "0,0,1",
+                                    "--lights", lights.string(), "--out", replay_out.string()}),
+                       1, lights.string() + ": ", replay_out);
+  }
 }
 
 }  // namespace
