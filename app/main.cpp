@@ -1,5 +1,6 @@
 // relight: mixed-reality relighting from RGB-D. Subcommands: synth, replay, graph.
-// Exit codes: 0 success, 1 bad input or run-time failure (one line on stderr), 2 usage error.
+// Exit codes: 0 success, 1 bad input or run-time failure (one line on stderr), 2 usage error (one
+// line), 130 replay interrupted (outputs finalised); README "Exit codes and errors".
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <exception>
