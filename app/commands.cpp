@@ -69,6 +69,9 @@ void register_replay(CLI::App& app) {
   replay->add_option("sequence", options->sequence, "TUM RGB-D folder or OpenNI2 .oni recording (default: the embedded sample)");
   replay->add_option("--out", options->out, "Output folder")->capture_default_str();
   replay->add_option("--frames", options->frames, "Frame range A:B (B exclusive), A:, :B or N");
+  replay->add_option("--loop", options->loops, "Play the sequence (after --frames) this many times, e.g. for soak runs")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   replay->add_option("--intrinsics", options->intrinsics, "Override intrinsics: kinect, fr1, fr2, fr3");
   replay->add_flag("--quiet", options->quiet, "No progress or summary on stderr");
   replay->add_flag("!--no-frames", options->write_frames, "Do not write per-frame images");

@@ -59,7 +59,8 @@ th{background:#f4f4f4}td.l,th.l{text-align:left}.kv td:first-child{font-weight:6
 
 void summary_section(std::ostringstream& html, const Json& timing) {
   html << "<table class=kv>";
-  for (const char* key : {"sequence", "source", "compute", "frames", "seconds", "fps", "dropped_frames", "stopped_by"}) {
+  for (const char* key :
+       {"sequence", "source", "compute", "frames", "seconds", "fps", "peak_rss_mb", "dropped_frames", "stopped_by"}) {
     if (!timing.contains(key)) continue;
     const Json& value = timing[key];
     std::string text = value.is_string()  ? value.get<std::string>()

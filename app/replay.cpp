@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 
 #include "constant_stage.h"
@@ -72,9 +73,41 @@ class RangeSource final : public FrameSource {
   std::size_t position_ = 0;
 };
 
-}  // namespace
+// Plays the sequence `loops` times (soak tests, long benchmarks): frame indices keep counting and
+// timestamps keep increasing, so temporal stages see one long, continuous run.
+class LoopingSource final : public FrameSource {
+ public:
+  using Opener = std::function<std::unique_ptr<FrameSource>()>;
+  LoopingSource(Opener open, int loops) : open_(std::move(open)), loops_(loops), source_(open_()) {}
+  std::optional<RgbdFrame> next() override {
+    for (;;) {
+      if (auto frame = source_->next()) {
+        if (loop_ == 0) last_timestamp_ = frame->info.timestamp;
+        if (index_ == 0) first_timestamp_ = frame->info.timestamp;
+        frame->info.index = index_++;
+        frame->info.timestamp += loop_ * (last_timestamp_ - first_timestamp_ + kFramePeriod);
+        return frame;
+      }
+      if (++loop_ >= loops_ || index_ == 0) return std::nullopt;
+      source_ = open_();
+    }
+  }
+  std::int64_t size_hint() const override { return source_->size_hint() * loops_; }
+  std::string describe() const override {
+    return source_->describe() + ", played " + std::to_string(loops_) + " times";
+  }
 
-std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options) {
+ private:
+  static constexpr double kFramePeriod = 1.0 / 30.0;
+  Opener open_;
+  int loops_;
+  std::unique_ptr<FrameSource> source_;
+  int loop_ = 0;
+  std::int64_t index_ = 0;
+  double first_timestamp_ = 0, last_timestamp_ = 0;
+};
+
+std::unique_ptr<FrameSource> open_source_once(const ReplayOptions& options) {
   TumOptions tum;
   if (!options.intrinsics.empty()) {
     tum.intrinsics = PinholeIntrinsics::preset(options.intrinsics);
@@ -95,6 +128,14 @@ std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options) {
     });
   }
   return source;
+}
+
+}  // namespace
+
+std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options) {
+  if (options.loops < 1) throw Error("--loop must be at least 1");
+  if (options.loops == 1) return open_source_once(options);
+  return std::make_unique<LoopingSource>([options] { return open_source_once(options); }, options.loops);
 }
 
 ReplayPipeline::ReplayPipeline() = default;

@@ -21,6 +21,7 @@ struct ReplayOptions {
   std::filesystem::path sequence;  ///< empty: the embedded sample (data/tum_fr1_rpy)
   std::filesystem::path out = "relight-out";
   std::string frames;              ///< "A:B" range, empty = all
+  int loops = 1;                   ///< play the (ranged) sequence this many times
   std::string intrinsics;          ///< TUM preset name overriding the sequence's own
   bool quiet = false;
   bool write_frames = true;        ///< per-frame PNGs under out/frames

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numeric>
 
+#include <sys/resource.h>
+
 #include "html_report.h"
 #include "relight/core/atomic_file.h"
 #include "report_collector_stage.h"
@@ -27,6 +29,8 @@ nlohmann::ordered_json timing_report(const FrameGraph& graph, double total_secon
   report["frames"] = graph.frames_run();
   report["seconds"] = total_seconds;
   report["fps"] = total_seconds > 0 ? static_cast<double>(graph.frames_run()) / total_seconds : 0.0;
+  rusage usage{};
+  if (::getrusage(RUSAGE_SELF, &usage) == 0) report["peak_rss_mb"] = static_cast<double>(usage.ru_maxrss) / 1024.0;
   report["execution_order"] = graph.execution_order();
   report["culled_stages"] = graph.culled_stages();
   auto& stages = report["stages"] = nlohmann::ordered_json::array();

@@ -90,6 +90,16 @@ TEST(Cli, FrameRangeLimitsTheRun) {
   EXPECT_EQ(nlohmann::json::parse(read_text_file(dir.path() / "report.json"))["frames"], 2);
 }
 
+TEST(Cli, LoopPlaysTheRangeAgainAndReportsPeakMemory) {
+  TempDir dir;
+  ASSERT_EQ(relight("replay --quiet --no-frames --frames 1:3 --loop 3 --out " + dir.path().string()).exit_code, 0);
+  const auto report = nlohmann::json::parse(read_text_file(dir.path() / "report.json"));
+  EXPECT_EQ(report["frames"], 6);
+  EXPECT_NE(report["sequence"].get<std::string>().find("played 3 times"), std::string::npos);
+  EXPECT_GT(report["peak_rss_mb"].get<double>(), 1.0);
+  expect_one_line_error(relight("replay --quiet --loop 0 --out " + dir.path().string()), 2);
+}
+
 TEST(Cli, BadInputGivesOneLineAndExitCodeOne) {
   TempDir dir;
   expect_one_line_error(relight("replay /no/such/folder --out " + dir.path().string()), 1);
