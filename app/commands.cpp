@@ -48,6 +48,13 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                      "and a fitted 3x4 matrix) or none; composite.mp4 shows the mapped result, frames/ both")
       ->check(CLI::IsMember({"none", "sample", "stats"}))
       ->capture_default_str();
+  command.add_option("--colormap-model", options.colormap_model,
+                     "Polynomial model of --colormap sample: per_channel_affine, linear_3x3 or affine_3x4")
+      ->check(CLI::IsMember({"per_channel_affine", "linear_3x3", "affine_3x4"}))
+      ->capture_default_str();
+  command.add_flag("--channel-swap", options.channel_swap,
+                   "--colormap sample: also fit channel-permuted colour pairs (helps when the virtual colour is "
+                   "absent from the real scene and the camera treats R, G, B alike)");
   command.add_flag("--buffers", options.write_buffers, "Also write L_rv and L_r per frame (EXR) under frames/");
   command.add_flag("!--no-video", options.video, "Do not write composite.mp4");
 }

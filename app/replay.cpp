@@ -170,6 +170,14 @@ colormap::ColorMapMethod color_map_method(const std::string& name) {
   throw Error("--colormap '" + name + "' is not one of none, sample, stats");
 }
 
+colormap::PolynomialModel polynomial_model(const std::string& name) {
+  for (const auto model : {colormap::PolynomialModel::PerChannelAffine, colormap::PolynomialModel::Linear3x3,
+                           colormap::PolynomialModel::Affine3x4}) {
+    if (name == colormap::to_string(model)) return model;
+  }
+  throw Error("--colormap-model '" + name + "' is not one of per_channel_affine, linear_3x3, affine_3x4");
+}
+
 /// The colour mapping between DIR's L_rv/L_r and the camera, and its composite; returns the name
 /// of the buffer that holds the final picture ("composite" when there is no mapping).
 std::string add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel,
@@ -178,9 +186,8 @@ std::string add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& opt
   if (method == colormap::ColorMapMethod::None) return "composite";  // DIR's own composite is unmapped
   colormap::SampleMappingOptions mapping;
   mapping.tone_map = tone_map;
-  // A virtual object's hue often matches only one real surface; without the permuted pairs the
-  // 3x4 fit is unconstrained in the other channels (a red object came out white).
-  mapping.channel_swap = true;
+  mapping.channel_swap = options.channel_swap;
+  mapping.model = polynomial_model(options.colormap_model);
   pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping));
   pipeline.graph->emplace<render::MappedCompositeStage>();
   pipeline.graph->keep("composite_mapped");

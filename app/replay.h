@@ -42,6 +42,8 @@ struct ReplayOptions {
   bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
   /// Colour mapping of the rendered light to the camera (colormap/): none | sample | stats.
   std::string colormap = "stats";
+  std::string colormap_model = "affine_3x4";  ///< sample mapping: per_channel_affine | linear_3x3 | affine_3x4
+  bool channel_swap = false;                  ///< sample mapping: add channel-permuted pairs
   bool video = true;                           ///< composite.mp4
 };
 
