@@ -40,6 +40,16 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--vpls", options.vpls, "Light samples for virtual point lights per frame")
       ->check(CLI::Range(0, 4096))
       ->capture_default_str();
+  command.add_option("--vpl-budget", options.vpl_budget,
+                     "How the VPL samples are shared among the lights: equal, power (emitted power), weights "
+                     "(--vpl-weights) or flux (the flux each light's VPLs carried last frame)")
+      ->check(CLI::IsMember({"equal", "power", "weights", "flux"}))
+      ->capture_default_str();
+  command.add_option("--vpl-weights", options.vpl_weights,
+                     "With --vpl-budget weights: one weight per light, comma-separated (the lights file's order, "
+                     "then the --virtual-light ones; missing weights are 1)")
+      ->delimiter(',')
+      ->check(CLI::NonNegativeNumber);
   command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

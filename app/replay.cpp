@@ -163,6 +163,14 @@ std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
   return parse_tag_layout(text, scene.string());
 }
 
+render::VplBudget vpl_budget(const std::string& name) {
+  if (name == "equal") return render::VplBudget::Equal;
+  if (name == "power") return render::VplBudget::ByPower;
+  if (name == "weights") return render::VplBudget::ByWeight;
+  if (name == "flux") return render::VplBudget::ByPreviousFlux;
+  throw Error("--vpl-budget '" + name + "' is not one of equal, power, weights, flux");
+}
+
 colormap::ColorMapMethod color_map_method(const std::string& name) {
   if (name == "none") return colormap::ColorMapMethod::None;
   if (name == "sample") return colormap::ColorMapMethod::Sample;
@@ -216,6 +224,8 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
   render::DirStageOptions dir;
   dir.vpls.count = options.vpls;
+  dir.vpls.budget = vpl_budget(options.vpl_budget);
+  dir.vpls.light_weights = options.vpl_weights;
   dir.tone_map.exposure = options.exposure;
   dir.materials_buffer = "materials";
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view

@@ -38,6 +38,8 @@ struct ReplayOptions {
   std::filesystem::path lights;                ///< lights JSON of `relight lights` (recorded sequences)
   std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]
   int vpls = 64;                               ///< first-bounce light samples per frame
+  std::string vpl_budget = "power";            ///< equal | power | weights | flux (render/vpl.h)
+  std::vector<float> vpl_weights;              ///< per light (lights file order, then virtual lights)
   float exposure = 1.f;                        ///< tone mapping of the rendered light
   bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
   /// Colour mapping of the rendered light to the camera (colormap/): none | sample | stats.

@@ -79,6 +79,8 @@ void DirStage::run(StageContext& context) {
 
   const std::vector<Vpl> vpls = generate_vpls(scene_, RayTracer(scene_, RayTracer::Build::Fast), options_.vpls);
   vpl_count_ = vpls.size();
+  if (options_.vpls.budget == VplBudget::ByPreviousFlux)
+    options_.vpls.previous_flux = vpl_flux_per_light(vpls, scene_.lights.size());
   MrCamera camera{frame.intrinsics, camera_to_world};
   camera.intrinsics.width = width;
   camera.intrinsics.height = height;

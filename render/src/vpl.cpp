@@ -111,6 +111,9 @@ class VplTracer {
   VplTracer(const MrScene& scene, const RayTracer& tracer, const VplOptions& options, std::vector<Vpl>& out)
       : scene_(scene), tracer_(tracer), options_(options), out_(out) {}
 
+  /// The primary light whose paths the following emit() calls follow.
+  void set_light(std::size_t light) { light_ = static_cast<std::uint32_t>(light); }
+
   /// Follows one light path segment and records the VPL(s) it ends in.
   void emit(const Vec3& origin, const Vec3& direction, const Vec3& flux, bool in_real_virtual, bool in_real, int bounce,
             Pcg32& rng) {
@@ -144,6 +147,7 @@ class VplTracer {
     vpl.in_real_virtual = in_real_virtual;
     vpl.in_real = in_real;
     vpl.bounce = bounce;
+    vpl.light = light_;
     out_.push_back(vpl);
     if (bounce >= options_.bounces) return;
     // Continue the light path by sampling the VPL's BRDF (reciprocity: wo = where light came from).
@@ -159,30 +163,68 @@ class VplTracer {
   const RayTracer& tracer_;
   const VplOptions& options_;
   std::vector<Vpl>& out_;
+  std::uint32_t light_ = 0;
 };
 
-/// Light samples per light: equal shares, or shares by emitted power (luminance x solid angle).
-std::vector<int> light_budget(const MrScene& scene, const BoundingSphere& bounds, const VplOptions& options) {
-  std::vector<double> weight;
-  double total = 0.0;
-  for (const MrLight& light : scene.lights) {
-    double w = 0.0;
-    // Power: intensity times solid angle, or for a directional light irradiance times the area
-    // of the scene's cross-section.
-    const float extent = light.kind == LightKind::Directional ? kPi * std::max(bounds.radius, 0.f) * std::max(bounds.radius, 0.f)
-                                                              : emission_solid_angle(light);
-    if (emits_vpls(light))
-      w = options.budget == VplBudget::Equal ? 1.0 : std::max(0.f, luminance(light.intensity)) * extent;
-    weight.push_back(w);
-    total += w;
+double power_weight(const MrLight& light, const BoundingSphere& bounds) {
+  // Power: intensity times solid angle, or for a directional light irradiance times the area of
+  // the scene's cross-section.
+  const float extent = light.kind == LightKind::Directional ? kPi * std::max(bounds.radius, 0.f) * std::max(bounds.radius, 0.f)
+                                                            : emission_solid_angle(light);
+  return std::max(0.f, luminance(light.intensity)) * extent;
+}
+
+/// The weights of VplBudget (vpl.h) for the lights that emit VPLs; 0 for the others.
+std::vector<double> budget_weights(const MrScene& scene, const BoundingSphere& bounds, const VplOptions& options) {
+  const std::size_t n = scene.lights.size();
+  std::vector<double> weight(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const MrLight& light = scene.lights[i];
+    if (!emits_vpls(light)) continue;
+    switch (options.budget) {
+      case VplBudget::Equal: weight[i] = 1.0; break;
+      case VplBudget::ByPower:
+      case VplBudget::ByPreviousFlux: weight[i] = power_weight(light, bounds); break;
+      case VplBudget::ByWeight: weight[i] = i < options.light_weights.size() ? options.light_weights[i] : 1.0; break;
+    }
   }
+  if (options.budget != VplBudget::ByPreviousFlux) return weight;
+  // Lights without last frame's flux keep their power weight, scaled by the ratio of flux to
+  // power of the lights that have one.
+  double flux_sum = 0.0, power_sum = 0.0;
+  for (std::size_t i = 0; i < n && i < options.previous_flux.size(); ++i) {
+    if (weight[i] <= 0.0) continue;
+    flux_sum += std::max(0.0, options.previous_flux[i]);
+    power_sum += weight[i];
+  }
+  if (flux_sum <= 0.0) return weight;  // nothing reached a surface last frame: by power
+  const double scale = flux_sum / power_sum;
+  double mean = 0.0, emitting = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (weight[i] <= 0.0) continue;
+    weight[i] = i < options.previous_flux.size() ? std::max(0.0, options.previous_flux[i]) : weight[i] * scale;
+    mean += weight[i];
+    emitting += 1.0;
+  }
+  mean /= emitting;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (emits_vpls(scene.lights[i])) weight[i] = std::max(weight[i], mean / 16.0);
+  }
+  return weight;
+}
+
+/// Light samples per light, by the weights of the budget.
+std::vector<int> light_budget(const MrScene& scene, const BoundingSphere& bounds, const VplOptions& options) {
+  const std::vector<double> weight = budget_weights(scene, bounds, options);
+  double total = 0.0;
+  for (double w : weight) total += std::max(0.0, w);
   std::vector<int> count(scene.lights.size(), 0);
   if (total <= 0.0) return count;
   // Largest remainder, so that the shares add up to options.count exactly.
   int given = 0;
   std::vector<std::pair<double, std::size_t>> remainder;
   for (std::size_t i = 0; i < weight.size(); ++i) {
-    const double exact = options.count * weight[i] / total;
+    const double exact = options.count * std::max(0.0, weight[i]) / total;
     count[i] = static_cast<int>(std::floor(exact));
     given += count[i];
     remainder.emplace_back(exact - count[i], i);
@@ -222,6 +264,16 @@ void emit_directional(const MrLight& light, std::size_t index, int n, const Boun
 
 }  // namespace
 
+std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t light_count) {
+  std::vector<double> flux(light_count, 0.0);
+  for (const Vpl& vpl : vpls) {
+    // A path that a virtual object splits ends in two VPLs; the real+virtual one counts it once.
+    if (vpl.bounce != 1 || !vpl.in_real_virtual || vpl.light >= light_count) continue;
+    flux[vpl.light] += luminance(vpl.flux);
+  }
+  return flux;
+}
+
 std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options) {
   if (options.count < 0) throw Error("the VPL count must not be negative");
   if (options.bounces < 1) throw Error("VPLs need at least one bounce");
@@ -233,6 +285,7 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
   const BoundingSphere virtual_sphere = virtual_bounds(scene);
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     const MrLight& light = scene.lights[l];
+    vpl_tracer.set_light(l);
     if (light.kind == LightKind::Directional) {
       emit_directional(light, l, budget[l], bounds, virtual_sphere, options, vpl_tracer);
       continue;

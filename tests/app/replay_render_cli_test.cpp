@@ -98,6 +98,8 @@ TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
   expect_one_line_error(relight("replay" + seq + " --virtual-light 1,2,x,4" + out), 1);
   expect_one_line_error(relight("replay" + seq + pebble + " --colormap vivid" + out), 2);  // a usage error
   expect_one_line_error(relight("replay" + seq + pebble + " --colormap sample --colormap-model cubic" + out), 2);
+  expect_one_line_error(relight("replay" + seq + pebble + " --vpl-budget most" + out), 2);
+  expect_one_line_error(relight("replay" + seq + pebble + " --vpl-budget weights --vpl-weights 1,-2" + out), 2);
   // A recorded sequence needs its lights and a placement.
   expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + " --place 0,0,1" + out), 1);
   expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + out), 1);

@@ -162,6 +162,55 @@ TEST(Vpls, FirstBounceFluxAddsUpToTheLightsPowerAndFollowsTheBudget) {
   EXPECT_THROW((void)generate_vpls(scene, tracer, VplOptions{-1}), Error);
 }
 
+// Two equal point lights in a closed box: every sample ends on a surface.
+MrScene two_lights_in_a_box() {
+  MrScene scene;
+  const std::uint32_t white = scene.add_material(diffuse(Eigen::Vector3f::Constant(0.5f)));
+  scene.meshes.push_back(tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
+  MrLight left, right;
+  left.position = {-0.2f, 0.f, 0.f};
+  right.position = {0.2f, 0.f, 0.f};
+  left.intensity = right.intensity = Eigen::Vector3f::Constant(1.f);
+  scene.lights = {left, right};
+  return scene;
+}
+
+std::pair<int, int> vpls_per_light(const std::vector<Vpl>& vpls) {
+  std::pair<int, int> count{0, 0};
+  for (const Vpl& vpl : vpls) (vpl.light == 0 ? count.first : count.second) += 1;
+  return count;
+}
+
+TEST(Vpls, BudgetByWeightOrLastFramesFluxMovesSamplesNotEnergy) {
+  const MrScene scene = two_lights_in_a_box();
+  const RayTracer tracer(scene);
+  VplOptions options;
+  options.count = 400;
+  options.budget = VplBudget::ByWeight;
+  options.light_weights = {3.f, 1.f};
+  const auto weighted = generate_vpls(scene, tracer, options);
+  EXPECT_EQ(vpls_per_light(weighted), std::make_pair(300, 100));
+  // Each light still delivers its whole power, 4 pi W for 1 W/sr, however many samples it has.
+  const std::vector<double> flux = vpl_flux_per_light(weighted, 2);
+  const double four_pi = 4.0 * std::numbers::pi;  // white light: luminance = 1 per W
+  EXPECT_NEAR(flux[0], four_pi, 1e-3);
+  EXPECT_NEAR(flux[1], four_pi, 1e-3);
+
+  // Last frame's flux: the right light's VPLs found nothing, so it keeps only the floor share
+  // (1/16 of the mean weight) and the left light gets the rest.
+  options.budget = VplBudget::ByPreviousFlux;
+  options.previous_flux = {2.0, 0.0};
+  const auto by_flux = vpls_per_light(generate_vpls(scene, tracer, options));
+  const double floor_share = (1.0 / 16.0) / (2.0 + 1.0 / 16.0);  // mean weight 1, floor 1/16
+  EXPECT_NEAR(by_flux.second, 400 * floor_share, 1.0);
+  EXPECT_EQ(by_flux.first + by_flux.second, 400);
+  // Without last frame's flux the budget is by power: equal here.
+  options.previous_flux.clear();
+  EXPECT_EQ(vpls_per_light(generate_vpls(scene, tracer, options)), std::make_pair(200, 200));
+  options.budget = VplBudget::Equal;
+  EXPECT_EQ(vpls_per_light(generate_vpls(scene, tracer, options)), std::make_pair(200, 200));
+}
+
 TEST(Vpls, DirectionalLightDeliversItsIrradianceTimesTheLitArea) {
   MrScene scene = floor_scene(Eigen::Vector3f::Constant(0.8f), {0.f, 0.f, 2.f}, 0.f);
   scene.lights.clear();

@@ -38,6 +38,7 @@ namespace relight::render {
 
 struct DirStageOptions {
   DirVkOptions renderer{};
+  /// With VplBudget::ByPreviousFlux the stage feeds each frame's flux per light into the next.
   VplOptions vpls{.count = 64};
   DepthMeshOptions mesh{.stride = 2};
   PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};

@@ -47,9 +47,23 @@ struct Vpl {
   bool in_real_virtual = true;
   bool in_real = true;
   int bounce = 1;  ///< 1 = lit directly by a primary light
+  std::uint32_t light = 0;  ///< index of the primary light (MrScene::lights) the path started at
 };
 
-enum class VplBudget { Equal, ByPower };
+/// How the `count` light samples are shared among the lights (dissertation §5.2.3). Whatever the
+/// shares, each light's VPLs carry its whole emitted flux (flux per sample = power / samples), so
+/// the budget moves noise between lights, not energy.
+///   Equal           the same number per light;
+///   ByPower         proportional to emitted power (luminance x solid angle, or x the scene's
+///                   cross-section for a directional light);
+///   ByWeight        proportional to `light_weights` (one per light; missing entries count 1);
+///   ByPreviousFlux  proportional to the flux the light's VPLs carried last frame
+///                   (`previous_flux`, from vpl_flux_per_light), i.e. the light that actually
+///                   reached surfaces: a spot light aimed past the scene gets few samples. A light
+///                   without an entry takes its ByPower weight scaled to the others, and every
+///                   light keeps at least 1/16 of the mean share so that one that found nothing
+///                   last frame can recover.
+enum class VplBudget { Equal, ByPower, ByWeight, ByPreviousFlux };
 
 struct VplOptions {
   int count = 256;      ///< first-bounce light samples (each may yield two VPLs, see above)
@@ -57,7 +71,13 @@ struct VplOptions {
   VplBudget budget = VplBudget::ByPower;
   float virtual_share = 0.5f;  ///< of each light's samples aimed at the virtual objects (0 = off)
   std::uint64_t seed = 1;
+  std::vector<float> light_weights{};   ///< VplBudget::ByWeight
+  std::vector<double> previous_flux{};  ///< VplBudget::ByPreviousFlux
 };
+
+/// Per light of the scene, the luminance of the flux its first-bounce VPLs carry (the input of
+/// VplBudget::ByPreviousFlux for the next frame).
+[[nodiscard]] std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t light_count);
 
 /// VPLs of every light of `scene`. A directional light (the environment lights of the light-
 /// extraction stage) shoots parallel rays from a disk facing it that covers the scene's bounding
