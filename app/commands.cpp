@@ -65,7 +65,8 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_flag("--channel-swap", options.channel_swap,
                    "--colormap sample: also fit channel-permuted colour pairs (helps when the virtual colour is "
                    "absent from the real scene and the camera treats R, G, B alike)");
-  command.add_flag("--buffers", options.write_buffers, "Also write L_rv and L_r per frame (EXR) under frames/");
+  command.add_flag("--buffers", options.write_buffers,
+                   "Also write L_rv, L_r and (with colour mapping) delta_L per frame as EXR under frames/");
   command.add_flag("!--no-video", options.video, "Do not write composite.mp4");
 }
 

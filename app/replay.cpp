@@ -315,6 +315,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
     if (pipeline.renders && options.write_buffers) {
       writer->add_radiance("L_rv");
       writer->add_radiance("L_r");
+      if (pipeline.final_composite != "composite") writer->add_radiance("delta_L");  // the colour-mapped difference
     }
     graph.add(std::move(writer));
   }

@@ -60,6 +60,10 @@ TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
     EXPECT_LE(largest_elsewhere, 4);  // 3 measured
     const RadianceImage lrv = read_radiance(out / "frames" / (std::string(frame) + "_L_rv.exr"));
     EXPECT_EQ(lrv.width(), camera.width());
+    const RadianceImage delta = read_radiance(out / "frames" / (std::string(frame) + "_delta_L.exr"));
+    int nonzero = 0;
+    for (const Float3& d : delta.pixels()) nonzero += d == Float3{} ? 0 : 1;
+    EXPECT_GT(nonzero, 200) << "delta_L is non-zero where the pebble changes the picture";
   }
   ASSERT_TRUE(std::filesystem::exists(out / "composite.mp4"));
   EXPECT_GT(std::filesystem::file_size(out / "composite.mp4"), 1000u);
