@@ -7,6 +7,7 @@
 #include "relight/brdf/brdf_shared.h"
 #include "relight/core/error.h"
 #include "relight/shaders/brdf_kmeans_comp.h"
+#include "relight/vk/barrier.h"
 #include "relight/vk/buffer.h"
 #include "relight/vk/compute_pipeline.h"
 #include "relight/vk/context.h"
@@ -27,11 +28,13 @@ struct KMeansVk::Resources {
                            .push_constant_bytes = sizeof(gpu::KMeansParams),
                            .max_descriptor_sets = 2}),
         timer(context),
-        centres(context, RELIGHT_KMEANS_MAX_CLUSTERS * 4 * sizeof(float)) {}
+        centres(context, RELIGHT_KMEANS_MAX_CLUSTERS * 4 * sizeof(float), vk::BufferDomain::Upload) {}
   vk::ComputePipeline pipeline;
   vk::GpuTimer timer;
+  // Host-visible, so that the centres of an iteration need no copy of their own.
   vk::VulkanBuffer centres;
   std::optional<vk::VulkanBuffer> points, labels, partials;
+  std::optional<vk::VulkanBuffer> partials_host;  // read-back copy, filled in the iteration's own submission
   vk::UniqueDescriptorSet set;
   std::vector<std::uint32_t> rows;  // host copy of the partial sums
 };
@@ -53,6 +56,7 @@ void KMeansVk::set_points(std::span<const Float3> points) {
     r.points.emplace(context_, bytes);
     r.labels.emplace(context_, points.size() * sizeof(std::uint32_t));
     r.partials.emplace(context_, partial_bytes);
+    r.partials_host.emplace(context_, partial_bytes, vk::BufferDomain::Readback);
     r.set = r.pipeline.bind({&*r.points, &r.centres, &*r.labels, &*r.partials});
   }
   context_.transfer().upload(std::as_bytes(points), *r.points);
@@ -70,18 +74,25 @@ ClusterSums KMeansVk::step(std::span<const Eigen::Vector3f> centres) {
   for (std::uint32_t k = 0; k < k_count; ++k) {
     for (int c = 0; c < 3; ++c) packed[4 * k + static_cast<std::uint32_t>(c)] = centres[k][c];
   }
-  context_.transfer().upload(std::as_bytes(std::span<const float>(packed)), r.centres);
+  r.centres.write(std::as_bytes(std::span<const float>(packed)));
   const std::uint32_t groups = vk::ComputePipeline::group_count(points_, kGroup);
   const gpu::KMeansParams params{points_, k_count};
+  const std::size_t slots = static_cast<std::size_t>(k_count) * kSums;
+  r.rows.resize(groups * slots);
+  const std::span<std::byte> rows = std::as_writable_bytes(std::span<std::uint32_t>(r.rows));
+  // One submission per Lloyd iteration: on a discrete GPU the fence round trips, not the
+  // dispatch, are the cost (three per iteration made the Vulkan engine no faster than the CPU).
   context_.submit([&](VkCommandBuffer cmd) {
     r.timer.start(cmd);
     r.pipeline.dispatch(cmd, r.set, params, groups, 1);
     r.timer.stop(cmd);
+    vk::memory_barrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    const VkBufferCopy region{0, 0, rows.size()};
+    vkCmdCopyBuffer(cmd, r.partials->handle(), r.partials_host->handle(), 1, &region);
+    vk::memory_barrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT);
   });
   if (const auto ms = r.timer.elapsed_ms()) gpu_ms_ = gpu_ms_.value_or(0.0) + *ms;
-  const std::size_t slots = static_cast<std::size_t>(k_count) * kSums;
-  r.rows.resize(groups * slots);
-  context_.transfer().download(*r.partials, std::as_writable_bytes(std::span<std::uint32_t>(r.rows)));
+  r.partials_host->read(rows);
   for (std::uint32_t g = 0; g < groups; ++g) {
     const std::uint32_t* row = r.rows.data() + g * slots;
     for (std::uint32_t k = 0; k < k_count; ++k) {

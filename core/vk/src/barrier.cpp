@@ -10,6 +10,7 @@ VkAccessFlags accesses(VkPipelineStageFlags stages, bool writes_only) {
     out |= VK_ACCESS_SHADER_WRITE_BIT | (writes_only ? 0 : VK_ACCESS_SHADER_READ_BIT);
   if (stages & VK_PIPELINE_STAGE_TRANSFER_BIT)
     out |= VK_ACCESS_TRANSFER_WRITE_BIT | (writes_only ? 0 : VK_ACCESS_TRANSFER_READ_BIT);
+  if (stages & VK_PIPELINE_STAGE_HOST_BIT) out |= VK_ACCESS_HOST_WRITE_BIT | (writes_only ? 0 : VK_ACCESS_HOST_READ_BIT);
   if (stages & VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT)
     out |= VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | (writes_only ? 0 : VK_ACCESS_COLOR_ATTACHMENT_READ_BIT);
   return out;
