@@ -56,31 +56,58 @@ void check_increasing(const std::filesystem::path& file, int line, Timestamp pre
   }
 }
 
+// An image side in pixels: a whole number in [1, 1 << 16] (read as a double first: converting an
+// out-of-range number straight to int is undefined behaviour).
+int image_side(const nlohmann::json& k, const char* key, int fallback, const std::filesystem::path& file) {
+  if (!k.contains(key)) return fallback;
+  const double side = k.at(key).get<double>();
+  if (!(side >= 1 && side <= 65536 && side == std::floor(side))) {
+    throw Error(file.string() + ": bad \"intrinsics\": \"" + key + "\" must be a whole number of pixels in [1, 65536]");
+  }
+  return static_cast<int>(side);
+}
+
 std::optional<PinholeIntrinsics> intrinsics_from_json(const nlohmann::json& json, const std::filesystem::path& file) {
   if (!json.contains("intrinsics")) return std::nullopt;
   const auto& k = json["intrinsics"];
+  PinholeIntrinsics intrinsics;
   try {
-    PinholeIntrinsics intrinsics;
     intrinsics.fx = k.at("fx").get<double>();
     intrinsics.fy = k.at("fy").get<double>();
     intrinsics.cx = k.at("cx").get<double>();
     intrinsics.cy = k.at("cy").get<double>();
-    intrinsics.width = k.value("width", 640);
-    intrinsics.height = k.value("height", 480);
-    return intrinsics;
+    intrinsics.width = image_side(k, "width", 640, file);
+    intrinsics.height = image_side(k, "height", 480, file);
   } catch (const nlohmann::json::exception& e) {
     throw Error(file.string() + ": bad \"intrinsics\": " + e.what());
   }
+  const auto finite = [](double v) { return std::isfinite(v); };
+  if (!(finite(intrinsics.fx) && finite(intrinsics.fy) && finite(intrinsics.cx) && finite(intrinsics.cy) &&
+        intrinsics.fx > 0 && intrinsics.fy > 0)) {
+    throw Error(file.string() + ": bad \"intrinsics\": fx, fy, cx, cy must be finite, fx and fy positive");
+  }
+  return intrinsics;
+}
+
+double depth_scale_from_json(const nlohmann::json& scene, const std::filesystem::path& file) {
+  const auto found = scene.find("depth_scale");
+  if (found == scene.end()) return 5000.0;
+  const double scale = found->is_number() ? found->get<double>() : 0.0;
+  if (!(std::isfinite(scale) && scale > 0)) throw Error(file.string() + ": \"depth_scale\" must be a positive number");
+  return scale;
 }
 
 std::optional<nlohmann::json> read_scene_json(const std::filesystem::path& folder) {
   const auto file = folder / "scene.json";
   if (!std::filesystem::exists(file)) return std::nullopt;
+  nlohmann::json scene;
   try {
-    return nlohmann::json::parse(read_text_file(file));
+    scene = nlohmann::json::parse(read_text_file(file));
   } catch (const nlohmann::json::exception& e) {
     throw Error(file.string() + ": not valid JSON: " + e.what());
   }
+  if (!scene.is_object()) throw Error(file.string() + ": expected a JSON object");
+  return scene;
 }
 
 std::string folder_preset(const std::filesystem::path& folder) {
@@ -184,8 +211,10 @@ TumSequence TumSequence::open(const std::filesystem::path& folder, const TumOpti
     sequence.intrinsics_ = PinholeIntrinsics::kinect_v1();
     sequence.intrinsics_source_ = "Kinect v1 defaults";
   }
-  sequence.depth_scale_ = options.depth_scale.value_or(scene ? scene->value("depth_scale", 5000.0) : 5000.0);
-  if (!(sequence.depth_scale_ > 0)) throw Error(folder.string() + ": depth scale must be positive");
+  sequence.depth_scale_ = options.depth_scale.value_or(scene ? depth_scale_from_json(*scene, folder / "scene.json") : 5000.0);
+  if (!(std::isfinite(sequence.depth_scale_) && sequence.depth_scale_ > 0)) {
+    throw Error(folder.string() + ": depth scale must be positive and finite");
+  }
 
   const auto colors = read_tum_list(folder / "rgb.txt");
   const auto depths = read_tum_list(folder / "depth.txt");

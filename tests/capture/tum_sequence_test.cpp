@@ -213,6 +213,18 @@ TEST_F(DamagedSequence, SceneJsonIntrinsicsWin) {
   EXPECT_NE(open_error().find("scene.json"), std::string::npos);
 }
 
+// Valid JSON of the wrong shape used to escape as a JSON library exception (found by fuzzing).
+TEST_F(DamagedSequence, SceneJsonOfTheWrongShapeIsAnErrorNamingIt) {
+  for (const char* scene : {R"(1.05)", R"({"depth_scale": "5000"})", R"({"depth_scale": 0})",
+                            R"({"intrinsics": {"fx": 600, "fy": 600, "cx": 320, "cy": 240, "width": 1e300}})",
+                            R"({"intrinsics": {"fx": 600, "fy": 600, "cx": 320, "cy": 240, "height": 479.5}})",
+                            R"({"intrinsics": {"fx": 0, "fy": 600, "cx": 320, "cy": 240}})"}) {
+    write_file_atomically(folder_ / "scene.json", std::string_view(scene));
+    const std::string message = open_error();
+    EXPECT_NE(message.find("scene.json"), std::string::npos) << scene << ": " << message;
+  }
+}
+
 TEST(TumSource, RangeSelectsFramesAndRejectsEmptyRanges) {
   TumSource source(TumSequence::open(kRealSlice), 1, 3);
   EXPECT_EQ(source.size_hint(), 2);
