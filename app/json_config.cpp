@@ -7,16 +7,25 @@ namespace relight::app {
 
 namespace {
 
-std::string scalar_text(const nlohmann::json& value) {
+// Sections (nested objects) address subcommands, which nest one level in relight. A file nested
+// deeper than this is a mistake, and the bound keeps flatten()'s recursion off the end of the
+// stack on a file of a million '{'s.
+constexpr std::size_t kDeepestSection = 8;
+
+// The error names the key rather than quoting the value: the value may be arbitrarily large and
+// deep (printing it could overflow the stack too).
+std::string scalar_text(const std::string& key, const nlohmann::json& value) {
   if (value.is_string()) return value.get<std::string>();
   if (value.is_boolean()) return value.get<bool>() ? "true" : "false";
   if (value.is_number() || value.is_null()) return value.dump();
-  throw CLI::ConfigError("value " + value.dump() + " must be a string, number, boolean or array of those");
+  throw CLI::ConfigError("the value of '" + key + "' must be a string, number, boolean or array of those");
 }
 
 void flatten(const nlohmann::json& object, std::vector<std::string>& parents, std::vector<CLI::ConfigItem>& items) {
   for (const auto& [key, value] : object.items()) {
     if (value.is_object()) {
+      if (parents.size() >= kDeepestSection)
+        throw CLI::ConfigError("sections nest deeper than " + std::to_string(kDeepestSection) + " levels at '" + key + "'");
       parents.push_back(key);
       flatten(value, parents, items);
       parents.pop_back();
@@ -26,9 +35,9 @@ void flatten(const nlohmann::json& object, std::vector<std::string>& parents, st
     item.parents = parents;
     item.name = key;
     if (value.is_array()) {
-      for (const auto& element : value) item.inputs.push_back(scalar_text(element));
+      for (const auto& element : value) item.inputs.push_back(scalar_text(key, element));
     } else {
-      item.inputs.push_back(scalar_text(value));
+      item.inputs.push_back(scalar_text(key, value));
     }
     items.push_back(std::move(item));
   }

@@ -43,6 +43,20 @@ TEST_F(ConfigRobustness, ValueOfTheWrongType) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+// Found by fuzzing (fuzz/json_config_fuzzer.cpp): a config nested a hundred thousand levels deep
+// used to overflow the stack, in the sections (objects) and in the error message quoting a value
+// (arrays).
+TEST_F(ConfigRobustness, DeeplyNestedSectionsOrValues) {
+  constexpr int kDepth = 100000;
+  std::string objects;
+  for (int i = 0; i < kDepth; ++i) objects += "{\"replay\": ";
+  objects += "1" + std::string(kDepth, '}');
+  expect_clean_error(replay_with(objects), 2, config.string() + ": sections nest deeper than", out);
+  const std::string arrays = "{\"object\": " + std::string(kDepth, '[') + std::string(kDepth, ']') + "}";
+  expect_clean_error(replay_with(arrays), 2, config.string() + ": the value of 'object' must be", out);
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST_F(ConfigRobustness, MissingFile) {
   const auto run = run_relight({"replay", "--config", config.string(), "--out", out.string()});
   expect_clean_error(run, 2, config.string() + ": cannot be read", out);
