@@ -34,3 +34,12 @@ if [ "${RELIGHT_ASAN:-1}" != 0 ]; then
   ASAN_OPTIONS=fast_unwind_on_malloc=0 ctest --preset asan --parallel "$(nproc)" --timeout 900 -L "$asan_labels" -R 'OpenNi'
   echo "sanitizer stage: $((SECONDS - start)) s"
 fi
+
+# Fuzzing: a short run of every libFuzzer target (scripts/fuzz.sh, build/fuzz); longer runs by
+# hand with scripts/fuzz.sh SECONDS. Any crash fails CI and leaves its input in build/fuzz/crashes/.
+fuzz_seconds="${RELIGHT_FUZZ_SECONDS:-30}"
+if [ "$fuzz_seconds" != 0 ]; then
+  start=$SECONDS
+  "$root/scripts/fuzz.sh" "$fuzz_seconds"
+  echo "fuzzing stage: $((SECONDS - start)) s"
+fi
