@@ -4,13 +4,17 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <initializer_list>
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string_view>
 #include <vector>
 
 #include "relight/core/atomic_file.h"
@@ -57,9 +61,49 @@ const char* describe_depth(int cv_depth) {
   }
 }
 
-cv::Mat read_any(const std::filesystem::path& path, int flags) {
+// The formats relight reads, told apart by their first bytes. OpenCV picks its decoder from the
+// content alone, among many more (DICOM through GDCM, GDAL rasters, JPEG 2000, ...), so a file
+// that is not what its reader expects is refused before any decoder sees it: a 134-byte file
+// with a DICOM signature, named depth.png, aborted the process inside GDCM.
+enum class ImageFormat { Png, Jpeg, Exr, RadianceHdr };
+
+bool has_signature(std::string_view head, ImageFormat format) {
+  switch (format) {
+    case ImageFormat::Png: return head.starts_with("\x89PNG\r\n\x1a\n");
+    case ImageFormat::Jpeg: return head.starts_with("\xff\xd8\xff");
+    case ImageFormat::Exr: return head.starts_with("v/1\x01");
+    case ImageFormat::RadianceHdr: return head.starts_with("#?RADIANCE") || head.starts_with("#?RGBE");
+  }
+  return false;
+}
+
+const char* describe(ImageFormat format) {
+  switch (format) {
+    case ImageFormat::Png: return "PNG";
+    case ImageFormat::Jpeg: return "JPEG";
+    case ImageFormat::Exr: return "OpenEXR";
+    case ImageFormat::RadianceHdr: return "Radiance HDR";
+  }
+  return "?";
+}
+
+void check_format(const std::filesystem::path& path, std::initializer_list<ImageFormat> accepted) {
+  std::array<char, 16> bytes{};
+  std::ifstream in(path, std::ios::binary);
+  in.read(bytes.data(), bytes.size());
+  const std::string_view head(bytes.data(), static_cast<std::size_t>(in.gcount()));
+  std::string expected;
+  for (const ImageFormat format : accepted) {
+    if (has_signature(head, format)) return;
+    expected += std::string(expected.empty() ? "" : " or ") + describe(format);
+  }
+  throw Error("cannot decode " + path.string() + ": not a " + expected + " file");
+}
+
+cv::Mat read_any(const std::filesystem::path& path, int flags, std::initializer_list<ImageFormat> accepted) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw Error("cannot read " + path.string() + ": no such file");
+  check_format(path, accepted);
   // OpenCV keeps EXR behind an opt-in switch since 4.5; relight reads only files it is asked to.
   ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
   cv::Mat image;
@@ -96,7 +140,7 @@ cv::Mat wrap(const Image<T>& image, int cv_type) {
 }  // namespace
 
 DepthMap read_depth_png(const std::filesystem::path& path, double scale) {
-  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR);
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR, {ImageFormat::Png});
   if (raw.channels() != 1 || raw.depth() != CV_16U) {
     throw Error("depth image " + path.string() + " is " + describe_depth(raw.depth()) + " with " +
                 std::to_string(raw.channels()) + " channel(s); expected a 16-bit single-channel PNG");
@@ -125,7 +169,7 @@ void write_depth_png(const std::filesystem::path& path, const DepthMap& depth, d
 }
 
 DepthMap read_depth_exr(const std::filesystem::path& path) {
-  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE, {ImageFormat::Exr});
   if (raw.channels() != 1 || raw.depth() != CV_32F) {
     throw Error("depth image " + path.string() + " is " + describe_depth(raw.depth()) + " with " +
                 std::to_string(raw.channels()) + " channel(s); expected a single-channel float EXR");
@@ -141,7 +185,7 @@ void write_depth_exr(const std::filesystem::path& path, const DepthMap& depth) {
 }
 
 LabelImage read_label_png(const std::filesystem::path& path) {
-  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE);
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_GRAYSCALE, {ImageFormat::Png});
   if (raw.channels() != 1 || (raw.depth() != CV_16U && raw.depth() != CV_8U)) {
     throw Error("label image " + path.string() + " is " + describe_depth(raw.depth()) + " with " +
                 std::to_string(raw.channels()) + " channel(s); expected a single-channel PNG");
@@ -158,7 +202,7 @@ void write_label_png(const std::filesystem::path& path, const LabelImage& labels
 }
 
 ColorImage read_color(const std::filesystem::path& path) {
-  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR, {ImageFormat::Png, ImageFormat::Jpeg});
   if (raw.depth() != CV_8U) {
     throw Error("colour image " + path.string() + " is " + describe_depth(raw.depth()) + "; expected 8-bit");
   }
@@ -177,7 +221,7 @@ void write_color(const std::filesystem::path& path, const ColorImage& image) {
 void write_mask(const std::filesystem::path& path, const Mask& mask) { write_encoded(path, wrap(mask, CV_8UC1)); }
 
 RadianceImage read_radiance(const std::filesystem::path& path) {
-  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR);
+  const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR, {ImageFormat::Exr, ImageFormat::RadianceHdr});
   cv::Mat linear;
   raw.convertTo(linear, CV_32FC3);
   RadianceImage image(raw.cols, raw.rows);

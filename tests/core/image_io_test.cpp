@@ -102,6 +102,32 @@ TEST(ImageIo, MissingAndCorruptFilesAreErrors) {
   EXPECT_THROW((void)read_depth_png(dir.path() / "corrupt.png", 5000.0), Error);
 }
 
+// Found by fuzzing (fuzz/depth_png_fuzzer.cpp): this file, 134 bytes with a DICOM signature
+// named depth.png, was handed by OpenCV to GDCM, which aborted the process.
+TEST(ImageIo, FilesOfAnotherFormatAreRefusedBeforeDecoding) {
+  TempDir dir;
+  const auto dicom = dir.path() / "depth.png";
+  write_file_atomically(dicom, std::string(128, '\xa4') + "DICM1\x01");
+  for (const auto& read : {+[](const std::filesystem::path& p) { (void)read_depth_png(p, 5000.0); },
+                           +[](const std::filesystem::path& p) { (void)read_label_png(p); },
+                           +[](const std::filesystem::path& p) { (void)read_color(p); }}) {
+    try {
+      read(dicom);
+      ADD_FAILURE() << "a DICOM file was decoded";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("depth.png: not a PNG"), std::string::npos) << e.what();
+    }
+  }
+  // Each reader takes its own formats and no other: a PNG is not radiance, an EXR not a colour image.
+  write_color(dir.path() / "c.png", ColorImage(4, 2));
+  write_radiance(dir.path() / "r.exr", RadianceImage(4, 2));
+  EXPECT_NO_THROW((void)read_color(dir.path() / "c.png"));
+  EXPECT_NO_THROW((void)read_radiance(dir.path() / "r.exr"));
+  EXPECT_THROW((void)read_radiance(dir.path() / "c.png"), Error);
+  EXPECT_THROW((void)read_color(dir.path() / "r.exr"), Error);
+  EXPECT_THROW((void)read_depth_exr(dir.path() / "c.png"), Error);
+}
+
 TEST(ImageIo, PreviewsMarkInvalidPixelsBlack) {
   DepthMap depth(2, 1);
   depth(0, 0) = 1.f;

@@ -1,7 +1,8 @@
 #pragma once
 // Image files through OpenCV's codecs (kept out of this header). Every reader throws
-// relight::Error with the file name and the reason; every writer is atomic (see atomic_file.h)
-// and picks the format from the extension.
+// relight::Error with the file name and the reason, and decodes only the formats it names below,
+// told by their signature (OpenCV would hand any file to whichever of its many decoders claims
+// it); every writer is atomic (see atomic_file.h) and picks the format from the extension.
 #include <filesystem>
 
 #include "relight/core/image.h"
@@ -21,7 +22,7 @@ void write_depth_exr(const std::filesystem::path& path, const DepthMap& depth);
 LabelImage read_label_png(const std::filesystem::path& path);
 void write_label_png(const std::filesystem::path& path, const LabelImage& labels);
 
-/// 8-bit colour (PNG, JPEG, ...). Grey images are expanded to RGB; 16-bit images are rejected.
+/// 8-bit colour, PNG or JPEG. Grey images are expanded to RGB; 16-bit images are rejected.
 ColorImage read_color(const std::filesystem::path& path);
 void write_color(const std::filesystem::path& path, const ColorImage& image);
 void write_mask(const std::filesystem::path& path, const Mask& mask);
