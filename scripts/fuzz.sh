@@ -26,11 +26,15 @@ for target in "${targets[@]}"; do
   found="$build/corpus/$target"
   crashes="$build/crashes/$target"
   log="$build/logs/$target.log"
+  report="$build/logs/$target.sanitizer"
   mkdir -p "$found" "$crashes" "$(dirname "$log")"
+  rm -f "$report".*
   # One input may take at most 10 s and 2 GiB; more is a finding (a hang or an allocation a
-  # malformed file can trigger), as a crash is.
+  # malformed file can trigger), as a crash is. Sanitizer reports go to their own file: the image
+  # readers mute stderr while a decoder runs, which would swallow a report from inside it.
   status=0
-  "$binary" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
+  ASAN_OPTIONS="log_path=$report" UBSAN_OPTIONS="log_path=$report:print_stacktrace=1" \
+    "$binary" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
     -artifact_prefix="$crashes/" "$found" "$root/fuzz/corpus/$target" >"$log" 2>&1 || status=$?
   executions="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)"
   rate="$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)"
@@ -41,6 +45,9 @@ for target in "${targets[@]}"; do
     result="CRASH ($(ls -t "$crashes" | head -1)), log: $log"
   fi
   printf '%-12s %8s %12s %10s %8s  %s\n' "$target" "$seconds" "${executions:-?}" "${rate:-?}" "$corpus" "$result"
-  [ "$status" -eq 0 ] || grep -E -m1 -A14 "^==[0-9]+== ?ERROR|deadly signal|uncaught exception" "$log" || tail -20 "$log"
+  if [ "$status" -ne 0 ]; then
+    grep -h -E -m1 -A14 "^==[0-9]+== ?ERROR|runtime error|deadly signal|uncaught exception" "$report".* "$log" 2>/dev/null ||
+      tail -20 "$log"
+  fi
 done
 exit "$failed"
