@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds (optimised, with assertions) and runs every test CI runs, then
-# the unit tests of the cheaper labels under AddressSanitizer + UndefinedBehaviorSanitizer and a
-# short run of every fuzz target.
+# the unit tests of six labels under AddressSanitizer + UndefinedBehaviorSanitizer and a short run
+# of every fuzz target.
 # Usage: scripts/test.sh [extra ctest arguments for the main suite, e.g. -L core]
 # RELIGHT_ASAN=0 skips the sanitizer stage, RELIGHT_FUZZ_SECONDS=0 the fuzzing stage.
 set -euo pipefail
@@ -18,12 +18,14 @@ ctest --test-dir "$root/build/debug" --output-on-failure --parallel "$(nproc)" -
 
 # Sanitizers (the asan preset, build/asan; suppressions and options in sanitizers/ and the
 # preset). Only these labels: with ASan + UBSan our numeric code runs 8-30 times slower, and
-# brdf, render, app would need a second build of everything. Within them,
-# MarkerPose.NoiseFreeSyntheticFrames... is left out: its minutes go to synth's ray caster
-# rendering 640x480 frames, which the synth label already runs under the sanitizers.
+# reconstruct, render, app (and so pipeline, robustness) would need a second build of nearly
+# everything. Within them, MarkerPose.NoiseFreeSyntheticFrames... is left out: its minutes go to
+# synth's ray caster rendering 640x480 frames, which the synth label already runs under the
+# sanitizers.
 if [ "${RELIGHT_ASAN:-1}" != 0 ]; then
-  asan_labels='core|capture|synth|colormap'
-  asan_tests=(relight_core_tests relight_capture_tests relight_synth_tests relight_colormap_tests)
+  asan_labels='core|capture|synth|colormap|lights|brdf'
+  asan_tests=(relight_core_tests relight_capture_tests relight_synth_tests relight_colormap_tests
+              relight_lights_tests relight_brdf_tests)
   start=$SECONDS
   cmake --preset asan >/dev/null
   cmake --build --preset asan --parallel "$(nproc)" --target "${asan_tests[@]}"
