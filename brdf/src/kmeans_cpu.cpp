@@ -12,13 +12,12 @@
 #include "relight/brdf/kmeans.h"
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
+#include "kmeans_step_kernel.h"
 
 namespace relight::brdf {
 
 namespace {
 
-constexpr float kValueScale = static_cast<float>(RELIGHT_KMEANS_VALUE_SCALE);
-constexpr float kDistanceScale = static_cast<float>(RELIGHT_KMEANS_DISTANCE_SCALE);
 constexpr std::size_t kChunk = 8192;
 
 void check_clusters(std::size_t clusters) {
@@ -26,10 +25,6 @@ void check_clusters(std::size_t clusters) {
     throw Error("brdf K-means: the number of clusters must be 1.." + std::to_string(RELIGHT_KMEANS_MAX_CLUSTERS));
   }
 }
-
-// The same float expressions as brdf_kmeans.comp (no contraction: this file is built with
-// -ffp-contract=off).
-inline std::uint32_t quantise(float value, float scale) { return static_cast<std::uint32_t>(value * scale + 0.5f); }
 
 }  // namespace
 
@@ -55,7 +50,7 @@ struct KMeansCpu::Arena {
   tbb::task_arena arena;
 };
 
-KMeansCpu::KMeansCpu(int threads) : threads_(threads) {}
+KMeansCpu::KMeansCpu(int threads, KMeansCpuKernel kernel) : threads_(threads), kernel_(kernel) {}
 KMeansCpu::~KMeansCpu() = default;
 KMeansCpu::KMeansCpu(KMeansCpu&&) noexcept = default;
 KMeansCpu& KMeansCpu::operator=(KMeansCpu&&) noexcept = default;
@@ -65,84 +60,13 @@ void KMeansCpu::set_points(std::span<const Float3> points) {
   xs_.resize(n);
   ys_.resize(n);
   zs_.resize(n);
-  qx_.resize(n);
-  qy_.resize(n);
-  qz_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     xs_[i] = points[i].x;
     ys_[i] = points[i].y;
     zs_[i] = points[i].z;
-    qx_[i] = quantise(points[i].x, kValueScale);
-    qy_[i] = quantise(points[i].y, kValueScale);
-    qz_[i] = quantise(points[i].z, kValueScale);
   }
   active_ = n;
 }
-
-namespace {
-
-constexpr int kBlock = 256;
-
-/// Nearest centre of `count` points (structure of arrays) and the quantised squared distance;
-/// written as plain loops over the points so that GCC vectorises them, and also built for AVX2
-/// ("avx2" does not enable FMA: both versions round exactly like the shader).
-__attribute__((target_clones("avx2", "default"))) void assign_block(
-    const float* x, const float* y, const float* z, int count, const float* cx, const float* cy, const float* cz,
-    int clusters, std::uint8_t* label, std::uint32_t* distance) {
-  // The running argmin in 32-bit lanes like the distances, so that the selects vectorise
-  // without packing masks to bytes.
-  float best[kBlock];
-  std::int32_t arg[kBlock];
-  for (int i = 0; i < count; ++i) {
-    best[i] = std::numeric_limits<float>::infinity();
-    arg[i] = 0;
-  }
-  for (int k = 0; k < clusters; ++k) {
-    const float ax = cx[k], ay = cy[k], az = cz[k];
-    const std::int32_t kk = k;
-    for (int i = 0; i < count; ++i) {
-      const float dx = x[i] - ax, dy = y[i] - ay, dz = z[i] - az;
-      const float d = (dx * dx + dy * dy) + dz * dz;
-      const bool closer = d < best[i];
-      best[i] = closer ? d : best[i];
-      arg[i] = closer ? kk : arg[i];
-    }
-  }
-  for (int i = 0; i < count; ++i) {
-    label[i] = static_cast<std::uint8_t>(arg[i]);
-    distance[i] = static_cast<std::uint32_t>(best[i] * kDistanceScale + 0.5f);
-  }
-}
-
-/// Adds the block's per-cluster sums to `sums`: for each cluster a masked reduction over the
-/// block in 32-bit integers (a block's sums fit, brdf_shared.h), which vectorises, instead of a
-/// scatter into the cluster's sums per point, whose additions wait on each other whenever
-/// neighbouring points share a cluster. Integer sums: the same totals in any order.
-__attribute__((target_clones("avx2", "default"))) void sum_block(
-    const std::uint8_t* label, const std::uint32_t* qx, const std::uint32_t* qy, const std::uint32_t* qz,
-    const std::uint32_t* distance, int count, int clusters, ClusterSums::Cluster* sums) {
-  for (int k = 0; k < clusters; ++k) {
-    const auto kk = static_cast<std::uint8_t>(k);
-    std::uint32_t sx = 0, sy = 0, sz = 0, n = 0, sd = 0;
-    for (int i = 0; i < count; ++i) {
-      const std::uint32_t in = label[i] == kk ? 1u : 0u;
-      const std::uint32_t mask = 0u - in;
-      sx += qx[i] & mask;
-      sy += qy[i] & mask;
-      sz += qz[i] & mask;
-      sd += distance[i] & mask;
-      n += in;
-    }
-    ClusterSums::Cluster& s = sums[k];
-    s.sum[0] += sx;
-    s.sum[1] += sy;
-    s.sum[2] += sz;
-    s.count += n;
-    s.distance += sd;
-  }
-}
-
-}  // namespace
 
 ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres) {
   const std::size_t k_count = centres.size();
@@ -151,30 +75,24 @@ ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres) {
   labels_.resize(n);
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
   std::vector<ClusterSums::Cluster> partial(chunks * k_count);
-  float cx[RELIGHT_KMEANS_MAX_CLUSTERS], cy[RELIGHT_KMEANS_MAX_CLUSTERS], cz[RELIGHT_KMEANS_MAX_CLUSTERS];
+  detail::KMeansCentres soa;
+  soa.count = static_cast<int>(k_count);
   for (std::size_t k = 0; k < k_count; ++k) {
-    cx[k] = centres[k].x();
-    cy[k] = centres[k].y();
-    cz[k] = centres[k].z();
+    soa.x[k] = centres[k].x();
+    soa.y[k] = centres[k].y();
+    soa.z[k] = centres[k].z();
   }
   // TBB rather than parallel_rows(): its workers stay alive between the 20-100 steps of a run,
   // and a chunk that no worker has taken yet runs on the calling thread instead of waiting for a
   // helper thread to be scheduled (on a loaded machine that wait cost more than the step).
   const auto run_chunks = [&](int begin, int end) {
-        std::uint32_t distance[kBlock];
-        for (int chunk = begin; chunk < end; ++chunk) {
-          ClusterSums::Cluster* sums = partial.data() + static_cast<std::size_t>(chunk) * k_count;
-          const std::size_t first = static_cast<std::size_t>(chunk) * kChunk;
-          const std::size_t last = std::min(n, first + kChunk);
-          for (std::size_t b = first; b < last; b += kBlock) {
-            const int count = static_cast<int>(std::min<std::size_t>(kBlock, last - b));
-            std::uint8_t* label = labels_.data() + b;
-            assign_block(xs_.data() + b, ys_.data() + b, zs_.data() + b, count, cx, cy, cz, static_cast<int>(k_count),
-                         label, distance);
-            sum_block(label, qx_.data() + b, qy_.data() + b, qz_.data() + b, distance, count,
-                      static_cast<int>(k_count), sums);
-          }
-        }
+    for (int chunk = begin; chunk < end; ++chunk) {
+      const std::size_t first = static_cast<std::size_t>(chunk) * kChunk;
+      const std::size_t count = std::min(n, first + kChunk) - first;
+      detail::kmeans_assign_and_sum(xs_.data() + first, ys_.data() + first, zs_.data() + first, count, soa,
+                                    labels_.data() + first, partial.data() + static_cast<std::size_t>(chunk) * k_count,
+                                    kernel_ == KMeansCpuKernel::Portable);
+    }
   };
   if (worker_count(threads_) <= 1 || chunks <= 1) {
     run_chunks(0, static_cast<int>(chunks));
@@ -220,58 +138,89 @@ KMeansResult lloyd(KMeansEngine& engine, std::vector<Eigen::Vector3f> initial, c
   return result;
 }
 
-std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> all_points, int clusters, std::mt19937_64& rng,
-                                               int trials, std::size_t max_points) {
-  check_clusters(static_cast<std::size_t>(clusters));
-  if (all_points.empty()) throw Error("brdf K-means: no points to seed from");
-  // Seeding on an even-stride subset: the D^2 distribution of a few ten thousand points is the
-  // same for seeding purposes and keeps the greedy trials cheap.
-  std::vector<Float3> subset;
-  std::span<const Float3> points = all_points;
-  if (max_points > 0 && all_points.size() > max_points) {
-    const std::size_t stride = (all_points.size() + max_points - 1) / max_points;
-    for (std::size_t i = 0; i < all_points.size(); i += stride) subset.push_back(all_points[i]);
-    points = subset;
+namespace {
+
+/// The points k-means++ seeds from, structure of arrays (vectorises without shuffles).
+struct SeedPoints {
+  std::vector<float> x, y, z;
+  [[nodiscard]] std::size_t size() const { return x.size(); }
+  [[nodiscard]] Eigen::Vector3f operator[](std::size_t i) const { return {x[i], y[i], z[i]}; }
+};
+
+/// nearest[i] = min(previous[i], |point i - centre|^2) (nearest may alias previous); returns the
+/// sum (the k-means++ potential). Eight running sums, so that the sum vectorises too.
+__attribute__((target_clones("avx2", "default"))) double nearest_squared_distances(
+    const float* x, const float* y, const float* z, std::size_t n, float cx, float cy, float cz,
+    const float* previous, float* nearest) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const float dx = x[i] - cx, dy = y[i] - cy, dz = z[i] - cz;
+    nearest[i] = std::min(previous[i], dx * dx + dy * dy + dz * dz);
   }
+  double lanes[8] = {};
+  std::size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    for (std::size_t l = 0; l < 8; ++l) lanes[l] += nearest[i + l];
+  }
+  double total = 0.0;
+  for (; i < n; ++i) total += nearest[i];
+  for (const double lane : lanes) total += lane;
+  return total;
+}
+
+double nearest_squared_distances(const SeedPoints& p, const Eigen::Vector3f& centre, const std::vector<float>& previous,
+                                 std::vector<float>& nearest) {
+  return nearest_squared_distances(p.x.data(), p.y.data(), p.z.data(), p.size(), centre.x(), centre.y(), centre.z(),
+                                   previous.data(), nearest.data());
+}
+
+/// An even-stride subset of at most `max_points` points (0: all): the D^2 distribution of a few
+/// ten thousand points is the same for seeding purposes and keeps the greedy trials cheap.
+SeedPoints seed_points(std::span<const Float3> all_points, std::size_t max_points) {
+  if (all_points.empty()) throw Error("brdf K-means: no points to seed from");
+  std::size_t stride = 1;
+  if (max_points > 0 && all_points.size() > max_points) stride = (all_points.size() + max_points - 1) / max_points;
+  SeedPoints points;
+  const std::size_t n = (all_points.size() + stride - 1) / stride;
+  points.x.resize(n);
+  points.y.resize(n);
+  points.z.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Float3& p = all_points[i * stride];
+    points.x[i] = p.x;
+    points.y[i] = p.y;
+    points.z[i] = p.z;
+  }
+  return points;
+}
+
+std::vector<Eigen::Vector3f> seed_centres(const SeedPoints& points, int clusters, std::mt19937_64& rng, int trials) {
+  check_clusters(static_cast<std::size_t>(clusters));
   const std::size_t n = points.size();
-  auto distance2 = [](const Float3& p, const Eigen::Vector3f& c) {
-    const float dx = p.x - c.x(), dy = p.y - c.y(), dz = p.z - c.z();
-    return dx * dx + dy * dy + dz * dz;
-  };
   std::vector<Eigen::Vector3f> centres;
   std::uniform_int_distribution<std::size_t> pick(0, n - 1);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  const Float3 first = points[pick(rng)];
-  centres.emplace_back(first.x, first.y, first.z);
-  std::vector<float> d2(n), trial_d2(n), best_d2(n);
-  double potential = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    d2[i] = distance2(points[i], centres[0]);
-    potential += d2[i];
-  }
+  centres.push_back(points[pick(rng)]);
+  std::vector<float> d2(n, std::numeric_limits<float>::infinity()), trial_d2(n), best_d2(n);
+  std::vector<double> cumulative(n);
+  double potential = nearest_squared_distances(points, centres[0], d2, d2);
   while (static_cast<int>(centres.size()) < clusters) {
     // Greedy k-means++ (as cv::kmeans and scikit-learn): `trials` candidates drawn by D^2, the
-    // one that lowers the potential most wins.
+    // one that lowers the potential most wins. All trials draw from the same distribution, so its
+    // cumulative sum is built once and each draw is a binary search.
+    double running = 0.0;
+    for (std::size_t i = 0; i < n; ++i) cumulative[i] = running += d2[i];
     double best_potential = std::numeric_limits<double>::infinity();
     Eigen::Vector3f best_centre = centres.back();
     for (int t = 0; t < std::max(1, trials); ++t) {
       std::size_t chosen = pick(rng);
       if (potential > 0.0) {
-        double target = unit(rng) * potential;
-        for (std::size_t i = 0; i < n; ++i) {
-          target -= d2[i];
-          if (target <= 0.0) {
-            chosen = i;
-            break;
-          }
-        }
+        const double target = unit(rng) * running;
+        chosen = std::min<std::size_t>(
+            n - 1, static_cast<std::size_t>(std::lower_bound(cumulative.begin(), cumulative.end(), target) -
+                                            cumulative.begin()));
       }
-      const Eigen::Vector3f candidate(points[chosen].x, points[chosen].y, points[chosen].z);
-      double trial_potential = 0.0;
-      for (std::size_t i = 0; i < n; ++i) {
-        trial_d2[i] = std::min(d2[i], distance2(points[i], candidate));
-        trial_potential += trial_d2[i];
-      }
+      const Eigen::Vector3f candidate = points[chosen];
+      const double trial_potential = nearest_squared_distances(points, candidate, d2, trial_d2);
       if (trial_potential < best_potential) {
         best_potential = trial_potential;
         best_centre = candidate;
@@ -285,12 +234,21 @@ std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> all_point
   return centres;
 }
 
+}  // namespace
+
+std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> points, int clusters, std::mt19937_64& rng,
+                                               int trials, std::size_t max_points) {
+  check_clusters(static_cast<std::size_t>(clusters));
+  return seed_centres(seed_points(points, max_points), clusters, rng, trials);
+}
+
 KMeansResult kmeans(KMeansEngine& engine, std::span<const Float3> points, const KMeansOptions& options, int attempts,
                     std::mt19937_64& rng) {
   engine.set_points(points);
+  const SeedPoints seeds = seed_points(points, kKMeansPpMaxPoints);
   KMeansResult best;
   for (int attempt = 0; attempt < std::max(1, attempts); ++attempt) {
-    KMeansResult r = lloyd(engine, kmeans_pp_centres(points, options.clusters, rng), options);
+    KMeansResult r = lloyd(engine, seed_centres(seeds, options.clusters, rng, kKMeansPpTrials), options);
     if (attempt == 0 || r.compactness < best.compactness) best = std::move(r);
   }
   return best;

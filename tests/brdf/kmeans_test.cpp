@@ -107,6 +107,41 @@ TEST(KMeans, ResultDoesNotDependOnTheThreadCount) {
   EXPECT_EQ(a.iterations, b.iterations);
 }
 
+TEST(KMeans, VectorisedAndPortableStepsAgreeExactly) {
+  // Random points (a count that leaves a tail after the groups of eight), plus points exactly
+  // halfway between two centres: both builds must break those ties towards the lower index.
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<float> unit(0.f, 2.f);
+  std::vector<Float3> points;
+  for (int i = 0; i < 10007; ++i) points.push_back({unit(rng), unit(rng), unit(rng)});
+  for (int i = 0; i < 64; ++i) points.push_back({0.5f, 0.25f * static_cast<float>(i % 8), 1.f});
+  for (const int clusters : {1, 6, 16}) {
+    std::vector<Eigen::Vector3f> centres = kmeans_pp_centres(points, clusters, rng);
+    if (clusters >= 2) {
+      centres[0] = {0.25f, 1.f, 1.f};  // the halfway points are 0.25 + 0.5 * (y - 1)^2 from both
+      centres[1] = {0.75f, 1.f, 1.f};
+    }
+    KMeansCpu fastest(2, KMeansCpuKernel::Fastest), portable(2, KMeansCpuKernel::Portable);
+    fastest.set_points(points);
+    portable.set_points(points);
+    const ClusterSums a = fastest.step(centres), b = portable.step(centres);
+    std::vector<std::uint8_t> la, lb;
+    fastest.read_labels(la);
+    portable.read_labels(lb);
+    EXPECT_EQ(la, lb) << clusters;
+    ASSERT_EQ(a.clusters.size(), b.clusters.size());
+    for (std::size_t k = 0; k < a.clusters.size(); ++k) {
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(a.clusters[k].sum[c], b.clusters[k].sum[c]) << clusters << " " << k;
+      EXPECT_EQ(a.clusters[k].count, b.clusters[k].count) << clusters << " " << k;
+      EXPECT_EQ(a.clusters[k].distance, b.clusters[k].distance) << clusters << " " << k;
+    }
+    if (clusters >= 2) {
+      // The tie points all went to centre 0, and none of them is nearer to centre 1.
+      for (std::size_t i = 10007; i < points.size(); ++i) EXPECT_NE(la[i], 1) << i;
+    }
+  }
+}
+
 TEST(KMeans, UseFirstStepsOnAPrefixAsIfOnlyItWasSet) {
   const SceneClusters data = scene_points(test::brdf_scene().color);
   const std::size_t prefix = data.points.size() / 3;

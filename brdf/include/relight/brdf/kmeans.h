@@ -82,11 +82,18 @@ class KMeansEngine {
   virtual void read_labels(std::vector<std::uint8_t>& labels) = 0;
 };
 
-/// The CPU engine: points split into chunks of 8192 over TBB workers, assigned and summed in
-/// vectorised blocks of 256, integer sums per chunk added up.
+/// Which build of the CPU step's inner loop runs (both give identical results).
+enum class KMeansCpuKernel {
+  Fastest,   ///< AVX2 where the CPU has it, else portable
+  Portable,  ///< plain C++ (for CPUs without AVX2, and to test the two against each other)
+};
+
+/// The CPU engine: points split into chunks of 8192 over TBB workers, each assigned and summed
+/// eight at a time with AVX2 where the CPU has it (a portable loop otherwise), integer sums per
+/// chunk added up.
 class KMeansCpu final : public KMeansEngine {
  public:
-  explicit KMeansCpu(int threads = 0);
+  explicit KMeansCpu(int threads = 0, KMeansCpuKernel kernel = KMeansCpuKernel::Fastest);
   ~KMeansCpu() override;
   KMeansCpu(KMeansCpu&&) noexcept;
   KMeansCpu& operator=(KMeansCpu&&) noexcept;
@@ -98,10 +105,10 @@ class KMeansCpu final : public KMeansEngine {
  private:
   struct Arena;  // the TBB task arena of `threads_` workers (kept out of this header)
   int threads_;
+  KMeansCpuKernel kernel_;
   std::unique_ptr<Arena> arena_;
   std::size_t active_ = 0;                   // points that step() works on
-  std::vector<float> xs_, ys_, zs_;           // points, structure of arrays
-  std::vector<std::uint32_t> qx_, qy_, qz_;  // their fixed-point values (brdf_shared.h)
+  std::vector<float> xs_, ys_, zs_;  // points, structure of arrays
   std::vector<std::uint8_t> labels_;
 };
 
@@ -109,14 +116,19 @@ class KMeansCpu final : public KMeansEngine {
 [[nodiscard]] KMeansResult lloyd(KMeansEngine& engine, std::vector<Eigen::Vector3f> initial,
                                  const KMeansOptions& options);
 
+/// k-means++ defaults: greedy candidates per centre, and the most points seeding looks at.
+inline constexpr int kKMeansPpTrials = 3;
+inline constexpr std::size_t kKMeansPpMaxPoints = 32768;
+
 /// k-means++ seeding (Arthur & Vassilvitskii): first centre uniform, then D^2 sampling, greedy
 /// with `trials` candidates per centre (the lowest potential wins, as in cv::kmeans), on an
 /// even-stride subset of at most `max_points` points (0: all).
 [[nodiscard]] std::vector<Eigen::Vector3f> kmeans_pp_centres(std::span<const Float3> points, int clusters,
-                                                             std::mt19937_64& rng, int trials = 3,
-                                                             std::size_t max_points = 32768);
+                                                             std::mt19937_64& rng, int trials = kKMeansPpTrials,
+                                                             std::size_t max_points = kKMeansPpMaxPoints);
 
-/// `attempts` runs from k-means++ seeds, the lowest compactness kept (cv::kmeans' setting).
+/// `attempts` runs from k-means++ seeds, the lowest compactness kept (cv::kmeans' setting); the
+/// seeding subset is gathered once for all attempts.
 [[nodiscard]] KMeansResult kmeans(KMeansEngine& engine, std::span<const Float3> points, const KMeansOptions& options,
                                   int attempts, std::mt19937_64& rng);
 
