@@ -6,6 +6,8 @@
 //   specular/nelder_mead, specular/ceres: ms to fit every cluster of the frame (<= 2048 samples
 //     each, two moving lights); ks_rel_error and n_rel_error on the glossy sphere (k_s 0.6, n 80)
 //     fitted from the camera image with its true k_d. Goal <= 15 ms.
+//   specular/objective_vulkan: F of the glossy sphere's 2048 samples at the 24 x 16 (n, k_s) start
+//     grid of the Vulkan backend, on the GPU against the CPU objective (double) per candidate.
 //   brdf/frame: the whole estimation per frame (highlights, k_d, warm-started K-means, Nelder-Mead
 //     fit), steady state. Goal <= 25 ms.
 #include <opencv2/core.hpp>
@@ -19,6 +21,7 @@
 #include "bench.h"
 #include "relight/brdf/brdf_stages.h"
 #include "relight/brdf/kmeans_vk.h"
+#include "relight/brdf/specular_objective_vk.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
@@ -130,6 +133,18 @@ bench::Json kmeans_vulkan(const bench::Options& options) {
   return kmeans_case(options, engine, context->device_info().name);
 }
 
+/// The glossy sphere alone, with its true k_d, from the camera image.
+SpecularProblem sphere_problem(const Frame& f) {
+  const int blue = f.scene.material_index("glossy_blue");
+  LabelImage ids(f.color.width(), f.color.height());
+  for (std::size_t i = 0; i < ids.size(); ++i) ids.pixels()[i] = f.truth.material.pixels()[i] == blue + 1 ? 1 : 0;
+  SpecularProblem problem;
+  problem.kd = f.scene.materials[static_cast<std::size_t>(blue)].kd.cast<float>();
+  problem.lights = f.lights;
+  problem.samples = select_samples(f.color, f.positions, f.truth.normals, ids, 0, &f.estimate.highlights, 2048);
+  return problem;
+}
+
 bench::Json specular_case(const bench::Options& options, SpecularMethod method) {
   const Frame& f = frame();
   BrdfOptions bo = options_for(f);
@@ -139,14 +154,7 @@ bench::Json specular_case(const bench::Options& options, SpecularMethod method) 
   const double ms = bench::median_ms(
       [&] { fit_materials(f.color, &f.estimate.highlights, f.positions, f.truth.normals, f.lights, bo, *solver, materials); },
       options.repetitions);
-  // The glossy sphere alone, with its true k_d, from the camera image.
-  const int blue = f.scene.material_index("glossy_blue");
-  LabelImage ids(f.color.width(), f.color.height());
-  for (std::size_t i = 0; i < ids.size(); ++i) ids.pixels()[i] = f.truth.material.pixels()[i] == blue + 1 ? 1 : 0;
-  SpecularProblem problem;
-  problem.kd = f.scene.materials[static_cast<std::size_t>(blue)].kd.cast<float>();
-  problem.lights = f.lights;
-  problem.samples = select_samples(f.color, f.positions, f.truth.normals, ids, 0, &f.estimate.highlights, 2048);
+  const SpecularProblem problem = sphere_problem(f);
   const SpecularFit fit = solver->fit(problem, bo.specular);
   const double sphere_ms = bench::median_ms([&] { (void)solver->fit(problem, bo.specular); }, options.repetitions);
   int fitted = 0;
@@ -163,6 +171,32 @@ bench::Json specular_case(const bench::Options& options, SpecularMethod method) 
 
 bench::Json specular_nelder_mead(const bench::Options& options) { return specular_case(options, SpecularMethod::NelderMead); }
 bench::Json specular_ceres(const bench::Options& options) { return specular_case(options, SpecularMethod::Ceres); }
+
+bench::Json specular_objective_vulkan(const bench::Options& options) {
+  const Frame& f = frame();
+  const SpecularProblem problem = sphere_problem(f);
+  SpecularOptions so;
+  const std::vector<SpecularCandidate> grid = specular_start_grid(so, 24, 16);
+  std::string why;
+  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);
+  if (!context) throw Error("no Vulkan device: " + why);
+  SpecularObjectiveVk gpu(*context);
+  std::vector<double> ours, theirs(grid.size());
+  const bench::Comparison cmp = bench::compare_interleaved(
+      [&] { ours = gpu.evaluate(problem, so, grid); },
+      [&] {
+        for (std::size_t i = 0; i < grid.size(); ++i) theirs[i] = specular_objective(problem, so, grid[i].ks, grid[i].n);
+      },
+      options.repetitions);
+  double worst = 0.0;
+  for (std::size_t i = 0; i < grid.size(); ++i) worst = std::max(worst, std::abs(ours[i] - theirs[i]) / theirs[i]);
+  bench::Json json = bench::comparison_json(cmp, "cpu_objective");
+  json["candidates"] = grid.size();
+  json["samples"] = problem.samples.size();
+  json["max_rel_diff"] = worst;
+  json["device"] = context->device_info().name;
+  return json;
+}
 
 bench::Json brdf_frame(const bench::Options& options) {
   const Frame& f = frame();
@@ -190,4 +224,5 @@ RELIGHT_BENCH_CASE("kmeans/cpu", kmeans_cpu);
 RELIGHT_BENCH_CASE("kmeans/vulkan", kmeans_vulkan);
 RELIGHT_BENCH_CASE("specular/nelder_mead", specular_nelder_mead);
 RELIGHT_BENCH_CASE("specular/ceres", specular_ceres);
+RELIGHT_BENCH_CASE("specular/objective_vulkan", specular_objective_vulkan);
 RELIGHT_BENCH_CASE("brdf/frame", brdf_frame);

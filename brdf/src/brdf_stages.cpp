@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "relight/brdf/kmeans_vk.h"
+#include "relight/brdf/specular_objective_vk.h"
 #include "relight/core/error.h"
 #include "parallel_tbb.h"
 
@@ -57,25 +58,33 @@ Materials materials_from_clusters(const KMeansResult& result, const std::vector<
 
 void fit_materials(const ColorImage& color, const Mask* highlights, const PositionMap& positions,
                    const NormalMap& normals, const ShadingLights& lights, const BrdfOptions& options,
-                   const SpecularSolver& solver, Materials& materials) {
+                   const SpecularSolver& solver, Materials& materials, SpecularObjectiveVk* gpu_start) {
   const int clusters = static_cast<int>(materials.clusters.size());
   std::vector<std::vector<SpecularSample>> samples =
       select_cluster_samples(color, positions, normals, materials.ids, clusters, highlights, options.max_samples);
+  std::vector<SpecularProblem> problems(static_cast<std::size_t>(clusters));
+  std::vector<SpecularOptions> starts(problems.size(), options.specular);
+  for (std::size_t k = 0; k < problems.size(); ++k) {
+    problems[k].kd = materials.clusters[k].kd;
+    problems[k].lights = lights;
+    problems[k].samples = std::move(samples[k]);
+    // One GPU submission per cluster, before the parallel fits (the queue is not shared).
+    if (gpu_start && !problems[k].samples.empty()) {
+      starts[k].start = best_grid_start(*gpu_start, problems[k], options.specular);
+    }
+  }
   detail::parallel_ranges(
       clusters, options.threads, 1,
       [&](int begin, int end) {
         for (int k = begin; k < end; ++k) {
-          MaterialParams& m = materials.clusters[static_cast<std::size_t>(k)];
-          SpecularProblem problem;
-          problem.kd = m.kd;
-          problem.lights = lights;
-          problem.samples = std::move(samples[static_cast<std::size_t>(k)]);
-          if (problem.samples.empty()) {
+          const auto index = static_cast<std::size_t>(k);
+          MaterialParams& m = materials.clusters[index];
+          if (problems[index].samples.empty()) {
             m.ks = 0.f;
             m.fit_rms = -1.f;
             continue;
           }
-          const SpecularFit fit = solver.fit(problem, options.specular);
+          const SpecularFit fit = solver.fit(problems[index], starts[index]);
           m.ks = fit.ks;
           m.n = fit.n;
           m.fit_rms = static_cast<float>(fit.rms);
@@ -166,6 +175,13 @@ void KMeansStage::run(StageContext& context) {
 SpecularFitStage::SpecularFitStage(BrdfOptions options, BrdfBuffers buffers)
     : options_(std::move(options)), buffers_(std::move(buffers)), solver_(make_solver(options_.solver)) {}
 
+SpecularFitStage::SpecularFitStage(vk::VulkanContext& context, BrdfOptions options, BrdfBuffers buffers)
+    : SpecularFitStage(std::move(options), std::move(buffers)) {
+  gpu_start_ = std::make_unique<SpecularObjectiveVk>(context);
+}
+
+SpecularFitStage::~SpecularFitStage() = default;
+
 void SpecularFitStage::declare(StageBuilder& builder) {
   clusters_ = builder.read<Materials>(buffers_.clusters);
   color_ = builder.read<ColorImage>(buffers_.color);
@@ -182,20 +198,21 @@ void SpecularFitStage::run(StageContext& context) {
   out = context.get(clusters_);
   const ShadingLights lights = camera_lights(context.get(lights_), context.get(frame_), options_.ambient);
   fit_materials(context.get(color_), &context.get(highlights_), context.get(positions_), context.get(normals_), lights,
-                options_, *solver_, out);
+                options_, *solver_, out, gpu_start_.get());
 }
 
-void add_brdf_stages(FrameGraph& graph, const BrdfOptions& options, Backend kmeans_backend,
-                     vk::VulkanContext* context, const BrdfBuffers& buffers) {
+void add_brdf_stages(FrameGraph& graph, const BrdfOptions& options, Backend backend, vk::VulkanContext* context,
+                     const BrdfBuffers& buffers) {
   graph.emplace<HighlightRemovalStage>(options.highlight, buffers);
   graph.emplace<DiffuseStage>(options.diffuse, options.ambient, buffers);
-  if (kmeans_backend == Backend::Vulkan) {
-    if (!context) throw LogicError("add_brdf_stages: Vulkan K-means needs a VulkanContext");
+  if (backend == Backend::Vulkan) {
+    if (!context) throw LogicError("add_brdf_stages: the Vulkan backend needs a VulkanContext");
     graph.emplace<KMeansStage>(*context, options.kmeans, options.seed, buffers);
+    graph.emplace<SpecularFitStage>(*context, options, buffers);
   } else {
     graph.emplace<KMeansStage>(options.kmeans, options.seed, buffers);
+    graph.emplace<SpecularFitStage>(options, buffers);
   }
-  graph.emplace<SpecularFitStage>(options, buffers);
 }
 
 }  // namespace relight::brdf

@@ -188,6 +188,12 @@ StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options) 
   const int count = std::max(2, options.start_exponents);
   const double low = std::log(static_cast<double>(options.n_min));
   StartShape best = start_shape_spacing(options);
+  if (options.start) {
+    best.ks = std::clamp(static_cast<double>(options.start->ks), 0.0, static_cast<double>(options.ks_max));
+    best.n = std::clamp(static_cast<double>(options.start->n), static_cast<double>(options.n_min),
+                        static_cast<double>(options.n_max));
+    return best;
+  }
   double best_f = std::numeric_limits<double>::infinity();
   for (int k = 0; k < count; ++k) {
     const double n = std::exp(low + k * best.log_n_spacing);

@@ -70,8 +70,9 @@ class ShapeTerms {
 /// The lights with the first `moving` moved by offsets[3 l .. 3 l + 2] (null: none moved).
 [[nodiscard]] ShadingLights moved_lights(const ShadingLights& ordered, int moving, const double* offsets);
 
-/// Starting point of a (k_s, n) fit: the best of options.start_exponents exponents spaced evenly
-/// in log n over [n_min, n_max], each with its least-squares k_s.
+/// Starting point of a (k_s, n) fit: options.start when set, else the best of
+/// options.start_exponents exponents spaced evenly in log n over [n_min, n_max], each with its
+/// least-squares k_s.
 struct StartShape {
   double ks = 0.0;
   double n = 1.0;

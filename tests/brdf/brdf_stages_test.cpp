@@ -109,16 +109,24 @@ TEST(BrdfStages, GraphProducesConsistentMaterials) {
 
 class BrdfStagesVkTest : public test::VulkanTest {};
 
-TEST_F(BrdfStagesVkTest, VulkanKMeansStageGivesTheSameMaterials) {
+TEST_F(BrdfStagesVkTest, VulkanBackendGivesTheSameMaterials) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const Materials cpu = run_graph(Backend::Cpu, nullptr, 2);  // the second frame starts warm
   const Materials gpu = run_graph(Backend::Vulkan, &context, 2);
   ASSERT_EQ(cpu.clusters.size(), gpu.clusters.size());
+  // K-means: identical (exact integer sums on both).
   EXPECT_EQ(cpu.ids, gpu.ids);
   for (std::size_t k = 0; k < cpu.clusters.size(); ++k) {
-    EXPECT_EQ(cpu.clusters[k].kd, gpu.clusters[k].kd);
-    EXPECT_EQ(cpu.clusters[k].ks, gpu.clusters[k].ks);
-    EXPECT_EQ(cpu.clusters[k].n, gpu.clusters[k].n);
+    const MaterialParams &a = cpu.clusters[k], &b = gpu.clusters[k];
+    EXPECT_EQ(a.kd, b.kd);
+    // The specular fits start from different grids (CPU: 12 exponents with least-squares k_s;
+    // GPU: 24 x 16 (n, k_s)) and must reach the same optimum.
+    EXPECT_EQ(a.ks > 0.f, b.ks > 0.f) << k;
+    if (a.ks > 0.f && b.ks > 0.f) {
+      EXPECT_NEAR(b.ks, a.ks, 0.02f * a.ks) << k;
+      EXPECT_NEAR(b.n, a.n, 0.05f * a.n) << k;
+      std::printf("cluster %zu: CPU start ks %.4f n %.2f, GPU start ks %.4f n %.2f\n", k, a.ks, a.n, b.ks, b.n);
+    }
   }
 }
 

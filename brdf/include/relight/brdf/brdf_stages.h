@@ -33,6 +33,8 @@ class VulkanContext;
 
 namespace brdf {
 
+class SpecularObjectiveVk;
+
 struct BrdfBuffers {
   std::string color = "color";
   std::string positions = "positions";
@@ -125,9 +127,15 @@ class KMeansStage final : public Stage {
   KMeansResult result_;
 };
 
+/// The specular fit on the CPU, or with each cluster's starting point chosen on the GPU
+/// (fit_materials()'s gpu_start) when constructed with a context. Either way it declares the CPU
+/// backend: its buffers (Materials, the samples it gathers) live on the host, and the GPU start
+/// uploads its own small batch.
 class SpecularFitStage final : public Stage {
  public:
   explicit SpecularFitStage(BrdfOptions options = {}, BrdfBuffers buffers = {});
+  SpecularFitStage(vk::VulkanContext& context, BrdfOptions options = {}, BrdfBuffers buffers = {});
+  ~SpecularFitStage() override;
   [[nodiscard]] std::string name() const override { return "specular_fit"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
@@ -136,6 +144,7 @@ class SpecularFitStage final : public Stage {
   BrdfOptions options_;
   BrdfBuffers buffers_;
   std::unique_ptr<SpecularSolver> solver_;
+  std::unique_ptr<SpecularObjectiveVk> gpu_start_;
   Read<Materials> clusters_;
   Read<ColorImage> color_;
   Read<Mask> highlights_;
@@ -146,8 +155,9 @@ class SpecularFitStage final : public Stage {
   Write<Materials> materials_;
 };
 
-/// The four stages; K-means on Vulkan when `kmeans_backend` is Vulkan (needs `context`).
-void add_brdf_stages(FrameGraph& graph, const BrdfOptions& options = {}, Backend kmeans_backend = Backend::Cpu,
+/// The four stages; K-means and the specular fit's starting points on Vulkan when `backend` is
+/// Vulkan (needs `context`).
+void add_brdf_stages(FrameGraph& graph, const BrdfOptions& options = {}, Backend backend = Backend::Cpu,
                      vk::VulkanContext* context = nullptr, const BrdfBuffers& buffers = {});
 
 /// Clusters and materials for one frame without a graph (benchmarks, tools): the same work as the
@@ -163,10 +173,12 @@ void estimate_brdf(const ColorImage& color, const PositionMap& positions, const 
                    const ShadingLights& lights, const BrdfOptions& options, KMeansEngine& engine,
                    KMeansTracker& tracker, const SpecularSolver& solver, BrdfFrame& out);
 
-/// Fits every cluster of `materials` (ids and k_d set) in parallel; fills k_s, n, fit_rms.
+/// Fits every cluster of `materials` (ids and k_d set) in parallel; fills k_s, n, fit_rms. With
+/// `gpu_start`, each cluster's fit starts from the best of a dense (k_s, n) grid evaluated on the
+/// GPU (best_grid_start()) instead of the solvers' own exponent grid.
 void fit_materials(const ColorImage& color, const Mask* highlights, const PositionMap& positions,
                    const NormalMap& normals, const ShadingLights& lights, const BrdfOptions& options,
-                   const SpecularSolver& solver, Materials& materials);
+                   const SpecularSolver& solver, Materials& materials, SpecularObjectiveVk* gpu_start = nullptr);
 
 /// Materials from a K-means result on the pixels `pixels` (indices into a width x height image).
 [[nodiscard]] Materials materials_from_clusters(const KMeansResult& result, const std::vector<std::uint32_t>& pixels,

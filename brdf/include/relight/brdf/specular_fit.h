@@ -30,6 +30,7 @@
 // is declared diffuse (k_s = 0).
 #include <Eigen/Core>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,12 @@ struct SpecularProblem {
   ShadingLights lights;
 };
 
+/// A starting point of the (k_s, n) fit.
+struct SpecularStart {
+  float ks = 0.f;
+  float n = 1.f;
+};
+
 struct SpecularOptions {
   float ks_max = 1.f;
   float n_min = 1.f;
@@ -57,6 +64,9 @@ struct SpecularOptions {
   /// The fits start from the best of this many exponents spaced evenly in log n over
   /// [n_min, n_max], each with its least-squares k_s (for fixed n the model is linear in k_s).
   int start_exponents = 12;
+  /// When set, the fits start here instead of from that grid (SpecularFitStage on Vulkan: the
+  /// best of a denser (k_s, n) grid evaluated on the GPU, specular_objective_vk.h).
+  std::optional<SpecularStart> start;
   /// How many of the strongest lights may move (at most 2); 0 keeps every light fixed.
   int moving_lights = 2;
   float point_offset_max = 0.05f;      ///< metres, per axis, for point lights
