@@ -1,7 +1,9 @@
 #pragma once
 // A source stage for the DIR-stage tests: one view of the synthetic scene, written every frame
 // as the reconstruct stages would - colour, camera-frame positions and normals, and the pose -
-// optionally with fresh Kinect-like depth noise (sigma = depth_noise * z^2) in every frame.
+// optionally with fresh Kinect-like depth noise (sigma = depth_noise * z^2) in every frame. With
+// Output::Depth it writes the (noisy) depth instead of positions and normals, for the
+// reconstruct stages to turn into geometry as in `relight replay`.
 #include <random>
 
 #include "relight/core/frame_graph.h"
@@ -13,15 +15,22 @@ namespace relight::render::test {
 
 class SyntheticFrameStage final : public Stage {
  public:
-  SyntheticFrameStage(PinholeIntrinsics intrinsics, Pose pose, float depth_noise = 0.f)
+  enum class Output { Geometry, Depth };
+  SyntheticFrameStage(PinholeIntrinsics intrinsics, Pose pose, float depth_noise = 0.f,
+                      Output output = Output::Geometry)
       : intrinsics_(intrinsics),
         pose_(pose),
         depth_noise_(depth_noise),
+        output_(output),
         truth_(synth::render_frame(synth::default_indoor_scene(), intrinsics, pose)) {}
   [[nodiscard]] std::string name() const override { return "synthetic_frame"; }
   void declare(StageBuilder& builder) override {
     frame_ = builder.write<FrameInfo>("frame");
     color_ = builder.write<ColorImage>("color");
+    if (output_ == Output::Depth) {
+      depth_ = builder.write<DepthMap>("depth");
+      return;
+    }
     positions_ = builder.write<PositionMap>("positions");
     normals_ = builder.write<NormalMap>("normals");
   }
@@ -34,6 +43,10 @@ class SyntheticFrameStage final : public Stage {
     }
     context.get(frame_) = FrameInfo{context.frame_index(), 0.0, pose_, intrinsics_};
     context.get(color_) = synth::encode_color(truth_.radiance);
+    if (output_ == Output::Depth) {
+      context.get(depth_) = std::move(depth);
+      return;
+    }
     context.get(positions_) = positions_from_depth(depth, intrinsics_);
     context.get(normals_) = truth_.normals;
   }
@@ -42,11 +55,13 @@ class SyntheticFrameStage final : public Stage {
   PinholeIntrinsics intrinsics_;
   Pose pose_;
   float depth_noise_;
+  Output output_;
   synth::RenderedFrame truth_;
   Write<FrameInfo> frame_;
   Write<ColorImage> color_;
   Write<PositionMap> positions_;
   Write<NormalMap> normals_;
+  Write<DepthMap> depth_;
 };
 
 }  // namespace relight::render::test
