@@ -3,9 +3,10 @@
 // 0.02, smoothing 10: the dissertation's comparison), and normals/pcl_omp (NormalEstimationOMP,
 // k = 10) as its own line. Same process, same 640x480 synthetic frames (static camera, Kinect v1
 // noise), angular error against the ray caster's exact normals on the last frame.
-// "ms" is one steady-state frame (the previous frame's outputs as history); the errors are
-// after 10 frames. Without PCL (libpcl-dev, scripts/debian-packages-bench.txt) the baseline
-// fields are absent.
+// "ms" is one steady-state frame (the previous frame's outputs as history; method 1 on the CPU
+// through a NormalsRawDepthCpu, as the stage runs it, whose scratch memory persists between
+// frames); the errors are after 10 frames. Without PCL (libpcl-dev,
+// scripts/debian-packages-bench.txt) the baseline fields are absent.
 // normals/method1_vulkan: method 1 with every per-pixel pass on the GPU (NormalsRawDepthVk:
 // cross products eq. 4.4–4.6, temporal blend eq. 4.7–4.8, hole filling) and pass 1's pyramid on
 // the CPU; "ms" is one frame end to end (pyramid, buffer allocation, uploads, three dispatches,
@@ -152,10 +153,9 @@ Json method1_cpu(const bench::Options& options) {
   const NormalsHistory history{normals[last], positions[last], s.pose};
   PositionMap scratch_positions;
   NormalMap scratch_normals;
+  NormalsRawDepthCpu method;  // as the stage: scratch memory kept between frames
   Json json = compare_with_pcl(
-      [&] {
-        normals_raw_depth(s.noisy.back(), s.intrinsics, s.pose, &history, {}, scratch_positions, scratch_normals);
-      },
+      [&] { method.run(s.noisy.back(), s.intrinsics, s.pose, &history, {}, scratch_positions, scratch_normals); },
       options);
   json["angular_error_deg"] = error.mean_deg;
   json["coverage"] = error.coverage;

@@ -1,195 +1,282 @@
-// CPU implementation of method 1 (definition in normals_raw_depth.h).
+// CPU implementation of method 1 (definition in normals_raw_depth.h). Per frame: pass 1 builds
+// the pyramid from the previous normals (rows in parallel, two level-0 rows and one level-1 row
+// per task, coarser levels after), pass 2 computes positions, cross products and the blend per
+// row in parallel and lists each row's holes, and the holes are filled last (few pixels, one
+// thread). The per-pixel work is in normals_raw_depth_kernels.h (scalar) and
+// normals_raw_depth_avx2.cpp (AVX2, same results).
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
+#include "normals_raw_depth_kernels.h"
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
-#include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
 
 namespace relight {
 
+namespace method1 {
+/// What NormalsRawDepthCpu keeps between frames.
+struct Scratch {
+  Pyramid pyramid;
+  std::vector<float> x_scale;               ///< padded by stride + 8 on both sides
+  std::vector<std::uint32_t> hole_columns;  ///< row r's holes at r * width
+  std::vector<int> hole_counts;
+  std::vector<std::pair<std::size_t, Float3>> fills;
+};
+}  // namespace method1
+
+struct NormalsRawDepthCpu::Workspace : method1::Scratch {};
+
 namespace {
 
-Float3 normalized_or_zero(const Float3& v) {
-  const float len = length(v);
-  return len > 0.f ? (1.f / len) * v : Float3{};
+using method1::Pyramid;
+
+bool use_avx2(const NormalsRawDepthOptions& options) { return options.simd && method1::avx2_available(); }
+
+// Level shapes as the reference pyramid: half resolution (rounding up), halving while both sides
+// exceed one texel, at most `levels` levels.
+void shape_pyramid(Pyramid& pyramid, int width, int height, int levels) {
+  pyramid.levels.clear();
+  int w = (width + 1) / 2, h = (height + 1) / 2, size = w * h;
+  pyramid.levels.push_back({w, h, 0});
+  while (static_cast<int>(pyramid.levels.size()) < levels && w > 1 && h > 1) {
+    w = (w + 1) / 2;
+    h = (h + 1) / 2;
+    pyramid.levels.push_back({w, h, size});
+    size += w * h;
+  }
+  // Padded by 8: the AVX2 loop loads eight neighbouring texels from any texel on.
+  for (auto* v : {&pyramid.x, &pyramid.y, &pyramid.z, &pyramid.curvature}) v->resize(static_cast<std::size_t>(size) + 8);
 }
 
-float pow128(float x) {
-  for (int i = 0; i < 7; ++i) x *= x;
-  return x;
+void level0_row(const NormalMap& previous, int hr, Pyramid& pyramid, bool avx2) {
+  if (avx2) {
+    method1::level0_row_avx2(previous.data(), previous.width(), previous.height(), hr, pyramid);
+    return;
+  }
+  for (int hc = 0; hc < pyramid.levels[0].width; ++hc) {
+    method1::level0_texel(previous.data(), previous.width(), previous.height(), hr, hc, pyramid);
+  }
 }
 
-using NormalLevel = NormalsPyramidLevel;
-
-// Pass 1 at half resolution: texel (r, c) summarises full-resolution pixel (2r, 2c).
-NormalLevel average_and_curvature(const NormalMap& previous, int threads) {
-  const int width = (previous.width() + 1) / 2;
-  const int height = (previous.height() + 1) / 2;
-  NormalLevel level{Image<Float3>(width, height), Image<float>(width, height)};
-  const auto at = [&](int r, int c) -> Float3 {
-    return previous.in_bounds(r, c) ? previous(r, c) : Float3{};
-  };
-  parallel_rows(height, threads, [&](int begin, int end) {
-    for (int hr = begin; hr < end; ++hr) {
-      for (int hc = 0; hc < width; ++hc) {
-        const int r = 2 * hr, c = 2 * hc;
-        const Float3 up = at(r - 1, c), down = at(r + 1, c), left = at(r, c - 1), right = at(r, c + 1);
-        level.normal(hr, hc) = normalized_or_zero(at(r, c) + up + down + left + right);  // missing ones are 0
-        const bool horizontal = is_valid_normal(left) && is_valid_normal(right);
-        const bool vertical = is_valid_normal(up) && is_valid_normal(down);
-        const float curv = horizontal && vertical ? std::min(dot(left, right), dot(up, down)) : 0.f;
-        level.curvature(hr, hc) = pow128(std::clamp(curv, 0.f, 1.f));
-      }
-    }
-  });
-  return level;
+void coarse_row(Pyramid& pyramid, int level, int r, bool avx2) {
+  if (avx2) {
+    method1::coarse_row_avx2(pyramid, level, r);
+    return;
+  }
+  for (int c = 0; c < pyramid.levels[static_cast<std::size_t>(level)].width; ++c) {
+    method1::coarse_texel(pyramid, level, r, c);
+  }
 }
 
-NormalLevel downsample(const NormalLevel& fine) {
-  const int width = (fine.normal.width() + 1) / 2;
-  const int height = (fine.normal.height() + 1) / 2;
-  NormalLevel coarse{Image<Float3>(width, height), Image<float>(width, height)};
-  for (int r = 0; r < height; ++r) {
-    for (int c = 0; c < width; ++c) {
-      Float3 sum;
-      float curvature = 0.f;
-      int count = 0;
-      for (int dr = 0; dr < 2; ++dr) {
-        for (int dc = 0; dc < 2; ++dc) {
-          if (!fine.normal.in_bounds(2 * r + dr, 2 * c + dc)) continue;
-          const Float3& n = fine.normal(2 * r + dr, 2 * c + dc);
-          if (!is_valid_normal(n)) continue;
-          sum += n;
-          curvature += fine.curvature(2 * r + dr, 2 * c + dc);
-          ++count;
+void resolve_row(Pyramid& pyramid, const method1::Constants& k, int r, bool avx2) {
+  if (avx2) {
+    method1::resolve_row_avx2(pyramid, k, r);
+    return;
+  }
+  for (int c = 0; c < pyramid.levels[0].width; ++c) method1::resolve_texel(pyramid, k, r, c);
+}
+
+// Pass 1, and with `resolve_for` the resolved history normals for that frame's rotation. The
+// rows are split in blocks of 2^(levels − 1) level-0 rows: level l's rows above a block come
+// from that block's rows only, so one task builds every level and the resolved rows of its block
+// while they are in its cache.
+void build_pyramid(const NormalMap& previous, int levels, int threads, bool avx2, Pyramid& pyramid,
+                   const method1::Constants* resolve_for = nullptr) {
+  shape_pyramid(pyramid, previous.width(), previous.height(), std::max(1, levels));
+  const auto padded = pyramid.x.size();
+  for (auto* v : {&pyramid.history_x, &pyramid.history_y, &pyramid.history_z}) v->resize(resolve_for ? padded : 0);
+  const int top = static_cast<int>(pyramid.levels.size()) - 1;
+  const int block = 1 << top;  // level-0 rows
+  const int blocks = (pyramid.levels[0].height + block - 1) / block;
+  parallel_for_each_row(
+      blocks, threads,
+      [&](int b) {
+        for (int level = 0; level <= top; ++level) {
+          const int rows = block >> level;
+          const int end = std::min((b + 1) * rows, pyramid.levels[static_cast<std::size_t>(level)].height);
+          for (int r = b * rows; r < end; ++r) {
+            if (level == 0) {
+              level0_row(previous, r, pyramid, avx2);
+            } else {
+              coarse_row(pyramid, level, r, avx2);
+            }
+          }
         }
-      }
-      coarse.normal(r, c) = normalized_or_zero(sum);
-      coarse.curvature(r, c) = count > 0 ? curvature / static_cast<float>(count) : 0.f;
-    }
-  }
-  return coarse;
+        if (resolve_for) {
+          const int end = std::min((b + 1) * block, pyramid.levels[0].height);
+          for (int r = b * block; r < end; ++r) resolve_row(pyramid, *resolve_for, r, avx2);
+        }
+      },
+      1);
 }
 
-std::vector<NormalLevel> build_pyramid(const NormalMap& previous, int levels, int threads) {
-  std::vector<NormalLevel> pyramid;
-  pyramid.push_back(average_and_curvature(previous, threads));
-  while (static_cast<int>(pyramid.size()) < levels && pyramid.back().normal.width() > 1 &&
-         pyramid.back().normal.height() > 1) {
-    pyramid.push_back(downsample(pyramid.back()));
-  }
-  return pyramid;
-}
-
-// Row-major float 3x4 rigid transform, for the inner loops.
-struct Rigid {
-  float m[3][4];
-  explicit Rigid(const Pose& pose) {
+method1::Constants frame_constants(const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                                   const NormalsHistory* previous, const NormalsRawDepthOptions& options, int width,
+                                   int height) {
+  method1::Constants k;
+  k.width = width;
+  k.height = height;
+  k.stride = options.stride;
+  k.inv_fx = static_cast<float>(1.0 / intrinsics.fx);
+  k.inv_fy = static_cast<float>(1.0 / intrinsics.fy);
+  k.cx = static_cast<float>(intrinsics.cx);
+  k.cy = static_cast<float>(intrinsics.cy);
+  k.fx = static_cast<float>(intrinsics.fx);
+  k.fy = static_cast<float>(intrinsics.fy);
+  k.max_jump_rel = options.max_jump_rel;
+  k.blend_base = options.blend_base;
+  k.disocclusion_m = options.disocclusion_m;
+  if (previous) {
+    // T_prev_from_current maps current camera-frame points into the previous camera frame.
+    const Pose prev_from_current = previous->camera_to_world.inverse() * camera_to_world;
+    const Pose current_from_prev = prev_from_current.inverse();
     for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) m[r][c] = static_cast<float>(pose.matrix()(r, c));
+      for (int c = 0; c < 4; ++c) k.prev_from_current[r * 4 + c] = static_cast<float>(prev_from_current.matrix()(r, c));
+      for (int c = 0; c < 3; ++c) k.current_from_prev[r * 3 + c] = static_cast<float>(current_from_prev.matrix()(r, c));
     }
   }
-  [[nodiscard]] Float3 point(const Float3& p) const {
-    return {m[0][0] * p.x + m[0][1] * p.y + m[0][2] * p.z + m[0][3],
-            m[1][0] * p.x + m[1][1] * p.y + m[1][2] * p.z + m[1][3],
-            m[2][0] * p.x + m[2][1] * p.y + m[2][2] * p.z + m[2][3]};
-  }
-  [[nodiscard]] Float3 direction(const Float3& d) const {
-    return {m[0][0] * d.x + m[0][1] * d.y + m[0][2] * d.z, m[1][0] * d.x + m[1][1] * d.y + m[1][2] * d.z,
-            m[2][0] * d.x + m[2][1] * d.y + m[2][2] * d.z};
-  }
-};
-
-// Pass 2's temporal blend for one pixel with a fresh normal `fresh` at camera-frame position p.
-Float3 blend_with_history(const Float3& fresh, const Float3& p, const NormalsHistory& previous,
-                          const std::vector<NormalLevel>& pyramid, const Rigid& prev_from_current,
-                          const Rigid& current_from_prev, const PinholeIntrinsics& intrinsics,
-                          const NormalsRawDepthOptions& options) {
-  const Float3 q = prev_from_current.point(p);
-  if (!(q.z > 0.f)) return fresh;
-  const float u = static_cast<float>(intrinsics.fx) * q.x / q.z + static_cast<float>(intrinsics.cx);
-  const float v = static_cast<float>(intrinsics.fy) * q.y / q.z + static_cast<float>(intrinsics.cy);
-  const int col = static_cast<int>(std::lround(u));
-  const int row = static_cast<int>(std::lround(v));
-  if (!previous.positions.in_bounds(row, col)) return fresh;
-  const float previous_z = previous.positions(row, col).z;
-  if (!(previous_z > 0.f) || std::fabs(previous_z - q.z) > options.disocclusion_m) return fresh;
-
-  const int max_level = static_cast<int>(pyramid.size()) - 1;
-  const float curvature = pyramid[0].curvature(row / 2, col / 2);
-  const int level = std::clamp(static_cast<int>(std::lround(curvature * static_cast<float>(max_level))), 0, max_level);
-  Float3 history = pyramid[level].normal(row >> (level + 1), col >> (level + 1));
-  if (!is_valid_normal(history)) history = pyramid[0].normal(row / 2, col / 2);
-  if (!is_valid_normal(history)) return fresh;
-  history = current_from_prev.direction(history);
-
-  const float c_n = std::fabs(dot(history, fresh));
-  const float c = options.blend_base * c_n + (1.f - c_n);
-  const Float3 blended = normalized_or_zero(c * history + (1.f - c) * fresh);
-  return is_valid_normal(blended) ? blended : fresh;
+  return k;
 }
 
-// Holes: pixels with a position but no normal take the mean of their valid 4-neighbours.
-void fill_holes(const PositionMap& positions, NormalMap& normals) {
-  std::vector<std::pair<std::size_t, Float3>> fills;
-  const int width = normals.width();
-  for (int r = 0; r < normals.height(); ++r) {
-    for (int c = 0; c < width; ++c) {
-      if (!(positions(r, c).z > 0.f) || is_valid_normal(normals(r, c))) continue;
+// (c − cx)·inv_fx for c in [−pad, width + pad), as positions_from_depth computes it; returns
+// the element of column 0. The AVX2 loop loads eight entries from c ± stride on.
+const float* column_scales(std::vector<float>& table, const method1::Constants& k) {
+  const int pad = std::clamp(k.stride, 0, k.width) + 8;
+  table.resize(static_cast<std::size_t>(k.width + 2 * pad));
+  for (int i = 0; i < k.width + 2 * pad; ++i) {
+    table[static_cast<std::size_t>(i)] = (static_cast<float>(i - pad) - k.cx) * k.inv_fx;
+  }
+  return table.data() + pad;
+}
+
+// Holes (a position but no normal after the blend) take the normalised sum of their
+// 4-neighbours' normals; all fills are computed before any is applied.
+void fill_holes(const method1::Pass2& pass, NormalMap& normals, std::vector<std::pair<std::size_t, Float3>>& fills) {
+  const int width = normals.width(), height = normals.height();
+  fills.clear();
+  for (int r = 0; r < height; ++r) {
+    const std::uint32_t* columns = pass.hole_columns + static_cast<std::size_t>(r) * static_cast<std::size_t>(width);
+    for (int j = 0; j < pass.hole_counts[r]; ++j) {
+      const int c = static_cast<int>(columns[j]);
       Float3 sum;
       if (r > 0) sum += normals(r - 1, c);
-      if (r + 1 < normals.height()) sum += normals(r + 1, c);
+      if (r + 1 < height) sum += normals(r + 1, c);
       if (c > 0) sum += normals(r, c - 1);
       if (c + 1 < width) sum += normals(r, c + 1);
-      const Float3 n = normalized_or_zero(sum);
-      if (is_valid_normal(n)) fills.emplace_back(static_cast<std::size_t>(r) * static_cast<std::size_t>(width) + static_cast<std::size_t>(c), n);
+      const Float3 n = method1::normalized_or_zero(sum);
+      if (is_valid_normal(n)) {
+        fills.emplace_back(static_cast<std::size_t>(r) * static_cast<std::size_t>(width) + static_cast<std::size_t>(c), n);
+      }
     }
   }
   for (const auto& [index, n] : fills) normals.pixels()[index] = n;
 }
 
+bool usable(const NormalsHistory* previous, const Image<Float3>& shape) {
+  return previous && previous->normals.same_shape(shape) && previous->positions.same_shape(shape);
+}
+
+// Pass 1 (when there is history) and everything pass 2 needs except its image pointers.
+method1::Pass2 prepare(method1::Scratch& ws, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                       const NormalsHistory* previous, const NormalsRawDepthOptions& options, int width, int height) {
+  method1::Pass2 pass;
+  pass.k = frame_constants(intrinsics, camera_to_world, previous, options, width, height);
+  if (previous) {
+    build_pyramid(previous->normals, options.mip_levels, options.threads, use_avx2(options), ws.pyramid, &pass.k);
+    pass.prev_positions = previous->positions.data();
+    pass.pyramid = &ws.pyramid;
+  }
+  const auto pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (ws.hole_columns.size() < pixels) ws.hole_columns.resize(pixels);
+  ws.hole_counts.resize(static_cast<std::size_t>(height));
+  pass.hole_columns = ws.hole_columns.data();
+  pass.hole_counts = ws.hole_counts.data();
+  return pass;
+}
+
+// Pass 2 over the rows in parallel, then the hole filling.
+void finish(method1::Scratch& ws, const method1::Pass2& pass, const NormalsRawDepthOptions& options,
+            NormalMap& normals) {
+  // The AVX2 row gathers with 32-bit indices into the previous positions (3 floats a pixel) and
+  // reads the column table within stride + 8 of the image.
+  const bool avx2 = use_avx2(options) && static_cast<long long>(pass.k.width) * pass.k.height * 3 < (1LL << 31) &&
+                    pass.k.stride >= 1 && pass.k.stride <= pass.k.width;
+  parallel_rows(pass.k.height, options.threads, [&](int begin, int end) {
+    for (int r = begin; r < end; ++r) {
+      pass.hole_counts[r] = 0;
+      if (avx2) {
+        method1::pass2_row_avx2(pass, r);
+      } else {
+        for (int c = 0; c < pass.k.width; ++c) method1::pass2_pixel(pass, r, c);
+      }
+    }
+  });
+  fill_holes(pass, normals, ws.fills);
+}
+
 }  // namespace
 
+NormalsRawDepthCpu::NormalsRawDepthCpu() : workspace_(std::make_unique<Workspace>()) {}
+NormalsRawDepthCpu::~NormalsRawDepthCpu() = default;
+
+void NormalsRawDepthCpu::run(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                             const NormalsHistory* previous, const NormalsRawDepthOptions& options,
+                             PositionMap& positions, NormalMap& normals) {
+  positions.resize(depth.width(), depth.height());
+  normals.resize(depth.width(), depth.height());
+  if (depth.empty()) return;
+  method1::Pass2 pass = prepare(*workspace_, intrinsics, camera_to_world, usable(previous, positions) ? previous : nullptr,
+                                options, depth.width(), depth.height());
+  pass.depth = depth.data();
+  pass.x_scale = column_scales(workspace_->x_scale, pass.k);
+  pass.positions_out = positions.data();
+  pass.normals = normals.data();
+  finish(*workspace_, pass, options, normals);
+}
+
+void NormalsRawDepthCpu::blend(const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                               const NormalsHistory* previous, const NormalsRawDepthOptions& options,
+                               const PositionMap& positions, NormalMap& normals) {
+  if (!normals.same_shape(positions)) throw LogicError("normals_raw_depth_blend: normals and positions differ in shape");
+  if (positions.empty()) return;
+  method1::Pass2 pass = prepare(*workspace_, intrinsics, camera_to_world, usable(previous, positions) ? previous : nullptr,
+                                options, positions.width(), positions.height());
+  pass.positions_in = positions.data();
+  pass.normals = normals.data();
+  finish(*workspace_, pass, options, normals);
+}
+
+bool normals_raw_depth_simd_available() { return method1::avx2_available(); }
+
 std::vector<NormalsPyramidLevel> normals_history_pyramid(const NormalMap& previous, int levels, int threads) {
-  return build_pyramid(previous, std::max(1, levels), threads);
+  Pyramid pyramid;
+  build_pyramid(previous, levels, threads, method1::avx2_available(), pyramid);
+  std::vector<NormalsPyramidLevel> out;
+  for (const method1::LevelShape& shape : pyramid.levels) {
+    NormalsPyramidLevel level{Image<Float3>(shape.width, shape.height), Image<float>(shape.width, shape.height)};
+    for (std::size_t i = 0; i < level.normal.size(); ++i) {
+      const std::size_t j = static_cast<std::size_t>(shape.offset) + i;
+      level.normal.pixels()[i] = {pyramid.x[j], pyramid.y[j], pyramid.z[j]};
+      level.curvature.pixels()[i] = pyramid.curvature[j];
+    }
+    out.push_back(std::move(level));
+  }
+  return out;
 }
 
 void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
                        const NormalsHistory* previous, const NormalsRawDepthOptions& options,
                        PositionMap& positions, NormalMap& normals) {
-  positions_from_depth(depth, intrinsics, positions, options.threads);
-  normals_from_positions(positions, normals,
-                         {.stride = options.stride, .max_jump_rel = options.max_jump_rel, .threads = options.threads});
-  normals_raw_depth_blend(intrinsics, camera_to_world, previous, options, positions, normals);
+  NormalsRawDepthCpu().run(depth, intrinsics, camera_to_world, previous, options, positions, normals);
 }
 
 void normals_raw_depth_blend(const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
                              const NormalsHistory* previous, const NormalsRawDepthOptions& options,
                              const PositionMap& positions, NormalMap& normals) {
-  if (!normals.same_shape(positions)) throw LogicError("normals_raw_depth_blend: normals and positions differ in shape");
-  const bool usable_history =
-      previous && previous->normals.same_shape(positions) && previous->positions.same_shape(positions);
-  if (usable_history) {
-    const std::vector<NormalLevel> pyramid = build_pyramid(previous->normals, std::max(1, options.mip_levels),
-                                                           options.threads);
-    const Pose prev_from_current_pose = previous->camera_to_world.inverse() * camera_to_world;
-    const Rigid prev_from_current(prev_from_current_pose);
-    const Rigid current_from_prev(prev_from_current_pose.inverse());
-    parallel_rows(positions.height(), options.threads, [&](int begin, int end) {
-      for (int r = begin; r < end; ++r) {
-        for (int c = 0; c < positions.width(); ++c) {
-          Float3& n = normals(r, c);
-          if (!is_valid_normal(n)) continue;
-          n = blend_with_history(n, positions(r, c), *previous, pyramid, prev_from_current, current_from_prev,
-                                 intrinsics, options);
-        }
-      }
-    });
-  }
-  fill_holes(positions, normals);
+  NormalsRawDepthCpu().blend(intrinsics, camera_to_world, previous, options, positions, normals);
 }
 
 void NormalsRawDepthStageBase::declare(StageBuilder& builder) {
@@ -221,7 +308,7 @@ void NormalsRawDepthStageBase::run(StageContext& context) {
 void NormalsRawDepthCpuStage::estimate(StageContext&, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
                                        const Pose& camera_to_world, const NormalsHistory* previous,
                                        PositionMap& positions, NormalMap& normals) {
-  normals_raw_depth(depth, intrinsics, camera_to_world, previous, options(), positions, normals);
+  method_.run(depth, intrinsics, camera_to_world, previous, options(), positions, normals);
 }
 
 }  // namespace relight

@@ -4,8 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
+#include <vector>
 
 #include "relight/core/frame_graph.h"
 #include "relight/reconstruct/normal_error.h"
@@ -167,6 +170,167 @@ TEST(NormalsRawDepth, DisocclusionResetsTheHistory) {
   PositionMap unused;
   normals_raw_depth(near, k, Pose::Identity(), &same_depth, {}, unused, blended);
   EXPECT_GT(blended(30, 40).x, 0.5f);
+}
+
+// ---- The CPU loops: AVX2 and scalar, fused and composed -----------------------------------
+
+struct Method1Outputs {
+  std::vector<PositionMap> positions;
+  std::vector<NormalMap> normals;
+};
+
+// Method 1 over a whole sequence with one NormalsRawDepthCpu (scratch memory reused).
+Method1Outputs run_frames(const test::SyntheticSequence& sequence, const NormalsRawDepthOptions& options) {
+  NormalsRawDepthCpu method;
+  Method1Outputs out;
+  for (std::size_t i = 0; i < sequence.frames.size(); ++i) {
+    const auto& frame = sequence.frames[i];
+    out.positions.emplace_back();
+    out.normals.emplace_back();
+    std::optional<NormalsHistory> history;
+    if (i > 0) history.emplace(NormalsHistory{out.normals[i - 1], out.positions[i - 1], sequence.frames[i - 1].camera_to_world});
+    method.run(frame.noisy, sequence.intrinsics, frame.camera_to_world, history ? &*history : nullptr, options,
+               out.positions.back(), out.normals.back());
+  }
+  return out;
+}
+
+std::size_t valid_normals(const NormalMap& normals) {
+  return static_cast<std::size_t>(std::count_if(normals.pixels().begin(), normals.pixels().end(), is_valid_normal));
+}
+
+TEST(NormalsRawDepthCpu, AvxLoopsEqualScalarLoopsBitForBit) {
+  if (!normals_raw_depth_simd_available()) GTEST_SKIP() << "this CPU has no AVX2: only the scalar loops run";
+  // 203x151: rows that are not a multiple of 8 pixels and pyramid levels with odd sides. Every
+  // 6th orbit pose: reprojected neighbours are not always neighbours (the gather path) while
+  // most are (the coherent path).
+  const auto sequence = test::render_sequence(synth::Trajectory::Orbit, 4, 203, 151, {}, 6);
+  const std::vector<NormalsRawDepthOptions> variants{{}, {.stride = 1}, {.mip_levels = 1}, {.mip_levels = 7}};
+  for (const NormalsRawDepthOptions& variant : variants) {
+    NormalsRawDepthOptions scalar = variant;
+    scalar.simd = false;
+    const Method1Outputs a = run_frames(sequence, variant);
+    const Method1Outputs b = run_frames(sequence, scalar);
+    for (std::size_t i = 0; i < sequence.frames.size(); ++i) {
+      EXPECT_TRUE(a.positions[i] == b.positions[i]) << "frame " << i << ", stride " << variant.stride;
+      EXPECT_TRUE(a.normals[i] == b.normals[i]) << "frame " << i << ", stride " << variant.stride << ", levels "
+                                                << variant.mip_levels;
+      EXPECT_GT(valid_normals(a.normals[i]), a.normals[i].size() / 2);  // not an empty comparison
+    }
+  }
+}
+
+// The fused pass (positions, cross products and blend per row) equals its definition: the
+// positions_from_depth + normals_from_positions reference, then normals_raw_depth_blend; on both
+// the AVX2 and the scalar loops. Exact equality holds because both evaluate the same float
+// operations in the same order (no fused multiply-add on x86-64, see normals_raw_depth_kernels.h).
+TEST(NormalsRawDepthCpu, FusedPassEqualsReferenceCrossProductsThenBlend) {
+  const auto sequence = test::render_sequence(synth::Trajectory::Orbit, 3, 160, 120, {}, 3);
+  for (const bool simd : {true, false}) {
+    const NormalsRawDepthOptions options{.simd = simd};
+    const Method1Outputs fused = run_frames(sequence, options);
+    PositionMap positions[2];
+    NormalMap normals[2];
+    for (std::size_t i = 0; i < sequence.frames.size(); ++i) {
+      const auto& frame = sequence.frames[i];
+      const std::size_t cur = i % 2, prev = 1 - cur;
+      positions_from_depth(frame.noisy, sequence.intrinsics, positions[cur]);
+      normals_from_positions(positions[cur], normals[cur], {.stride = options.stride, .max_jump_rel = options.max_jump_rel});
+      const NormalsHistory history{normals[prev], positions[prev], i > 0 ? sequence.frames[i - 1].camera_to_world : Pose::Identity()};
+      normals_raw_depth_blend(sequence.intrinsics, frame.camera_to_world, i > 0 ? &history : nullptr, options,
+                              positions[cur], normals[cur]);
+      EXPECT_TRUE(fused.positions[i] == positions[cur]) << "frame " << i << (simd ? " simd" : " scalar");
+      EXPECT_TRUE(fused.normals[i] == normals[cur]) << "frame " << i << (simd ? " simd" : " scalar");
+    }
+  }
+}
+
+TEST(NormalsRawDepthCpu, OneObjectOverFramesOfDifferentSizesEqualsFreshCalls) {
+  const auto large = test::render_sequence(synth::Trajectory::Orbit, 2, 160, 120);
+  const auto small = test::render_sequence(synth::Trajectory::Orbit, 2, 72, 50);
+  NormalsRawDepthCpu method;
+  for (const auto* sequence : {&large, &small, &large}) {
+    PositionMap positions[2], fresh_positions[2];
+    NormalMap normals[2], fresh_normals[2];
+    for (std::size_t i = 0; i < 2; ++i) {
+      const auto& frame = sequence->frames[i];
+      const NormalsHistory history{normals[1 - i], positions[1 - i], sequence->frames[0].camera_to_world};
+      const NormalsHistory fresh_history{fresh_normals[1 - i], fresh_positions[1 - i], sequence->frames[0].camera_to_world};
+      method.run(frame.noisy, sequence->intrinsics, frame.camera_to_world, i > 0 ? &history : nullptr, {}, positions[i],
+                 normals[i]);
+      normals_raw_depth(frame.noisy, sequence->intrinsics, frame.camera_to_world, i > 0 ? &fresh_history : nullptr, {},
+                        fresh_positions[i], fresh_normals[i]);
+      EXPECT_TRUE(normals[i] == fresh_normals[i]) << sequence->intrinsics.width << " frame " << i;
+      EXPECT_TRUE(positions[i] == fresh_positions[i]);
+    }
+  }
+}
+
+// Pass 1 (eq. 4.1–4.3) against a direct transcription of its definition on a curved, noisy
+// normal map with holes, wide enough for the AVX2 loops.
+TEST(NormalsHistoryPyramid, MatchesTheDefinitionOfPassOne) {
+  const int width = 75, height = 42;
+  NormalMap previous(width, height);
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      if ((r * 7 + c * 3) % 23 == 0) continue;  // holes
+      const float bumps = c > 40 ? 0.3f * std::sin(0.5f * static_cast<float>(r * c)) : 0.f;  // curved right half
+      const float a = 0.04f * static_cast<float>(c) + bumps;
+      const float b = 0.03f * static_cast<float>(r);
+      const Float3 n{std::sin(a), std::sin(b), -std::cos(a) * std::cos(b)};
+      previous(r, c) = (1.f / length(n)) * n;
+    }
+  }
+  const auto pyramid = normals_history_pyramid(previous, 4);
+  ASSERT_EQ(pyramid.size(), 4u);
+  const auto at = [&](int r, int c) { return previous.in_bounds(r, c) ? previous(r, c) : Float3{}; };
+  const auto normalised = [](const Float3& v) { return length(v) > 0.f ? (1.f / length(v)) * v : Float3{}; };
+  ASSERT_EQ(pyramid[0].normal.width(), 38);
+  ASSERT_EQ(pyramid[0].normal.height(), 21);
+  int flat = 0;
+  for (int hr = 0; hr < 21; ++hr) {
+    for (int hc = 0; hc < 38; ++hc) {
+      const int r = 2 * hr, c = 2 * hc;
+      const Float3 up = at(r - 1, c), down = at(r + 1, c), left = at(r, c - 1), right = at(r, c + 1);
+      const Float3 mean = normalised(at(r, c) + up + down + left + right);
+      float curvature = 0.f;
+      if (is_valid_normal(up) && is_valid_normal(down) && is_valid_normal(left) && is_valid_normal(right)) {
+        curvature = std::pow(std::clamp(std::min(dot(left, right), dot(up, down)), 0.f, 1.f), 128.f);
+      }
+      flat += curvature > 0.5f ? 1 : 0;
+      const Float3& got = pyramid[0].normal(hr, hc);
+      ASSERT_NEAR(got.x, mean.x, 1e-6f) << hr << "," << hc;
+      ASSERT_NEAR(got.y, mean.y, 1e-6f);
+      ASSERT_NEAR(got.z, mean.z, 1e-6f);
+      ASSERT_NEAR(pyramid[0].curvature(hr, hc), curvature, 1e-4f) << hr << "," << hc;
+    }
+  }
+  EXPECT_GT(flat, 100);  // both smooth and curved texels occur
+  EXPECT_LT(flat, 38 * 21 - 100);
+  for (std::size_t level = 1; level < pyramid.size(); ++level) {
+    const auto& fine = pyramid[level - 1];
+    const auto& coarse = pyramid[level];
+    ASSERT_EQ(coarse.normal.width(), (fine.normal.width() + 1) / 2);
+    for (int r = 0; r < coarse.normal.height(); ++r) {
+      for (int c = 0; c < coarse.normal.width(); ++c) {
+        Float3 sum;
+        float curvature = 0.f;
+        int count = 0;
+        for (int dr = 0; dr < 2; ++dr) {
+          for (int dc = 0; dc < 2; ++dc) {
+            if (!fine.normal.in_bounds(2 * r + dr, 2 * c + dc) || !is_valid_normal(fine.normal(2 * r + dr, 2 * c + dc))) continue;
+            sum += fine.normal(2 * r + dr, 2 * c + dc);
+            curvature += fine.curvature(2 * r + dr, 2 * c + dc);
+            ++count;
+          }
+        }
+        const Float3 mean = normalised(sum);
+        ASSERT_NEAR(coarse.normal(r, c).x, mean.x, 1e-6f) << "level " << level;
+        ASSERT_NEAR(coarse.normal(r, c).z, mean.z, 1e-6f) << "level " << level;
+        ASSERT_NEAR(coarse.curvature(r, c), count ? curvature / static_cast<float>(count) : 0.f, 1e-6f);
+      }
+    }
+  }
 }
 
 // ---- Frame graph -------------------------------------------------------------------------

@@ -21,10 +21,16 @@
 //     normal = normalize(c·N_p + (1 − c)·N).
 //   Holes (depth but no normal) get the normalised mean of their valid 4-neighbours.
 //
+// The CPU implementation computes positions, cross products and the blend in one pass over the
+// rows (the neighbours' positions are re-derived from depth), eight pixels at a time with AVX2
+// where the CPU has it (chosen at run time; the build stays baseline x86-64), and the scalar
+// loops otherwise. Both give bit-identical maps.
+//
 // Stage NormalsRawDepthCpuStage reads DepthMap "depth", FrameInfo "frame" (intrinsics,
 // camera_to_world: identity when absent), and the previous frame's NormalMap "normals",
 // PositionMap "positions" and FrameInfo "frame"; it writes NormalMap "normals" and PositionMap
 // "positions".
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -43,6 +49,7 @@ struct NormalsRawDepthOptions {
   int mip_levels = 4;             ///< half, quarter, eighth and sixteenth resolution
   float max_jump_rel = 0.05f;     ///< discontinuity test of the cross products (relative to z)
   int threads = 0;                ///< 0 = all cores
+  bool simd = true;               ///< AVX2 loops where available; false: the scalar loops (same maps)
 };
 
 /// What method 1 keeps from the previous frame: its outputs and its pose.
@@ -52,10 +59,37 @@ struct NormalsHistory {
   Pose camera_to_world;
 };
 
+/// Method 1 on the CPU, keeping its scratch memory (the pass-1 pyramid, per-row hole lists)
+/// between frames, so that a stream of same-sized frames allocates nothing after the first.
+/// Create once, reuse every frame; not for concurrent calls.
+class NormalsRawDepthCpu {
+ public:
+  NormalsRawDepthCpu();
+  ~NormalsRawDepthCpu();
+  NormalsRawDepthCpu(const NormalsRawDepthCpu&) = delete;
+  NormalsRawDepthCpu& operator=(const NormalsRawDepthCpu&) = delete;
+
+  /// normals_raw_depth (below) with this object's scratch memory.
+  void run(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+           const NormalsHistory* previous, const NormalsRawDepthOptions& options, PositionMap& positions,
+           NormalMap& normals);
+  /// normals_raw_depth_blend (below) with this object's scratch memory.
+  void blend(const PinholeIntrinsics& intrinsics, const Pose& camera_to_world, const NormalsHistory* previous,
+             const NormalsRawDepthOptions& options, const PositionMap& positions, NormalMap& normals);
+
+ private:
+  struct Workspace;
+  std::unique_ptr<Workspace> workspace_;
+};
+
 /// One frame of method 1. `previous` is null on the first frame. Resizes the outputs.
+/// (Allocates its scratch memory per call; NormalsRawDepthCpu keeps it.)
 void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
                        const NormalsHistory* previous, const NormalsRawDepthOptions& options,
                        PositionMap& positions, NormalMap& normals);
+
+/// Whether this CPU runs method 1's AVX2 loops (options.simd); otherwise the scalar loops run.
+[[nodiscard]] bool normals_raw_depth_simd_available();
 
 /// One level of the pass-1 pyramid: mean normal and curvature coefficient per texel.
 struct NormalsPyramidLevel {
@@ -112,6 +146,7 @@ class NormalsRawDepthCpuStage final : public NormalsRawDepthStageBase {
   void estimate(StageContext& context, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
                 const Pose& camera_to_world, const NormalsHistory* previous, PositionMap& positions,
                 NormalMap& normals) override;
+  NormalsRawDepthCpu method_;
 };
 
 }  // namespace relight
