@@ -6,7 +6,6 @@
 // normals_raw_depth_avx2.cpp (AVX2, same results).
 #include <algorithm>
 #include <cmath>
-#include <utility>
 #include <vector>
 
 #include "normals_raw_depth_kernels.h"
@@ -22,8 +21,10 @@ struct Scratch {
   Pyramid pyramid;
   std::vector<float> x_scale;               ///< padded by stride + 8 on both sides
   std::vector<std::uint32_t> hole_columns;  ///< row r's holes at r * width
+  std::vector<Float3> hole_values;          ///< same indexing
   std::vector<int> hole_counts;
-  std::vector<std::pair<std::size_t, Float3>> fills;
+  std::vector<std::uint32_t> hole_bits;
+  std::vector<std::uint8_t> filled;         ///< per row: holes filled inside the row pass
 };
 }  // namespace method1
 
@@ -152,29 +153,6 @@ const float* column_scales(std::vector<float>& table, const method1::Constants& 
   return table.data() + pad;
 }
 
-// Holes (a position but no normal after the blend) take the normalised sum of their
-// 4-neighbours' normals; all fills are computed before any is applied.
-void fill_holes(const method1::Pass2& pass, NormalMap& normals, std::vector<std::pair<std::size_t, Float3>>& fills) {
-  const int width = normals.width(), height = normals.height();
-  fills.clear();
-  for (int r = 0; r < height; ++r) {
-    const std::uint32_t* columns = pass.hole_columns + static_cast<std::size_t>(r) * static_cast<std::size_t>(width);
-    for (int j = 0; j < pass.hole_counts[r]; ++j) {
-      const int c = static_cast<int>(columns[j]);
-      Float3 sum;
-      if (r > 0) sum += normals(r - 1, c);
-      if (r + 1 < height) sum += normals(r + 1, c);
-      if (c > 0) sum += normals(r, c - 1);
-      if (c + 1 < width) sum += normals(r, c + 1);
-      const Float3 n = method1::normalized_or_zero(sum);
-      if (is_valid_normal(n)) {
-        fills.emplace_back(static_cast<std::size_t>(r) * static_cast<std::size_t>(width) + static_cast<std::size_t>(c), n);
-      }
-    }
-  }
-  for (const auto& [index, n] : fills) normals.pixels()[index] = n;
-}
-
 bool usable(const NormalsHistory* previous, const Image<Float3>& shape) {
   return previous && previous->normals.same_shape(shape) && previous->positions.same_shape(shape);
 }
@@ -189,32 +167,51 @@ method1::Pass2 prepare(method1::Scratch& ws, const PinholeIntrinsics& intrinsics
     pass.prev_positions = previous->positions.data();
     pass.pyramid = &ws.pyramid;
   }
+  // Sized for the worst case but touched only where there are holes.
   const auto pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   if (ws.hole_columns.size() < pixels) ws.hole_columns.resize(pixels);
+  if (ws.hole_values.size() < pixels) ws.hole_values.resize(pixels);
+  pass.hole_words = (width + 31) / 32;
+  ws.hole_bits.resize(static_cast<std::size_t>(pass.hole_words) * static_cast<std::size_t>(height));
   ws.hole_counts.resize(static_cast<std::size_t>(height));
+  ws.filled.resize(static_cast<std::size_t>(height));
   pass.hole_columns = ws.hole_columns.data();
+  pass.hole_values = ws.hole_values.data();
+  pass.hole_bits = ws.hole_bits.data();
   pass.hole_counts = ws.hole_counts.data();
   return pass;
 }
 
-// Pass 2 over the rows in parallel, then the hole filling.
-void finish(method1::Scratch& ws, const method1::Pass2& pass, const NormalsRawDepthOptions& options,
-            NormalMap& normals) {
+// Pass 2 over the rows in parallel. Each task fills the holes of its rows one row behind, while
+// they are in its cache, except its first and last rows (their outer neighbours belong to other
+// tasks), which are filled after all rows are blended.
+void finish(method1::Scratch& ws, const method1::Pass2& pass, const NormalsRawDepthOptions& options) {
   // The AVX2 row gathers with 32-bit indices into the previous positions (3 floats a pixel) and
   // reads the column table within stride + 8 of the image.
   const bool avx2 = use_avx2(options) && static_cast<long long>(pass.k.width) * pass.k.height * 3 < (1LL << 31) &&
                     pass.k.stride >= 1 && pass.k.stride <= pass.k.width;
-  parallel_rows(pass.k.height, options.threads, [&](int begin, int end) {
+  const int height = pass.k.height;
+  const auto fill = [&](int r) {
+    method1::fill_row(pass, r);
+    ws.filled[static_cast<std::size_t>(r)] = 1;
+  };
+  std::fill(ws.filled.begin(), ws.filled.end(), std::uint8_t{0});
+  parallel_rows(height, options.threads, [&](int begin, int end) {
+    const int first_inner = begin == 0 ? 0 : begin + 1;  // rows whose upper neighbour is ours
     for (int r = begin; r < end; ++r) {
-      pass.hole_counts[r] = 0;
+      method1::clear_holes(pass, r);
       if (avx2) {
         method1::pass2_row_avx2(pass, r);
       } else {
         for (int c = 0; c < pass.k.width; ++c) method1::pass2_pixel(pass, r, c);
       }
+      if (r - 1 >= first_inner) fill(r - 1);
     }
+    if (end == height && end - 1 >= first_inner) fill(end - 1);
   });
-  fill_holes(pass, normals, ws.fills);
+  for (int r = 0; r < height; ++r) {
+    if (!ws.filled[static_cast<std::size_t>(r)]) method1::fill_row(pass, r);
+  }
 }
 
 }  // namespace
@@ -234,7 +231,7 @@ void NormalsRawDepthCpu::run(const DepthMap& depth, const PinholeIntrinsics& int
   pass.x_scale = column_scales(workspace_->x_scale, pass.k);
   pass.positions_out = positions.data();
   pass.normals = normals.data();
-  finish(*workspace_, pass, options, normals);
+  finish(*workspace_, pass, options);
 }
 
 void NormalsRawDepthCpu::blend(const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
@@ -246,7 +243,7 @@ void NormalsRawDepthCpu::blend(const PinholeIntrinsics& intrinsics, const Pose& 
                                 options, positions.width(), positions.height());
   pass.positions_in = positions.data();
   pass.normals = normals.data();
-  finish(*workspace_, pass, options, normals);
+  finish(*workspace_, pass, options);
 }
 
 bool normals_raw_depth_simd_available() { return method1::avx2_available(); }

@@ -61,8 +61,14 @@ struct Pass2 {
   Float3* normals = nullptr;
   const Float3* prev_positions = nullptr; ///< null: no history, no blend
   const Pyramid* pyramid = nullptr;
+  // Holes (a position but no normal), listed per row in column order with the value they had
+  // before any fill, so that fills can be applied in any order: a fill reads a neighbouring hole
+  // as it was (the definition fills from the blended map).
   std::uint32_t* hole_columns = nullptr;  ///< row r's holes start at r * width
+  Float3* hole_values = nullptr;          ///< same indexing
   int* hole_counts = nullptr;             ///< per row
+  std::uint32_t* hole_bits = nullptr;     ///< row r's bits start at r * hole_words
+  int hole_words = 0;                     ///< (width + 31) / 32
 };
 
 inline bool valid_depth_value(float z) { return z > 0.f && z <= 3.4e38f; }  // positions_from_depth's test
@@ -219,10 +225,49 @@ inline Float3 blend_with_history(const Float3& n, const Float3& p, const Pass2& 
   return is_valid_normal(blended) ? blended : n;
 }
 
-/// Records column c of row r as a hole (a position without a normal).
+/// Records pixel (r, c), already written to `normals`, as a hole. Columns must come in order.
 inline void record_hole(const Pass2& in, int r, int c) {
   const auto row_start = static_cast<std::size_t>(r) * static_cast<std::size_t>(in.k.width);
-  in.hole_columns[row_start + static_cast<std::size_t>(in.hole_counts[r]++)] = static_cast<std::uint32_t>(c);
+  const auto j = row_start + static_cast<std::size_t>(in.hole_counts[r]++);
+  in.hole_columns[j] = static_cast<std::uint32_t>(c);
+  in.hole_values[j] = in.normals[row_start + static_cast<std::size_t>(c)];
+  in.hole_bits[static_cast<std::size_t>(r) * static_cast<std::size_t>(in.hole_words) + static_cast<std::size_t>(c / 32)] |=
+      1u << (c % 32);
+}
+
+/// Starts row r's hole records.
+inline void clear_holes(const Pass2& in, int r) {
+  in.hole_counts[r] = 0;
+  std::uint32_t* bits = in.hole_bits + static_cast<std::size_t>(r) * static_cast<std::size_t>(in.hole_words);
+  std::fill(bits, bits + in.hole_words, 0u);
+}
+
+/// Pixel (r, c) of the blended map before any hole was filled.
+inline Float3 unfilled(const Pass2& in, int r, int c) {
+  const auto row_start = static_cast<std::size_t>(r) * static_cast<std::size_t>(in.k.width);
+  const std::uint32_t bits =
+      in.hole_bits[static_cast<std::size_t>(r) * static_cast<std::size_t>(in.hole_words) + static_cast<std::size_t>(c / 32)];
+  if ((bits >> (c % 32) & 1u) == 0) return in.normals[row_start + static_cast<std::size_t>(c)];
+  const std::uint32_t* columns = in.hole_columns + row_start;
+  const auto j = std::lower_bound(columns, columns + in.hole_counts[r], static_cast<std::uint32_t>(c)) - columns;
+  return in.hole_values[row_start + static_cast<std::size_t>(j)];
+}
+
+/// Fills row r's holes with the normalised sum of their 4-neighbours' unfilled normals, where
+/// that is a valid normal. Needs rows r − 1 and r + 1 blended (with their holes recorded).
+inline void fill_row(const Pass2& in, int r) {
+  const int width = in.k.width, height = in.k.height;
+  const auto row_start = static_cast<std::size_t>(r) * static_cast<std::size_t>(width);
+  for (int j = 0; j < in.hole_counts[r]; ++j) {
+    const int c = static_cast<int>(in.hole_columns[row_start + static_cast<std::size_t>(j)]);
+    Float3 sum;
+    if (r > 0) sum += unfilled(in, r - 1, c);
+    if (r + 1 < height) sum += unfilled(in, r + 1, c);
+    if (c > 0) sum += unfilled(in, r, c - 1);
+    if (c + 1 < width) sum += unfilled(in, r, c + 1);
+    const Float3 n = normalized_or_zero(sum);
+    if (is_valid_normal(n)) in.normals[row_start + static_cast<std::size_t>(c)] = n;
+  }
 }
 
 /// Pass 2 for pixel (r, c) with the scalar arithmetic.

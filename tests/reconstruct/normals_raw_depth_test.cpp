@@ -8,6 +8,7 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "relight/core/frame_graph.h"
@@ -241,6 +242,52 @@ TEST(NormalsRawDepthCpu, FusedPassEqualsReferenceCrossProductsThenBlend) {
                               positions[cur], normals[cur]);
       EXPECT_TRUE(fused.positions[i] == positions[cur]) << "frame " << i << (simd ? " simd" : " scalar");
       EXPECT_TRUE(fused.normals[i] == normals[cur]) << "frame " << i << (simd ? " simd" : " scalar");
+    }
+  }
+}
+
+// Hole filling as defined: every hole (a position without a normal) takes the normalised sum of
+// its 4-neighbours in the map before any fill; transcribed here on a frame with many holes next
+// to holes (scattered missing depth), at sizes that split the rows over several tasks.
+TEST(NormalsRawDepthCpu, HolesAreFilledFromTheUnfilledNeighbours) {
+  auto sequence = test::render_sequence(synth::Trajectory::Static, 1, 160, 120);
+  DepthMap depth = sequence.frames[0].noisy;
+  for (int r = 0; r < depth.height(); ++r) {
+    for (int c = 0; c < depth.width(); ++c) {
+      if ((r * 31 + c * 17) % 13 == 0 || (r % 9 == 4 && c % 11 < 5)) depth(r, c) = 0.f;
+    }
+  }
+  PositionMap positions;
+  NormalMap expected;
+  positions_from_depth(depth, sequence.intrinsics, positions);
+  normals_from_positions(positions, expected, {.stride = 4});
+  const NormalMap unfilled = expected;
+  int holes = 0, holes_next_to_holes = 0;
+  const auto hole = [&](int r, int c) {
+    return unfilled.in_bounds(r, c) && positions(r, c).z > 0.f && !is_valid_normal(unfilled(r, c));
+  };
+  for (int r = 0; r < depth.height(); ++r) {
+    for (int c = 0; c < depth.width(); ++c) {
+      if (!hole(r, c)) continue;
+      ++holes;
+      holes_next_to_holes += hole(r - 1, c) || hole(r + 1, c) || hole(r, c - 1) || hole(r, c + 1) ? 1 : 0;
+      Float3 sum;
+      for (const auto& [dr, dc] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+        if (unfilled.in_bounds(r + dr, c + dc)) sum += unfilled(r + dr, c + dc);
+      }
+      const Float3 n = length(sum) > 0.f ? (1.f / length(sum)) * sum : Float3{};
+      if (is_valid_normal(n)) expected(r, c) = n;
+    }
+  }
+  EXPECT_GT(holes, 200);
+  EXPECT_GT(holes_next_to_holes, 20);
+  for (const bool simd : {true, false}) {
+    for (const int threads : {1, 2, 3}) {
+      PositionMap got_positions;
+      NormalMap got;
+      normals_raw_depth(depth, sequence.intrinsics, Pose::Identity(), nullptr, {.threads = threads, .simd = simd},
+                        got_positions, got);
+      EXPECT_TRUE(got == expected) << "threads " << threads << (simd ? " simd" : " scalar");
     }
   }
 }
