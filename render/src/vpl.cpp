@@ -1,11 +1,14 @@
 #include "relight/render/vpl.h"
 
 #include <Eigen/Geometry>
+#include <bit>
 #include <cmath>
 #include <numbers>
 
 #include "relight/core/error.h"
+#include "relight/render/hierarchical_warp.h"
 #include "relight/render/phong_brdf.h"
+#include "relight/render/reflective_shadow_map.h"
 #include "relight/render/sampler.h"
 #include "surface_shading.h"
 
@@ -131,7 +134,7 @@ class VplTracer {
     }
   }
 
- private:
+  /// Records a VPL at `hit`, lit along `direction`, and continues its path.
   void add(const SurfaceHit& hit, const Vec3& direction, const Vec3& flux, bool in_real_virtual, bool in_real, int bounce,
            Pcg32& rng) {
     if (!in_real_virtual && !in_real) return;
@@ -159,6 +162,7 @@ class VplTracer {
          vpl.in_real, bounce + 1, rng);
   }
 
+ private:
   const MrScene& scene_;
   const RayTracer& tracer_;
   const VplOptions& options_;
@@ -262,6 +266,48 @@ void emit_directional(const MrLight& light, std::size_t index, int n, const Boun
   }
 }
 
+/// Slots per RSM: all to one map, or shared by covered texels (largest remainder), with at least
+/// one for a map that covers anything while there are two slots or more.
+std::vector<int> rsm_slots(const std::vector<ReflectiveShadowMap>& maps, int n) {
+  std::vector<int> slots(maps.size(), 0);
+  if (maps.size() == 1) {
+    slots[0] = n;
+    return slots;
+  }
+  const auto real = static_cast<double>(maps[0].covered()), virtual_ = static_cast<double>(maps[1].covered());
+  if (real + virtual_ <= 0.0) return slots;
+  slots[0] = static_cast<int>(std::lround(n * real / (real + virtual_)));
+  if (n >= 2 && real > 0.0) slots[0] = std::max(slots[0], 1);
+  if (n >= 2 && virtual_ > 0.0) slots[0] = std::min(slots[0], n - 1);
+  slots[1] = n - slots[0];
+  return slots;
+}
+
+/// A spot light's n first-bounce VPLs from its RSMs (VplSource::ReflectiveShadowMaps).
+void emit_from_rsms(const MrScene& scene, const RayTracer& tracer, std::size_t index, int n, const VplOptions& options,
+                    VplTracer& vpl_tracer) {
+  if (n <= 0) return;
+  const MrLight& light = scene.lights[index];
+  const std::vector<ReflectiveShadowMap> maps = reflective_shadow_maps_cpu(scene, tracer, index, options.rsm_size);
+  const std::vector<int> slots = rsm_slots(maps, n);
+  for (std::size_t m = 0; m < maps.size(); ++m) {
+    if (slots[m] <= 0) continue;
+    const ImportancePyramid pyramid(maps[m].importance(), maps[m].size);
+    const auto count = static_cast<std::uint32_t>(slots[m]);
+    const std::vector<WarpedTexel> texels = warp_points(pyramid, hammersley_points(count));
+    for (std::size_t i = 0; i < texels.size(); ++i) {
+      const RsmTexel& texel = maps[m].texels[texels[i].y * static_cast<std::uint32_t>(maps[m].size) + texels[i].x];
+      Pcg32 rng = Pcg32::for_sample(options.seed, index, m * count + i);
+      // Flags as the ray-traced generator gives them: a real light's real RSM holds both worlds
+      // except behind a virtual object, its virtual RSM the real+virtual world only.
+      const bool in_real = light.real && (m == 0);
+      const bool in_real_virtual = !(light.real && m == 0 && texel.occluded_by_virtual);
+      const Vec3 flux = texel.flux / (texels[i].probability * static_cast<float>(count));
+      vpl_tracer.add(*texel.hit, texel.direction, flux, in_real_virtual, in_real, 1, rng);
+    }
+  }
+}
+
 }  // namespace
 
 std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t light_count) {
@@ -277,6 +323,9 @@ std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t
 std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options) {
   if (options.count < 0) throw Error("the VPL count must not be negative");
   if (options.bounces < 1) throw Error("VPLs need at least one bounce");
+  if (options.source == VplSource::ReflectiveShadowMaps &&
+      (options.rsm_size < 1 || options.rsm_size > 4096 || !std::has_single_bit(static_cast<unsigned>(options.rsm_size))))
+    throw Error("the RSM size must be a power of two in [1, 4096]");
   std::vector<Vpl> vpls;
   VplTracer vpl_tracer(scene, tracer, options, vpls);
   if (options.virtual_share < 0.f || options.virtual_share >= 1.f) throw Error("the virtual VPL share must be in [0, 1)");
@@ -288,6 +337,10 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
     vpl_tracer.set_light(l);
     if (light.kind == LightKind::Directional) {
       emit_directional(light, l, budget[l], bounds, virtual_sphere, options, vpl_tracer);
+      continue;
+    }
+    if (options.source == VplSource::ReflectiveShadowMaps && has_reflective_shadow_maps(light)) {
+      emit_from_rsms(scene, tracer, l, budget[l], options, vpl_tracer);
       continue;
     }
     const std::optional<Cone> cone = options.virtual_share > 0.f ? cone_towards(virtual_sphere, light.position) : std::nullopt;

@@ -65,6 +65,17 @@ struct Vpl {
 ///                   last frame can recover.
 enum class VplBudget { Equal, ByPower, ByWeight, ByPreviousFlux };
 
+/// Where a spot light's first-bounce VPLs come from.
+///   RayTraced             light samples traced against both layers (above), for every light;
+///   ReflectiveShadowMaps  importance-sampled texels of the spot light's RSMs
+///                         (reflective_shadow_map.h) by hierarchical warping of a Hammersley set
+///                         (hierarchical_warp.h), flux = texel flux / (probability x slots); a
+///                         real light's slots are shared between its real and virtual RSM by the
+///                         texels each covers. virtual_share does not apply (the virtual RSM is the
+///                         focus), and lights without RSMs (point, directional, spots wider than
+///                         75 degrees) stay ray traced. Further bounces are traced as above.
+enum class VplSource { RayTraced, ReflectiveShadowMaps };
+
 struct VplOptions {
   int count = 256;      ///< first-bounce light samples (each may yield two VPLs, see above)
   int bounces = 1;      ///< 1 = one indirect bounce; 2 adds VPLs lit by VPLs
@@ -73,6 +84,8 @@ struct VplOptions {
   std::uint64_t seed = 1;
   std::vector<float> light_weights{};   ///< VplBudget::ByWeight
   std::vector<double> previous_flux{};  ///< VplBudget::ByPreviousFlux
+  VplSource source = VplSource::RayTraced;
+  int rsm_size = 256;  ///< VplSource::ReflectiveShadowMaps: texels per side, a power of two
 };
 
 /// Per light of the scene, the luminance of the flux its first-bounce VPLs carry (the input of

@@ -1,0 +1,56 @@
+#pragma once
+// Reflective shadow maps (Dachsbacher & Stamminger, I3D 2005) of a spot light, as differential
+// instant radiosity uses them (Knecht et al. 2010; dissertation §5.2.3): a virtual spot light
+// sees the nearest surface of both layers in one RSM; a real spot light renders two, one through
+// the real layer and one through the virtual layer, and the VPL slots are shared between them by
+// the texels each covers.
+//
+// The view: a square perspective frustum along the spot's axis that just holds its outer cone,
+// `size` x `size` texels (this is the ray-cast reference; the rasterised shadow views of
+// shadow_maps.h do not output these attributes yet). A texel where the cone sees a surface stores
+//   hit       the surface (point, normals, material, real/virtual);
+//   flux      the flux I(omega) falloff(omega) dOmega that reaches it through the texel's solid
+//             angle dOmega: what a first-bounce VPL there carries (vpl.h);
+//   importance   luminance(flux) x max(luminance(k_d), kMinAlbedo): the diffusely reflected flux
+//             that RSM sampling is proportional to, floored so that a dark or purely glossy
+//             surface is still sampled (its VPLs stay unbiased, just noisier).
+// In a real light's real RSM, `occluded_by_virtual` marks texels whose surface lies behind a
+// virtual one (the real-only VPLs of Fig. 5.7); in its virtual RSM, texels behind a real surface
+// are empty (no world sees them).
+#include <Eigen/Core>
+#include <optional>
+#include <vector>
+
+#include "relight/render/mr_scene.h"
+#include "relight/render/ray_tracer.h"
+
+namespace relight::render {
+
+struct RsmTexel {
+  std::optional<SurfaceHit> hit;
+  Eigen::Vector3f direction = Eigen::Vector3f::Zero();  ///< unit, from the light through the texel
+  Eigen::Vector3f flux = Eigen::Vector3f::Zero();
+  float importance = 0.f;
+  bool occluded_by_virtual = false;
+};
+
+struct ReflectiveShadowMap {
+  int size = 0;
+  std::vector<RsmTexel> texels;  ///< row-major size x size
+  [[nodiscard]] std::vector<float> importance() const;
+  /// Texels with importance > 0.
+  [[nodiscard]] std::size_t covered() const;
+};
+
+/// The RSMs of spot light `light` of `scene`: one (both layers) for a virtual light, two (real
+/// layer, virtual layer) for a real one. Throws LogicError unless it is a spot light whose cone
+/// fits a perspective view (outer half-angle below kMaxRsmHalfAngleDeg) and size is a power of two.
+inline constexpr float kMaxRsmHalfAngleDeg = 75.f;
+inline constexpr float kMinAlbedo = 0.05f;
+[[nodiscard]] std::vector<ReflectiveShadowMap> reflective_shadow_maps_cpu(const MrScene& scene, const RayTracer& tracer,
+                                                                         std::size_t light, int size);
+
+/// Whether `light` can be sampled through RSMs (a spot light of at most kMaxRsmHalfAngleDeg).
+[[nodiscard]] bool has_reflective_shadow_maps(const MrLight& light);
+
+}  // namespace relight::render

@@ -1,0 +1,91 @@
+// Reflective shadow maps of spot lights by ray casting (reflective_shadow_map.h).
+#include "relight/render/reflective_shadow_map.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+
+#include "relight/core/error.h"
+#include "relight/render/phong_brdf.h"
+#include "surface_shading.h"
+
+namespace relight::render {
+namespace {
+
+using Vec3 = Eigen::Vector3f;
+
+float luminance(const Vec3& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
+
+/// The texel's share of the light's emission and the texel's importance for `hit`.
+void fill(RsmTexel& texel, const MrScene& scene, const std::optional<SurfaceHit>& hit, const Vec3& emitted) {
+  texel.hit = hit;
+  if (!hit) return;
+  texel.flux = emitted;
+  const float albedo = std::max(luminance(scene.materials[hit->material].kd), kMinAlbedo);
+  texel.importance = std::max(0.f, luminance(emitted)) * albedo;
+}
+
+}  // namespace
+
+std::vector<float> ReflectiveShadowMap::importance() const {
+  std::vector<float> values(texels.size());
+  for (std::size_t i = 0; i < texels.size(); ++i) values[i] = texels[i].importance;
+  return values;
+}
+
+std::size_t ReflectiveShadowMap::covered() const {
+  std::size_t count = 0;
+  for (const RsmTexel& texel : texels) count += texel.importance > 0.f ? 1 : 0;
+  return count;
+}
+
+bool has_reflective_shadow_maps(const MrLight& light) {
+  constexpr float kMaxHalfAngle = kMaxRsmHalfAngleDeg * std::numbers::pi_v<float> / 180.f;
+  return light.kind == LightKind::Spot && light.cos_outer >= std::cos(kMaxHalfAngle);
+}
+
+std::vector<ReflectiveShadowMap> reflective_shadow_maps_cpu(const MrScene& scene, const RayTracer& tracer,
+                                                            std::size_t light_index, int size) {
+  if (light_index >= scene.lights.size()) throw LogicError("reflective_shadow_maps_cpu: no such light");
+  const MrLight& light = scene.lights[light_index];
+  if (!has_reflective_shadow_maps(light)) throw LogicError("reflective_shadow_maps_cpu: not a spot light of <= 75 degrees");
+  if (size < 1 || !std::has_single_bit(static_cast<unsigned>(size)))
+    throw LogicError("reflective_shadow_maps_cpu: size " + std::to_string(size) + " is not a power of two");
+  // Image plane at distance 1 along the axis, just holding the outer cone.
+  const Vec3 axis = light.direction.normalized();
+  Vec3 t, b;
+  orthonormal_basis(axis, t, b);
+  const float cos_outer = std::clamp(light.cos_outer, 1e-3f, 1.f);
+  const float half_extent = std::sqrt(1.f - cos_outer * cos_outer) / cos_outer;
+  const float texel_side = 2.f * half_extent / static_cast<float>(size);
+  const auto texel_count = static_cast<std::size_t>(size) * static_cast<std::size_t>(size);
+  std::vector<ReflectiveShadowMap> maps(light.real ? 2 : 1, ReflectiveShadowMap{size, std::vector<RsmTexel>(texel_count)});
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const float px = -half_extent + (static_cast<float>(x) + 0.5f) * texel_side;
+      const float py = -half_extent + (static_cast<float>(y) + 0.5f) * texel_side;
+      const float r2 = 1.f + px * px + py * py;
+      const Vec3 direction = (px * t + py * b + axis).normalized();
+      // dOmega = dA cos(theta) / r^2 with cos(theta) = 1 / r on the plane at distance 1.
+      const float solid_angle = texel_side * texel_side / (r2 * std::sqrt(r2));
+      const Vec3 emitted = light.intensity * (detail::spot_falloff(light, direction) * solid_angle);
+      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(size) + static_cast<std::size_t>(x);
+      const std::optional<SurfaceHit> real = tracer.intersect(Layer::Real, light.position, direction);
+      const std::optional<SurfaceHit> virtual_hit = tracer.intersect(
+          Layer::Virtual, light.position, direction, real ? real->t : std::numeric_limits<float>::infinity());
+      for (ReflectiveShadowMap& map : maps) map.texels[i].direction = direction;
+      if (!light.real) {
+        fill(maps[0].texels[i], scene, virtual_hit ? virtual_hit : real, emitted);
+        continue;
+      }
+      fill(maps[0].texels[i], scene, real, emitted);
+      maps[0].texels[i].occluded_by_virtual = virtual_hit.has_value();
+      fill(maps[1].texels[i], scene, virtual_hit, emitted);
+    }
+  return maps;
+}
+
+}  // namespace relight::render
