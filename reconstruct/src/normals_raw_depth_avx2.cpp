@@ -228,15 +228,14 @@ RELIGHT_AVX2 inline void reproject8(const Constants& k, BlendLanes& b) {
 RELIGHT_AVX2 inline void look_up_history8(const Pass2& in, BlendLanes& b) {
   if (_mm256_movemask_ps(b.use) == 0) return;
   const __m256 zero = _mm256_setzero_ps();
-  const Pyramid& pyr = *in.pyramid;
-  const int level0_width = pyr.levels[0].width;
+  const History& history = *in.history;
+  const int level0_width = history.width;
   __m256 previous_z;
   if (b.coherent) {
     previous_z = load_aos8(in.prev_positions + static_cast<std::ptrdiff_t>(b.row_ref) * in.k.width + b.col_ref).z;
     const std::ptrdiff_t base = static_cast<std::ptrdiff_t>(b.row_ref >> 1) * level0_width + (b.col_ref >> 1);
-    b.history = {load_coherent(pyr.history_x.data(), base, b.col_ref, 1),
-                 load_coherent(pyr.history_y.data(), base, b.col_ref, 1),
-                 load_coherent(pyr.history_z.data(), base, b.col_ref, 1)};
+    b.history = {load_coherent(history.x.data(), base, b.col_ref, 1), load_coherent(history.y.data(), base, b.col_ref, 1),
+                 load_coherent(history.z.data(), base, b.col_ref, 1)};
   } else {
     const __m256i pixel = _mm256_add_epi32(_mm256_mullo_epi32(b.row, _mm256_set1_epi32(in.k.width)), b.col);
     const __m256i z_index =
@@ -244,9 +243,9 @@ RELIGHT_AVX2 inline void look_up_history8(const Pass2& in, BlendLanes& b) {
     previous_z = _mm256_mask_i32gather_ps(zero, reinterpret_cast<const float*>(in.prev_positions), z_index, b.use, 4);
     const __m256i texel = _mm256_add_epi32(
         _mm256_mullo_epi32(_mm256_srli_epi32(b.row, 1), _mm256_set1_epi32(level0_width)), _mm256_srli_epi32(b.col, 1));
-    b.history = {_mm256_mask_i32gather_ps(zero, pyr.history_x.data(), texel, b.use, 4),
-                 _mm256_mask_i32gather_ps(zero, pyr.history_y.data(), texel, b.use, 4),
-                 _mm256_mask_i32gather_ps(zero, pyr.history_z.data(), texel, b.use, 4)};
+    b.history = {_mm256_mask_i32gather_ps(zero, history.x.data(), texel, b.use, 4),
+                 _mm256_mask_i32gather_ps(zero, history.y.data(), texel, b.use, 4),
+                 _mm256_mask_i32gather_ps(zero, history.z.data(), texel, b.use, 4)};
   }
   const __m256 close = _mm256_cmp_ps(abs8(previous_z - b.qz), splat(in.k.disocclusion_m), _CMP_NGT_UQ);
   const __m256 has_history = _mm256_cmp_ps(b.history.x, b.history.x, _CMP_ORD_Q);
@@ -272,18 +271,18 @@ bool avx2_available() {
   return available;
 }
 
-RELIGHT_AVX2 void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out) {
+RELIGHT_AVX2 void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out, int out_row) {
   const int r = 2 * hr;
   const Float3* row = previous + static_cast<std::ptrdiff_t>(r) * width;
   const Float3* up = r >= 1 ? row - width : nullptr;
   const Float3* down = r + 1 < height ? row + width : nullptr;
   const int texels = out.levels[0].width;
-  float* x = out.x.data() + static_cast<std::ptrdiff_t>(hr) * texels;
-  float* y = out.y.data() + static_cast<std::ptrdiff_t>(hr) * texels;
-  float* z = out.z.data() + static_cast<std::ptrdiff_t>(hr) * texels;
-  float* curvature = out.curvature.data() + static_cast<std::ptrdiff_t>(hr) * texels;
+  float* x = out.x.data() + static_cast<std::ptrdiff_t>(out_row) * texels;
+  float* y = out.y.data() + static_cast<std::ptrdiff_t>(out_row) * texels;
+  float* z = out.z.data() + static_cast<std::ptrdiff_t>(out_row) * texels;
+  float* curvature = out.curvature.data() + static_cast<std::ptrdiff_t>(out_row) * texels;
   int hc = 0;
-  if (texels > 0) level0_texel(previous, width, height, hr, hc++, out);  // no left neighbour
+  if (texels > 0) level0_texel(previous, width, height, hr, hc++, out, out_row);  // no left neighbour
   // Texels hc..hc+7 read pixels 2hc−1 … 2hc+15 and one float of pixel 2hc+16.
   for (; 2 * hc + 16 < width; hc += 8) {
     const Float3* p = row + 2 * hc;
@@ -299,7 +298,7 @@ RELIGHT_AVX2 void level0_row_avx2(const Float3* previous, int width, int height,
     _mm256_storeu_ps(z + hc, n.z);
     _mm256_storeu_ps(curvature + hc, curvature_coefficient(curv));
   }
-  for (; hc < texels; ++hc) level0_texel(previous, width, height, hr, hc, out);
+  for (; hc < texels; ++hc) level0_texel(previous, width, height, hr, hc, out, out_row);
 }
 
 RELIGHT_AVX2 void coarse_row_avx2(Pyramid& p, int level, int r) {
@@ -340,8 +339,9 @@ RELIGHT_AVX2 void coarse_row_avx2(Pyramid& p, int level, int r) {
   for (; c < coarse.width; ++c) coarse_texel(p, level, r, c);
 }
 
-RELIGHT_AVX2 void resolve_row_avx2(Pyramid& p, const Constants& k, int r) {
+RELIGHT_AVX2 void resolve_row_avx2(const Pyramid& p, const Constants& k, int r, History& out, int out_row) {
   const int width = p.levels[0].width;
+  const std::ptrdiff_t out_start = static_cast<std::ptrdiff_t>(out_row) * out.width;
   const int max_level = static_cast<int>(p.levels.size()) - 1;
   const __m256 zero = _mm256_setzero_ps(), max_level_f = splat(static_cast<float>(max_level));
   const float* m = k.current_from_prev;
@@ -365,11 +365,11 @@ RELIGHT_AVX2 void resolve_row_avx2(Pyramid& p, const Constants& k, int r) {
     h = select(valid_normal(h), h, level0);
     const __m256 nan = splat(std::numeric_limits<float>::quiet_NaN());
     const __m256 valid = valid_normal(h);
-    _mm256_storeu_ps(p.history_x.data() + i0, select(valid, splat(m[0]) * h.x + splat(m[1]) * h.y + splat(m[2]) * h.z, nan));
-    _mm256_storeu_ps(p.history_y.data() + i0, select(valid, splat(m[3]) * h.x + splat(m[4]) * h.y + splat(m[5]) * h.z, nan));
-    _mm256_storeu_ps(p.history_z.data() + i0, select(valid, splat(m[6]) * h.x + splat(m[7]) * h.y + splat(m[8]) * h.z, nan));
+    _mm256_storeu_ps(out.x.data() + out_start + c, select(valid, splat(m[0]) * h.x + splat(m[1]) * h.y + splat(m[2]) * h.z, nan));
+    _mm256_storeu_ps(out.y.data() + out_start + c, select(valid, splat(m[3]) * h.x + splat(m[4]) * h.y + splat(m[5]) * h.z, nan));
+    _mm256_storeu_ps(out.z.data() + out_start + c, select(valid, splat(m[6]) * h.x + splat(m[7]) * h.y + splat(m[8]) * h.z, nan));
   }
-  for (; c < width; ++c) resolve_texel(p, k, r, c);
+  for (; c < width; ++c) resolve_texel(p, k, r, c, out, out_row);
 }
 
 RELIGHT_AVX2 void pass2_row_avx2(const Pass2& in, int r) {
@@ -447,14 +447,14 @@ RELIGHT_AVX2 void pass2_row_avx2(const Pass2& in, int r) {
 namespace relight::method1 {
 
 bool avx2_available() { return false; }
-void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out) {
-  for (int hc = 0; hc < out.levels[0].width; ++hc) level0_texel(previous, width, height, hr, hc, out);
+void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out, int out_row) {
+  for (int hc = 0; hc < out.levels[0].width; ++hc) level0_texel(previous, width, height, hr, hc, out, out_row);
 }
 void coarse_row_avx2(Pyramid& p, int level, int r) {
   for (int c = 0; c < p.levels[static_cast<std::size_t>(level)].width; ++c) coarse_texel(p, level, r, c);
 }
-void resolve_row_avx2(Pyramid& p, const Constants& k, int r) {
-  for (int c = 0; c < p.levels[0].width; ++c) resolve_texel(p, k, r, c);
+void resolve_row_avx2(const Pyramid& p, const Constants& k, int r, History& out, int out_row) {
+  for (int c = 0; c < p.levels[0].width; ++c) resolve_texel(p, k, r, c, out, out_row);
 }
 void pass2_row_avx2(const Pass2& in, int r) {
   for (int c = 0; c < in.k.width; ++c) pass2_pixel(in, r, c);

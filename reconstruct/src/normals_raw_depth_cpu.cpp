@@ -18,7 +18,8 @@ namespace relight {
 namespace method1 {
 /// What NormalsRawDepthCpu keeps between frames.
 struct Scratch {
-  Pyramid pyramid;
+  std::vector<LevelShape> shapes;  ///< of the pyramid levels (each block's pyramid lives in its thread)
+  History history;
   std::vector<float> x_scale;               ///< padded by stride + 8 on both sides
   std::vector<std::uint32_t> hole_columns;  ///< row r's holes at r * width
   std::vector<Float3> hole_values;          ///< same indexing
@@ -37,28 +38,39 @@ using method1::Pyramid;
 bool use_avx2(const NormalsRawDepthOptions& options) { return options.simd && method1::avx2_available(); }
 
 // Level shapes as the reference pyramid: half resolution (rounding up), halving while both sides
-// exceed one texel, at most `levels` levels.
-void shape_pyramid(Pyramid& pyramid, int width, int height, int levels) {
-  pyramid.levels.clear();
+// exceed one texel, at most `levels` levels; offsets as if all rows were stored.
+void shape_levels(std::vector<method1::LevelShape>& shapes, int width, int height, int levels) {
+  shapes.clear();
   int w = (width + 1) / 2, h = (height + 1) / 2, size = w * h;
-  pyramid.levels.push_back({w, h, 0});
-  while (static_cast<int>(pyramid.levels.size()) < levels && w > 1 && h > 1) {
+  shapes.push_back({w, h, 0});
+  while (static_cast<int>(shapes.size()) < std::max(1, levels) && w > 1 && h > 1) {
     w = (w + 1) / 2;
     h = (h + 1) / 2;
-    pyramid.levels.push_back({w, h, size});
+    shapes.push_back({w, h, size});
     size += w * h;
   }
-  // Padded by 8: the AVX2 loop loads eight neighbouring texels from any texel on.
+}
+
+// Storage for `shapes` with `rows(l)` rows at level l, plus 8 padding elements: the AVX2 loops
+// load eight neighbouring texels from any texel on.
+template <class Rows>
+void allocate(Pyramid& pyramid, const std::vector<method1::LevelShape>& shapes, Rows rows) {
+  pyramid.levels.clear();
+  int size = 0;
+  for (std::size_t l = 0; l < shapes.size(); ++l) {
+    pyramid.levels.push_back({shapes[l].width, rows(static_cast<int>(l)), size});
+    size += shapes[l].width * rows(static_cast<int>(l));
+  }
   for (auto* v : {&pyramid.x, &pyramid.y, &pyramid.z, &pyramid.curvature}) v->resize(static_cast<std::size_t>(size) + 8);
 }
 
-void level0_row(const NormalMap& previous, int hr, Pyramid& pyramid, bool avx2) {
+void level0_row(const NormalMap& previous, int hr, Pyramid& out, int out_row, bool avx2) {
   if (avx2) {
-    method1::level0_row_avx2(previous.data(), previous.width(), previous.height(), hr, pyramid);
+    method1::level0_row_avx2(previous.data(), previous.width(), previous.height(), hr, out, out_row);
     return;
   }
-  for (int hc = 0; hc < pyramid.levels[0].width; ++hc) {
-    method1::level0_texel(previous.data(), previous.width(), previous.height(), hr, hc, pyramid);
+  for (int hc = 0; hc < out.levels[0].width; ++hc) {
+    method1::level0_texel(previous.data(), previous.width(), previous.height(), hr, hc, out, out_row);
   }
 }
 
@@ -72,44 +84,67 @@ void coarse_row(Pyramid& pyramid, int level, int r, bool avx2) {
   }
 }
 
-void resolve_row(Pyramid& pyramid, const method1::Constants& k, int r, bool avx2) {
+void resolve_row(const Pyramid& pyramid, const method1::Constants& k, int r, method1::History& out, int out_row,
+                 bool avx2) {
   if (avx2) {
-    method1::resolve_row_avx2(pyramid, k, r);
+    method1::resolve_row_avx2(pyramid, k, r, out, out_row);
     return;
   }
-  for (int c = 0; c < pyramid.levels[0].width; ++c) method1::resolve_texel(pyramid, k, r, c);
+  for (int c = 0; c < pyramid.levels[0].width; ++c) method1::resolve_texel(pyramid, k, r, c, out, out_row);
 }
 
-// Pass 1, and with `resolve_for` the resolved history normals for that frame's rotation. The
-// rows are split in blocks of 2^(levels − 1) level-0 rows: level l's rows above a block come
-// from that block's rows only, so one task builds every level and the resolved rows of its block
-// while they are in its cache.
-void build_pyramid(const NormalMap& previous, int levels, int threads, bool avx2, Pyramid& pyramid,
-                   const method1::Constants* resolve_for = nullptr) {
-  shape_pyramid(pyramid, previous.width(), previous.height(), std::max(1, levels));
-  const auto padded = pyramid.x.size();
-  for (auto* v : {&pyramid.history_x, &pyramid.history_y, &pyramid.history_z}) v->resize(resolve_for ? padded : 0);
-  const int top = static_cast<int>(pyramid.levels.size()) - 1;
-  const int block = 1 << top;  // level-0 rows
-  const int blocks = (pyramid.levels[0].height + block - 1) / block;
+// Pass 1 runs in blocks of 2^(levels − 1) level-0 rows: level l's rows above a block come from
+// that block's rows only, so one task builds every level of its block while it is in its cache.
+int block_rows(const std::vector<method1::LevelShape>& shapes) { return 1 << (static_cast<int>(shapes.size()) - 1); }
+
+// Block b's rows of every level into `out`, whose row 0 of level l is global row first(l).
+template <class First>
+void build_block(const NormalMap& previous, const std::vector<method1::LevelShape>& shapes, int b, Pyramid& out,
+                 First first, bool avx2) {
+  const int block = block_rows(shapes);
+  for (int level = 0; level < static_cast<int>(shapes.size()); ++level) {
+    const int rows = block >> level;
+    const int end = std::min((b + 1) * rows, shapes[static_cast<std::size_t>(level)].height);
+    for (int r = b * rows; r < end; ++r) {
+      if (level == 0) {
+        level0_row(previous, r, out, r - first(0), avx2);
+      } else {
+        coarse_row(out, level, r - first(level), avx2);
+      }
+    }
+  }
+}
+
+// The whole pyramid (normals_history_pyramid).
+void build_pyramid(const NormalMap& previous, int levels, int threads, bool avx2, Pyramid& pyramid) {
+  std::vector<method1::LevelShape> shapes;
+  shape_levels(shapes, previous.width(), previous.height(), levels);
+  allocate(pyramid, shapes, [&](int l) { return shapes[static_cast<std::size_t>(l)].height; });
+  const int block = block_rows(shapes);
   parallel_for_each_row(
-      blocks, threads,
+      (shapes[0].height + block - 1) / block, threads,
+      [&](int b) { build_block(previous, shapes, b, pyramid, [](int) { return 0; }, avx2); }, 1);
+}
+
+// Pass 1 for pass 2: each block's pyramid in a scratch of the task's thread (it never leaves the
+// cache), resolved into `history`.
+void build_history(const NormalMap& previous, const method1::Constants& k, int levels, int threads, bool avx2,
+                   std::vector<method1::LevelShape>& shapes, method1::History& history) {
+  shape_levels(shapes, previous.width(), previous.height(), levels);
+  history.width = shapes[0].width;
+  const auto texels = static_cast<std::size_t>(shapes[0].width) * static_cast<std::size_t>(shapes[0].height) + 8;
+  for (auto* v : {&history.x, &history.y, &history.z}) v->resize(texels);
+  const int block = block_rows(shapes);
+  parallel_for_each_row(
+      (shapes[0].height + block - 1) / block, threads,
       [&](int b) {
-        for (int level = 0; level <= top; ++level) {
-          const int rows = block >> level;
-          const int end = std::min((b + 1) * rows, pyramid.levels[static_cast<std::size_t>(level)].height);
-          for (int r = b * rows; r < end; ++r) {
-            if (level == 0) {
-              level0_row(previous, r, pyramid, avx2);
-            } else {
-              coarse_row(pyramid, level, r, avx2);
-            }
-          }
-        }
-        if (resolve_for) {
-          const int end = std::min((b + 1) * block, pyramid.levels[0].height);
-          for (int r = b * block; r < end; ++r) resolve_row(pyramid, *resolve_for, r, avx2);
-        }
+        thread_local Pyramid scratch;
+        const auto first = [&](int l) { return b * (block >> l); };
+        allocate(scratch, shapes, [&](int l) {
+          return std::min(block >> l, shapes[static_cast<std::size_t>(l)].height - first(l));
+        });
+        build_block(previous, shapes, b, scratch, first, avx2);
+        for (int r = 0; r < scratch.levels[0].height; ++r) resolve_row(scratch, k, r, history, first(0) + r, avx2);
       },
       1);
 }
@@ -163,9 +198,10 @@ method1::Pass2 prepare(method1::Scratch& ws, const PinholeIntrinsics& intrinsics
   method1::Pass2 pass;
   pass.k = frame_constants(intrinsics, camera_to_world, previous, options, width, height);
   if (previous) {
-    build_pyramid(previous->normals, options.mip_levels, options.threads, use_avx2(options), ws.pyramid, &pass.k);
+    build_history(previous->normals, pass.k, options.mip_levels, options.threads, use_avx2(options), ws.shapes,
+                  ws.history);
     pass.prev_positions = previous->positions.data();
-    pass.pyramid = &ws.pyramid;
+    pass.history = &ws.history;
   }
   // Sized for the worst case but touched only where there are holes.
   const auto pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);

@@ -33,19 +33,22 @@ struct LevelShape {
   int width = 0, height = 0, offset = 0;
 };
 
-/// Pass 1's output: level l's texel (r, c) is element levels[l].offset + r * width + c of x, y,
-/// z and curvature (each followed by 8 padding elements; the coarser curvatures exist for
-/// normals_history_pyramid only).
-///
-/// Which history normal a pixel (row, col) of the previous frame contributes depends only on its
-/// level-0 texel (row >> 1, col >> 1): the level comes from that texel's curvature, level l's
-/// texel is (row >> 1 >> l, col >> 1 >> l), level 0's is the fallback. So pass 1 also resolves
-/// it once per level-0 texel, rotated into the current frame: history_x/y/z, same indexing as
-/// level 0 (plus padding), NaN where the texel has no valid history normal.
+/// Pass 1's pyramid, or the rows of it that one block of level-0 rows covers: level l's texel
+/// (r, c) is element levels[l].offset + r * width + c of x, y, z and curvature (each followed by
+/// 8 padding elements; the coarser curvatures exist for normals_history_pyramid only).
 struct Pyramid {
   std::vector<float> x, y, z, curvature;
-  std::vector<float> history_x, history_y, history_z;
   std::vector<LevelShape> levels;
+};
+
+/// Which history normal a pixel (row, col) of the previous frame contributes depends only on its
+/// level-0 texel (row >> 1, col >> 1): the level comes from that texel's curvature, level l's
+/// texel is (row >> 1 >> l, col >> 1 >> l), level 0's is the fallback. So pass 1 resolves it once
+/// per level-0 texel, rotated into the current frame: element r * width + c (plus 8 padding
+/// elements), NaN where the texel has no valid history normal.
+struct History {
+  std::vector<float> x, y, z;
+  int width = 0;  ///< level-0 texels per row
 };
 
 /// Pass 2's inputs and outputs for one frame. In the fused mode positions and fresh normals are
@@ -60,7 +63,7 @@ struct Pass2 {
   const Float3* positions_in = nullptr;   ///< blend-only mode
   Float3* normals = nullptr;
   const Float3* prev_positions = nullptr; ///< null: no history, no blend
-  const Pyramid* pyramid = nullptr;
+  const History* history = nullptr;
   // Holes (a position but no normal), listed per row in column order with the value they had
   // before any fill, so that fills can be applied in any order: a fill reads a neighbouring hole
   // as it was (the definition fills from the blended map).
@@ -96,8 +99,8 @@ inline float clamp01(float v) { return std::clamp(v, 0.f, 1.f); }
 // ---- Pass 1 ----------------------------------------------------------------------------------
 
 /// Level-0 texel (hr, hc) from the previous normals (width x height): mean of the pixel and its
-/// 4-neighbourhood, curvature of eq. 4.1–4.3.
-inline void level0_texel(const Float3* previous, int width, int height, int hr, int hc, Pyramid& out) {
+/// 4-neighbourhood, curvature of eq. 4.1–4.3; stored in row out_row of `out`.
+inline void level0_texel(const Float3* previous, int width, int height, int hr, int hc, Pyramid& out, int out_row) {
   const int r = 2 * hr, c = 2 * hc;
   const auto at = [&](int row, int col) -> Float3 {
     return row >= 0 && col >= 0 && row < height && col < width
@@ -109,7 +112,7 @@ inline void level0_texel(const Float3* previous, int width, int height, int hr, 
   const bool horizontal = is_valid_normal(left) && is_valid_normal(right);
   const bool vertical = is_valid_normal(up) && is_valid_normal(down);
   const float curv = horizontal && vertical ? std::min(dot(left, right), dot(up, down)) : 0.f;
-  const std::size_t i = static_cast<std::size_t>(hr) * static_cast<std::size_t>(out.levels[0].width) +
+  const std::size_t i = static_cast<std::size_t>(out_row) * static_cast<std::size_t>(out.levels[0].width) +
                         static_cast<std::size_t>(hc);
   out.x[i] = n.x;
   out.y[i] = n.y;
@@ -151,24 +154,25 @@ inline int chosen_level(float curvature, int max_level) {
   return lf >= 0.f ? static_cast<int>(std::min(lf, static_cast<float>(max_level))) : 0;
 }
 
-/// The resolved history normal of level-0 texel (r, c) (see Pyramid); needs every level's texels
-/// above it.
-inline void resolve_texel(Pyramid& p, const Constants& k, int r, int c) {
+/// The resolved history normal of level-0 texel (r, c) of `p` (see History), stored in row
+/// out_row of `out`; needs every level's texels above it.
+inline void resolve_texel(const Pyramid& p, const Constants& k, int r, int c, History& out, int out_row) {
   const auto texel = [&p](int level, int row, int col) {
     const LevelShape& shape = p.levels[static_cast<std::size_t>(level)];
     const auto i = static_cast<std::size_t>(shape.offset + (row >> level) * shape.width + (col >> level));
     return Float3{p.x[i], p.y[i], p.z[i]};
   };
   const auto i0 = static_cast<std::size_t>(r * p.levels[0].width + c);
+  const auto o = static_cast<std::size_t>(out_row * out.width + c);
   const int level = chosen_level(p.curvature[i0], static_cast<int>(p.levels.size()) - 1);
   Float3 h = texel(level, r, c);
   if (!is_valid_normal(h)) h = texel(0, r, c);
   const float* m = k.current_from_prev;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const bool valid = is_valid_normal(h);
-  p.history_x[i0] = valid ? m[0] * h.x + m[1] * h.y + m[2] * h.z : nan;
-  p.history_y[i0] = valid ? m[3] * h.x + m[4] * h.y + m[5] * h.z : nan;
-  p.history_z[i0] = valid ? m[6] * h.x + m[7] * h.y + m[8] * h.z : nan;
+  out.x[o] = valid ? m[0] * h.x + m[1] * h.y + m[2] * h.z : nan;
+  out.y[o] = valid ? m[3] * h.x + m[4] * h.y + m[5] * h.z : nan;
+  out.z[o] = valid ? m[6] * h.x + m[7] * h.y + m[8] * h.z : nan;
 }
 
 // ---- Pass 2 ----------------------------------------------------------------------------------
@@ -214,9 +218,9 @@ inline Float3 blend_with_history(const Float3& n, const Float3& p, const Pass2& 
       in.prev_positions[static_cast<std::size_t>(row) * static_cast<std::size_t>(k.width) + static_cast<std::size_t>(col)].z;
   if (!(previous_z > 0.f) || std::fabs(previous_z - q.z) > k.disocclusion_m) return n;
 
-  const Pyramid& pyr = *in.pyramid;
-  const auto i0 = static_cast<std::size_t>((row >> 1) * pyr.levels[0].width + (col >> 1));
-  const Float3 h{pyr.history_x[i0], pyr.history_y[i0], pyr.history_z[i0]};
+  const History& history = *in.history;
+  const auto i0 = static_cast<std::size_t>((row >> 1) * history.width + (col >> 1));
+  const Float3 h{history.x[i0], history.y[i0], history.z[i0]};
   if (std::isnan(h.x)) return n;  // no valid history normal
 
   const float c_n = std::fabs(dot(h, n));         // eq. 4.7
@@ -301,12 +305,13 @@ inline void pass2_pixel(const Pass2& in, int r, int c) {
 
 /// True when the CPU and the OS support AVX2 and this build has the AVX2 loops.
 [[nodiscard]] bool avx2_available();
-/// Level-0 texel row hr (all columns), same results as level0_texel.
-void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out);
+/// Level-0 texel row hr (all columns) into row out_row, same results as level0_texel.
+void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out, int out_row);
 /// Row r of coarse `level` (all columns), same results as coarse_texel.
 void coarse_row_avx2(Pyramid& p, int level, int r);
-/// Level-0 texel row r of the resolved history (all columns), same results as resolve_texel.
-void resolve_row_avx2(Pyramid& p, const Constants& k, int r);
+/// Level-0 texel row r of the resolved history (all columns) into row out_row, same results as
+/// resolve_texel.
+void resolve_row_avx2(const Pyramid& p, const Constants& k, int r, History& out, int out_row);
 /// Pass 2 for row r (all columns), same results as pass2_pixel. Requires width·height·3 < 2^31
 /// (gather indices).
 void pass2_row_avx2(const Pass2& in, int r);
