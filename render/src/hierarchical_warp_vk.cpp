@@ -1,5 +1,5 @@
-// Hierarchical warping on Vulkan (hierarchical_warp_vk.h): a pyramid dispatch per level, a
-// barrier between levels, one descent dispatch, all in one submission.
+// Hierarchical warping on Vulkan (hierarchical_warp_vk.h): a pyramid dispatch per three levels,
+// a barrier between dispatches, one descent dispatch, all in one submission.
 #include "relight/render/hierarchical_warp_vk.h"
 
 #include <algorithm>
@@ -28,15 +28,6 @@ std::size_t pyramid_floats(std::uint32_t size) {
   std::size_t floats = 0;
   for (std::size_t side = size; side >= 1; side /= 2) floats += side * side;
   return floats;
-}
-
-/// Groups for `items` invocations of warp_pyramid.comp, as a 2-D grid where one row would be too long.
-void dispatch_items(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline, const vk::UniqueDescriptorSet& set,
-                    const gpu::WarpPyramidParams& params, std::uint32_t items) {
-  constexpr std::uint32_t kMaxRow = 32768;
-  const std::uint32_t groups = vk::ComputePipeline::group_count(items, kLocal);
-  const std::uint32_t x = std::max(std::min(groups, kMaxRow), 1u);
-  pipeline.dispatch(cmd, set, params, x, vk::ComputePipeline::group_count(groups, x));
 }
 
 }  // namespace
@@ -78,15 +69,24 @@ std::optional<double> HierarchicalWarpVk::run(const vk::VulkanBuffer& importance
   const auto descend_set = p.descend.bind({p.sums.get(), &points, &samples});
   context_.submit([&](VkCommandBuffer cmd) {
     p.timer.start(cmd);
-    dispatch_items(cmd, p.pyramid, pyramid_set, {0, side, 0, 0}, side * side);
-    std::uint32_t fine_offset = 0;
-    for (std::uint32_t level = 1; level < levels; ++level) {
-      const std::uint32_t coarse_side = side >> level, fine_side = coarse_side * 2;
-      const std::uint32_t coarse_offset = fine_offset + fine_side * fine_side;
-      vk::compute_barrier(cmd);
-      dispatch_items(cmd, p.pyramid, pyramid_set, {1, coarse_side, fine_offset, coarse_offset},
-                     coarse_side * coarse_side);
-      fine_offset = coarse_offset;
+    if (levels == 1)  // a 1x1 map: only its copy into level 0
+      p.pyramid.dispatch(cmd, pyramid_set, gpu::WarpPyramidParams{0, 1, 0, 0, {0, 0, 0, 0}}, 1, 1);
+    std::uint32_t fine_level = 0, fine_offset = 0;
+    while (fine_level + 1 < levels) {
+      gpu::WarpPyramidParams params{fine_level == 0 ? 0u : 1u, side >> fine_level, fine_offset, 0, {0, 0, 0, 0}};
+      params.level_count = std::min<std::uint32_t>(RELIGHT_WARP_LEVELS_PER_DISPATCH, levels - 1 - fine_level);
+      std::uint32_t offset = fine_offset + params.fine_side * params.fine_side;
+      for (std::uint32_t i = 0; i < params.level_count; ++i) {
+        params.offsets[i] = offset;
+        const std::uint32_t level_side = side >> (fine_level + 1 + i);
+        offset += level_side * level_side;
+      }
+      if (fine_level > 0) vk::compute_barrier(cmd);
+      const std::uint32_t blocks = params.fine_side >> params.level_count;
+      const std::uint32_t groups = vk::ComputePipeline::group_count(blocks, RELIGHT_WARP_PYRAMID_GROUP);
+      p.pyramid.dispatch(cmd, pyramid_set, params, groups, groups);
+      fine_level += params.level_count;
+      fine_offset = params.offsets[params.level_count - 1];
     }
     vk::compute_barrier(cmd);
     if (count > 0)

@@ -173,7 +173,7 @@ class HierarchicalWarpVkTest : public relight::test::VulkanTest {};
 TEST_F(HierarchicalWarpVkTest, SameTexelsAsTheCpu) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   HierarchicalWarpVk warp(context);
-  for (int size : {1, 2, 64, 256}) {
+  for (int size : {1, 2, 4, 16, 64, 256}) {  // every split of the levels over dispatches
     std::vector<float> map = mixed_map(size);
     if (size == 1) map[0] = 3.f;
     std::vector<WarpPoint> points = hammersley_points(4096);

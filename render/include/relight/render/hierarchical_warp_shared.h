@@ -4,8 +4,12 @@
 #ifndef RELIGHT_RENDER_HIERARCHICAL_WARP_SHARED_H
 #define RELIGHT_RENDER_HIERARCHICAL_WARP_SHARED_H
 
-/// Invocations per work group of both shaders (1-D, one per texel or per point).
+/// Invocations per work group of warp_descend.comp (1-D, one per point).
 #define RELIGHT_WARP_LOCAL_SIZE 64
+/// Edge of warp_pyramid.comp's square work group (one invocation per block of the level read).
+#define RELIGHT_WARP_PYRAMID_GROUP 8
+/// Levels one warp_pyramid.comp dispatch writes at most (each invocation sums an 8x8 block).
+#define RELIGHT_WARP_LEVELS_PER_DISPATCH 3
 /// Levels the descent can hold (a 8192^2 map has 14).
 #define RELIGHT_WARP_MAX_LEVELS 14
 /// x and y of a sample when the map has no importance.
@@ -17,13 +21,15 @@ namespace relight::gpu {
 using uint = std::uint32_t;
 #endif
 
-/// Push constants of warp_pyramid.comp: mode 0 copies the map into level 0 (flushing subnormal
-/// values), mode 1 sums level `coarse` - 1 into level `coarse`.
+/// Push constants of warp_pyramid.comp: mode 0 reads the importance map (and writes it as level
+/// 0, flushing subnormal values), mode 1 a level of the pyramid; either way the next
+/// `level_count` (1..3) levels are written.
 struct WarpPyramidParams {
   uint mode;
-  uint coarse_side;    ///< texels per side of the level written
-  uint fine_offset;    ///< of the level read, in floats into the pyramid
-  uint coarse_offset;  ///< of the level written
+  uint fine_side;    ///< texels per side of the level read
+  uint fine_offset;  ///< of the level read, in floats into the pyramid (mode 1)
+  uint level_count;
+  uint offsets[4];   ///< of the levels written, in floats into the pyramid (the 4th is padding)
 };
 
 /// Push constants of warp_descend.comp. Samples are 3 words each: x, y, float bits of probability.
@@ -35,7 +41,7 @@ struct WarpDescendParams {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(WarpPyramidParams) == 16 && sizeof(WarpDescendParams) == 16);
+static_assert(sizeof(WarpPyramidParams) == 32 && sizeof(WarpDescendParams) == 16);
 }  // namespace relight::gpu
 #endif
 
