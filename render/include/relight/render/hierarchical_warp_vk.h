@@ -1,7 +1,7 @@
 #pragma once
 // Hierarchical warping on Vulkan (definition and CPU reference in hierarchical_warp.h): the sum
-// pyramid in one compute dispatch per three levels (shaders/warp_pyramid.comp), then one invocation per
-// point descends it (shaders/warp_descend.comp). Same texels as the CPU for the same points; the
+// pyramid in one compute dispatch per three levels (shaders/warp_pyramid.comp), then one
+// invocation per point descends it (shaders/warp_descend.comp). Same texels as the CPU for the same points; the
 // probabilities are importance / total with the device's division (within a few ulps).
 //
 // Reads:  importance (size * size floats, row-major, >= 0 and finite: the caller's contract on
