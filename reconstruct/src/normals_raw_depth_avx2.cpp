@@ -50,6 +50,14 @@ RELIGHT_AVX2 inline __m256 valid_normal(const V3& n) {
   return both(finite, gt(dot3(n, n), _mm256_setzero_ps()));
 }
 
+/// valid_normal for a vector scaled by ±1/|v| (normalized_or_zero, fresh_normal8): its length is
+/// about 1 unless the scale overflowed, so its components are finite exactly when its squared
+/// length is, and the test needs no per-component check.
+RELIGHT_AVX2 inline __m256 valid_scaled_normal(const V3& n) {
+  const __m256 d = dot3(n, n);
+  return both(gt(d, _mm256_setzero_ps()), le(d, splat(FLT_MAX)));
+}
+
 /// normalized_or_zero: (1 / |v|) · v, zero where |v| is not positive.
 RELIGHT_AVX2 inline V3 normalized_or_zero(const V3& v) {
   const __m256 len = _mm256_sqrt_ps(dot3(v, v));
@@ -57,11 +65,9 @@ RELIGHT_AVX2 inline V3 normalized_or_zero(const V3& v) {
   return keep(gt(len, _mm256_setzero_ps()), {inv * v.x, inv * v.y, inv * v.z});
 }
 
-/// round_half_away (std::lround as a float); adding +0 where it does not round up changes no value.
-RELIGHT_AVX2 inline __m256 round_half_away(__m256 x) {
-  const __m256 t = _mm256_round_ps(x, _MM_FROUND_TO_ZERO | _MM_FROUND_NO_EXC);
-  const __m256 one_with_sign = _mm256_or_ps(_mm256_and_ps(x, splat(-0.f)), splat(1.f));
-  return t + _mm256_and_ps(ge(abs8(x - t), splat(0.5f)), one_with_sign);
+/// round_half_up.
+RELIGHT_AVX2 inline __m256 round_half_up(__m256 x) {
+  return _mm256_round_ps(x + splat(0.5f), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC);
 }
 
 /// Eight consecutive Float3 into three registers.
@@ -203,8 +209,8 @@ RELIGHT_AVX2 inline void reproject8(const Constants& k, BlendLanes& b) {
   const V3 q{splat(m[0]) * p.x + splat(m[1]) * p.y + splat(m[2]) * p.z + splat(m[3]),
              splat(m[4]) * p.x + splat(m[5]) * p.y + splat(m[6]) * p.z + splat(m[7]),
              splat(m[8]) * p.x + splat(m[9]) * p.y + splat(m[10]) * p.z + splat(m[11])};
-  const __m256 colf = round_half_away(splat(k.fx) * q.x / q.z + splat(k.cx));
-  const __m256 rowf = round_half_away(splat(k.fy) * q.y / q.z + splat(k.cy));
+  const __m256 colf = round_half_up(splat(k.fx) * q.x / q.z + splat(k.cx));
+  const __m256 rowf = round_half_up(splat(k.fy) * q.y / q.z + splat(k.cy));
   const __m256 inside = both(both(ge(colf, zero), le(colf, splat(static_cast<float>(k.width - 1)))),
                              both(ge(rowf, zero), le(rowf, splat(static_cast<float>(k.height - 1)))));
   b.qz = q.z;
@@ -261,7 +267,7 @@ RELIGHT_AVX2 inline V3 blend_history8(const Pass2& in, const BlendLanes& b) {
   const __m256 c = splat(in.k.blend_base) * c_n + (splat(1.f) - c_n);  // eq. 4.8
   const __m256 c_fresh = splat(1.f) - c;
   const V3 blended = normalized_or_zero({c * h.x + c_fresh * n.x, c * h.y + c_fresh * n.y, c * h.z + c_fresh * n.z});
-  return select(both(b.use, valid_normal(blended)), blended, n);
+  return select(both(b.use, valid_scaled_normal(blended)), blended, n);
 }
 
 }  // namespace
@@ -324,7 +330,7 @@ RELIGHT_AVX2 void coarse_row_avx2(Pyramid& p, int level, int r) {
       V3 sum = zero3();
       __m256 curvature = zero, count = zero;
       for (int j = 0; j < 4; ++j) {  // (0,0), (0,1), (1,0), (1,1) as coarse_texel
-        const __m256 valid = valid_normal(children[j]);
+        const __m256 valid = valid_scaled_normal(children[j]);  // normalized_or_zero results
         sum = plus(sum, keep(valid, children[j]));
         curvature = curvature + _mm256_and_ps(valid, child_curvature[j]);
         count = count + _mm256_and_ps(valid, one);
@@ -349,7 +355,7 @@ RELIGHT_AVX2 void resolve_row_avx2(const Pyramid& p, const Constants& k, int r, 
   int c = 0;
   for (; c + 8 <= width; c += 8) {
     const std::ptrdiff_t i0 = row + c;
-    const __m256 lf = round_half_away(_mm256_loadu_ps(p.curvature.data() + i0) * max_level_f);
+    const __m256 lf = round_half_up(_mm256_loadu_ps(p.curvature.data() + i0) * max_level_f);
     const __m256i level = _mm256_cvttps_epi32(_mm256_and_ps(ge(lf, zero), _mm256_min_ps(lf, max_level_f)));
     const V3 level0{_mm256_loadu_ps(p.x.data() + i0), _mm256_loadu_ps(p.y.data() + i0), _mm256_loadu_ps(p.z.data() + i0)};
     V3 h = level0;
@@ -362,9 +368,9 @@ RELIGHT_AVX2 void resolve_row_avx2(const Pyramid& p, const Constants& k, int r, 
                       load_coherent(p.z.data(), base, c, l)};
       h = select(at_level, texels, h);
     }
-    h = select(valid_normal(h), h, level0);
+    h = select(valid_scaled_normal(h), h, level0);  // pyramid texels are normalized_or_zero results
     const __m256 nan = splat(std::numeric_limits<float>::quiet_NaN());
-    const __m256 valid = valid_normal(h);
+    const __m256 valid = valid_scaled_normal(h);
     _mm256_storeu_ps(out.x.data() + out_start + c, select(valid, splat(m[0]) * h.x + splat(m[1]) * h.y + splat(m[2]) * h.z, nan));
     _mm256_storeu_ps(out.y.data() + out_start + c, select(valid, splat(m[3]) * h.x + splat(m[4]) * h.y + splat(m[5]) * h.z, nan));
     _mm256_storeu_ps(out.z.data() + out_start + c, select(valid, splat(m[6]) * h.x + splat(m[7]) * h.y + splat(m[8]) * h.z, nan));
@@ -408,7 +414,7 @@ RELIGHT_AVX2 void pass2_row_avx2(const Pass2& in, int r) {
         b.p = load_aos8(in.positions_in + row_start + c);
         b.n = load_aos8(in.normals + row_start + c);
       }
-      b.has_normal = valid_normal(b.n);
+      b.has_normal = depth_row ? valid_scaled_normal(b.n) : valid_normal(b.n);
       if (blend) {
         reproject8(k, b);
         // The previous positions are read by gathers, which the hardware prefetchers do not

@@ -76,12 +76,9 @@ struct Pass2 {
 
 inline bool valid_depth_value(float z) { return z > 0.f && z <= 3.4e38f; }  // positions_from_depth's test
 
-/// std::lround as a float: halves away from zero. Exact for every float (x − trunc(x) is exact).
-inline float round_half_away(float x) {
-  float t = std::trunc(x);
-  if (std::fabs(x - t) >= 0.5f) t += std::copysign(1.f, x);
-  return t;
-}
+/// Nearest integer, halves up: floor(x + 0.5), as the Vulkan shader rounds (for x ≥ 0, std::lround
+/// except within an ulp below a half).
+inline float round_half_up(float x) { return std::floor(x + 0.5f); }
 
 inline Float3 normalized_or_zero(const Float3& v) {
   const float len = length(v);
@@ -150,7 +147,7 @@ inline void coarse_texel(Pyramid& p, int level, int r, int c) {
 
 /// The pyramid level that the level-0 curvature selects (flat: coarse, edges: fine).
 inline int chosen_level(float curvature, int max_level) {
-  const float lf = round_half_away(curvature * static_cast<float>(max_level));
+  const float lf = round_half_up(curvature * static_cast<float>(max_level));
   return lf >= 0.f ? static_cast<int>(std::min(lf, static_cast<float>(max_level))) : 0;
 }
 
@@ -207,8 +204,8 @@ inline Float3 blend_with_history(const Float3& n, const Float3& p, const Pass2& 
   const Float3 q{m[0] * p.x + m[1] * p.y + m[2] * p.z + m[3], m[4] * p.x + m[5] * p.y + m[6] * p.z + m[7],
                  m[8] * p.x + m[9] * p.y + m[10] * p.z + m[11]};
   if (!(q.z > 0.f)) return n;
-  const float colf = round_half_away(k.fx * q.x / q.z + k.cx);
-  const float rowf = round_half_away(k.fy * q.y / q.z + k.cy);
+  const float colf = round_half_up(k.fx * q.x / q.z + k.cx);
+  const float rowf = round_half_up(k.fy * q.y / q.z + k.cy);
   if (!(colf >= 0.f && colf <= static_cast<float>(k.width - 1) && rowf >= 0.f &&
         rowf <= static_cast<float>(k.height - 1))) {
     return n;
