@@ -277,34 +277,60 @@ bool avx2_available() {
   return available;
 }
 
+/// Level-0 texels hc … hc+7 of one row. `p` is the centre pixel of texel hc; the texels read
+/// pixels p − 1 … p + 15 (and one float of p + 16) of their row and p … p + 14 (and one float of
+/// p + 15) of the rows above and below (null: outside the image).
+RELIGHT_AVX2 inline void level0_texels8(const Float3* p, const Float3* above_p, const Float3* below_p, float* x,
+                                        float* y, float* z, float* curvature) {
+  const V3 centre = load_stride2(p), left = load_stride2(p - 1), right = load_stride2(p + 1);
+  const V3 above = above_p ? load_stride2(above_p) : zero3();
+  const V3 below = below_p ? load_stride2(below_p) : zero3();
+  const V3 n = normalized_or_zero(plus(plus(plus(plus(centre, above), below), left), right));
+  const __m256 pairs = both(both(valid_normal(left), valid_normal(right)), both(valid_normal(above), valid_normal(below)));
+  // std::min(a, b) is b < a ? b : a, which is _mm256_min_ps(b, a).
+  const __m256 curv = _mm256_and_ps(pairs, _mm256_min_ps(dot3(above, below), dot3(left, right)));
+  _mm256_storeu_ps(x, n.x);
+  _mm256_storeu_ps(y, n.y);
+  _mm256_storeu_ps(z, n.z);
+  _mm256_storeu_ps(curvature, curvature_coefficient(curv));
+}
+
 RELIGHT_AVX2 void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out, int out_row) {
   const int r = 2 * hr;
   const Float3* row = previous + static_cast<std::ptrdiff_t>(r) * width;
   const Float3* up = r >= 1 ? row - width : nullptr;
   const Float3* down = r + 1 < height ? row + width : nullptr;
   const int texels = out.levels[0].width;
-  float* x = out.x.data() + static_cast<std::ptrdiff_t>(out_row) * texels;
-  float* y = out.y.data() + static_cast<std::ptrdiff_t>(out_row) * texels;
-  float* z = out.z.data() + static_cast<std::ptrdiff_t>(out_row) * texels;
-  float* curvature = out.curvature.data() + static_cast<std::ptrdiff_t>(out_row) * texels;
-  int hc = 0;
-  if (texels > 0) level0_texel(previous, width, height, hr, hc++, out, out_row);  // no left neighbour
-  // Texels hc..hc+7 read pixels 2hc−1 … 2hc+15 and one float of pixel 2hc+16.
-  for (; 2 * hc + 16 < width; hc += 8) {
-    const Float3* p = row + 2 * hc;
-    const V3 centre = load_stride2(p), left = load_stride2(p - 1), right = load_stride2(p + 1);
-    const V3 above = up ? load_stride2(up + 2 * hc) : zero3();
-    const V3 below = down ? load_stride2(down + 2 * hc) : zero3();
-    const V3 n = normalized_or_zero(plus(plus(plus(plus(centre, above), below), left), right));
-    const __m256 pairs = both(both(valid_normal(left), valid_normal(right)), both(valid_normal(above), valid_normal(below)));
-    // std::min(a, b) is b < a ? b : a, which is _mm256_min_ps(b, a).
-    const __m256 curv = _mm256_and_ps(pairs, _mm256_min_ps(dot3(above, below), dot3(left, right)));
-    _mm256_storeu_ps(x + hc, n.x);
-    _mm256_storeu_ps(y + hc, n.y);
-    _mm256_storeu_ps(z + hc, n.z);
-    _mm256_storeu_ps(curvature + hc, curvature_coefficient(curv));
+  const std::ptrdiff_t o = static_cast<std::ptrdiff_t>(out_row) * texels;
+  float* x = out.x.data() + o;
+  float* y = out.y.data() + o;
+  float* z = out.z.data() + o;
+  float* curvature = out.curvature.data() + o;
+  if (texels < 8) {
+    for (int hc = 0; hc < texels; ++hc) level0_texel(previous, width, height, hr, hc, out, out_row);
+    return;
   }
-  for (; hc < texels; ++hc) level0_texel(previous, width, height, hr, hc, out, out_row);
+  // At the image's left and right edges: the same loop on a copy of the pixels read, with zeros
+  // where they fall outside the image (as level0_texel reads them).
+  const auto edge = [&](int hc) RELIGHT_AVX2 {
+    Float3 pixels[3][18] = {};
+    for (int j = 0; j < 18; ++j) {
+      const int c = 2 * hc - 1 + j;
+      if (c < 0 || c >= width) continue;
+      if (up) pixels[0][j] = up[c];
+      pixels[1][j] = row[c];
+      if (down) pixels[2][j] = down[c];
+    }
+    level0_texels8(&pixels[1][1], up ? &pixels[0][1] : nullptr, down ? &pixels[2][1] : nullptr, x + hc, y + hc,
+                   z + hc, curvature + hc);
+  };
+  edge(0);
+  int hc = 8;
+  for (; 2 * hc + 16 < width; hc += 8) {
+    level0_texels8(row + 2 * hc, up ? up + 2 * hc : nullptr, down ? down + 2 * hc : nullptr, x + hc, y + hc, z + hc,
+                   curvature + hc);
+  }
+  if (hc < texels) edge(texels - 8);  // overlaps the last texels computed: same values
 }
 
 RELIGHT_AVX2 void coarse_row_avx2(Pyramid& p, int level, int r) {
