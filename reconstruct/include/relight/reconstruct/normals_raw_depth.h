@@ -12,8 +12,8 @@
 //     N = normals_from_positions with stride 4 (eq. 4.4–4.6, towards the camera);
 //     p' = T_prev_from_current · p, where T_prev_from_current = camera_to_world_prev⁻¹ ·
 //          camera_to_world_current maps current camera-frame points into the previous camera
-//          frame; (u', v') = nearest pixel of φ(p');
-//     level = round(curv(u', v') · (mip_levels − 1)) (flat: coarse, edges: fine);
+//          frame; (u', v') = nearest pixel of φ(p') (floor(x + 0.5) per coordinate);
+//     level = floor(curv(u', v') · (mip_levels − 1) + 0.5) (flat: coarse, edges: fine);
 //     N_p = R_current_from_prev · A_level(u', v');
 //     c_N = |N_p·N|, c = c_B·c_N + (1 − c_N)                                        (eq. 4.7–4.8)
 //     c = 0 when there is no previous frame, (u', v') is outside it, N_p is missing, or
@@ -21,10 +21,11 @@
 //     normal = normalize(c·N_p + (1 − c)·N).
 //   Holes (depth but no normal) get the normalised mean of their valid 4-neighbours.
 //
-// The CPU implementation computes positions, cross products and the blend in one pass over the
-// rows (the neighbours' positions are re-derived from depth), eight pixels at a time with AVX2
-// where the CPU has it (chosen at run time; the build stays baseline x86-64), and the scalar
-// loops otherwise. Both give bit-identical maps.
+// The CPU implementation resolves, in pass 1, the history normal N_p of every level-0 texel once
+// (level choice, fallback to level 0, rotation), then computes positions, cross products, the
+// blend and the hole filling in one pass over the rows (the neighbours' positions are re-derived
+// from depth), eight pixels at a time with AVX2 where the CPU has it (chosen at run time; the
+// build stays baseline x86-64), and the scalar loops otherwise. Both give bit-identical maps.
 //
 // Stage NormalsRawDepthCpuStage reads DepthMap "depth", FrameInfo "frame" (intrinsics,
 // camera_to_world: identity when absent), and the previous frame's NormalMap "normals",
