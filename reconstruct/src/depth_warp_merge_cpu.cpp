@@ -8,7 +8,7 @@
 #include <vector>
 
 #if defined(__SSE2__)
-#include <emmintrin.h>
+#include <immintrin.h>
 #endif
 
 #include "relight/core/parallel.h"
@@ -231,12 +231,69 @@ void rasterise(const WarpedVertex& a, const WarpedVertex& b, const WarpedVertex&
   if (set_up(a, b, c, width, height, options, t)) cover(a, b, c, t, width, target);
 }
 
+bool single_tile(const TriangleSetup& t) { return t.x1 - t.x0 <= 1 && t.y1 - t.y0 <= 1; }
+
+__attribute__((target("avx"))) __m256 halves(float low, float high) {
+  return _mm256_setr_ps(low, low, low, low, high, high, high, high);
+}
+
+// Both triangles of one cell whose bounding boxes are single 2×2 tiles (what a warp close to the
+// identity gives nearly everywhere): the upper triangle's tile in lanes 0–3, the lower one's in
+// lanes 4–7, each lane doing cover's operations. The z-tests then run upper before lower, as
+// in the scalar order. Only called where the CPU has AVX.
+__attribute__((target("avx"))) void cover_cell_avx(const WarpedVertex* upper, const TriangleSetup& tu,
+                                                   const WarpedVertex* lower, const TriangleSetup& tl, int width,
+                                                   ZBuffer& target) {
+  const WarpedVertex &ua = upper[0], &ub = upper[1], &uc = upper[2];
+  const WarpedVertex &la = lower[0], &lb = lower[1], &lc = lower[2];
+  const __m256 inclusive = _mm256_set1_ps(kInclusive);
+  const __m256 one = _mm256_set1_ps(1.f);
+  const __m256 inv_area = halves(tu.inv_area, tl.inv_area);
+  const __m256 bc_u = halves(uc.u - ub.u, lc.u - lb.u), bc_v = halves(uc.v - ub.v, lc.v - lb.v);
+  const __m256 ca_u = halves(ua.u - uc.u, la.u - lc.u), ca_v = halves(ua.v - uc.v, la.v - lc.v);
+  const __m256 b_u = halves(ub.u, lb.u), b_v = halves(ub.v, lb.v);
+  const __m256 c_u = halves(uc.u, lc.u), c_v = halves(uc.v, lc.v);
+  const __m256 a_z = halves(ua.z, la.z), b_z = halves(ub.z, lb.z), c_z = halves(uc.z, lc.z);
+  const __m256 px = _mm256_add_ps(halves(static_cast<float>(tu.x0), static_cast<float>(tl.x0)),
+                                  _mm256_setr_ps(0.f, 1.f, 0.f, 1.f, 0.f, 1.f, 0.f, 1.f));
+  const __m256 py = _mm256_add_ps(halves(static_cast<float>(tu.y0), static_cast<float>(tl.y0)),
+                                  _mm256_setr_ps(0.f, 0.f, 1.f, 1.f, 0.f, 0.f, 1.f, 1.f));
+  const __m256 w0 = _mm256_mul_ps(
+      _mm256_sub_ps(_mm256_mul_ps(bc_u, _mm256_sub_ps(py, b_v)), _mm256_mul_ps(bc_v, _mm256_sub_ps(px, b_u))), inv_area);
+  const __m256 w1 = _mm256_mul_ps(
+      _mm256_sub_ps(_mm256_mul_ps(ca_u, _mm256_sub_ps(py, c_v)), _mm256_mul_ps(ca_v, _mm256_sub_ps(px, c_u))), inv_area);
+  const __m256 w2 = _mm256_sub_ps(_mm256_sub_ps(one, w0), w1);
+  const __m256 outside = _mm256_or_ps(
+      _mm256_or_ps(_mm256_cmp_ps(w0, inclusive, _CMP_LT_OQ), _mm256_cmp_ps(w1, inclusive, _CMP_LT_OQ)),
+      _mm256_cmp_ps(w2, inclusive, _CMP_LT_OQ));
+  const auto box = [](const TriangleSetup& t) { return (t.y1 > t.y0 ? 0xF : 0x3) & (t.x1 > t.x0 ? 0xF : 0x5); };
+  int inside = ~_mm256_movemask_ps(outside) & (box(tu) | box(tl) << 4);
+  if (inside == 0) return;
+  alignas(32) float z[8];
+  _mm256_store_ps(z, _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(_mm256_div_ps(w0, a_z), _mm256_div_ps(w1, b_z)),
+                                                      _mm256_div_ps(w2, c_z))));
+  const std::size_t stride = static_cast<std::size_t>(width);
+  const std::size_t base[2] = {static_cast<std::size_t>(tu.y0) * stride + static_cast<std::size_t>(tu.x0),
+                               static_cast<std::size_t>(tl.y0) * stride + static_cast<std::size_t>(tl.x0)};
+  const float weight[2] = {tu.weight, tl.weight};
+  for (; inside != 0; inside &= inside - 1) {
+    const int lane = __builtin_ctz(static_cast<unsigned>(inside));
+    const std::size_t index =
+        base[lane >> 2] + static_cast<std::size_t>(lane & 1) + static_cast<std::size_t>(lane >> 1 & 1) * stride;
+    if (z[lane] < target.z[index]) {
+      target.z[index] = z[lane];
+      target.weight[index] = weight[lane >> 2];
+    }
+  }
+}
+
 // Both triangles of every cell between source rows `top` and `bottom`, in the scalar order
 // (cell by cell, upper-left triangle first), so that ties of the z-test resolve the same way.
 void rasterise_row(const WarpedVertex* top, const WarpedVertex* bottom, int width, int height,
                    const DepthWarpMergeOptions& options, ZBuffer& target) {
   int c = 0;
 #if defined(__SSE2__)
+  static const bool has_avx = __builtin_cpu_supports("avx");
   for (; c + 4 < width; c += 4) {
     const Lanes t0 = load_lanes(top + c), t1 = load_lanes(top + c + 1);
     const Lanes b0 = load_lanes(bottom + c), b1 = load_lanes(bottom + c + 1);
@@ -246,6 +303,15 @@ void rasterise_row(const WarpedVertex* top, const WarpedVertex* bottom, int widt
     if ((upper.accepted | upper.wild | lower.accepted | lower.wild) == 0) continue;
     for (int i = 0; i < 4; ++i) {
       const int x = c + i;
+      if (has_avx && (upper.accepted & lower.accepted) >> i & 1) {
+        const TriangleSetup tu = lane(upper, i), tl = lane(lower, i);
+        if (single_tile(tu) && single_tile(tl)) {
+          const WarpedVertex upper_vertices[3] = {top[x], top[x + 1], bottom[x]};
+          const WarpedVertex lower_vertices[3] = {top[x + 1], bottom[x + 1], bottom[x]};
+          cover_cell_avx(upper_vertices, tu, lower_vertices, tl, width, target);
+          continue;
+        }
+      }
       if (upper.wild >> i & 1) {
         rasterise(top[x], top[x + 1], bottom[x], width, height, options, target);
       } else if (upper.accepted >> i & 1) {
