@@ -2,7 +2,12 @@
 // normals_from_positions.h). Rows are split over threads; every pixel depends only on its inputs.
 #include "relight/reconstruct/normals_from_positions.h"
 
+#include <algorithm>
 #include <cmath>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "relight/core/parallel.h"
 
@@ -32,6 +37,74 @@ bool difference(const Float3* forward, const Float3* backward, const Float3& cen
   }
   return false;
 }
+
+#if defined(__SSE2__)
+struct Float3x4 {
+  __m128 x, y, z;
+};
+
+// Four consecutive Float3 (12 floats) as x, y and z lanes.
+Float3x4 load4(const Float3* p) {
+  static_assert(sizeof(Float3) == 3 * sizeof(float));
+  const float* f = &p->x;
+  const __m128 a = _mm_loadu_ps(f), b = _mm_loadu_ps(f + 4), c = _mm_loadu_ps(f + 8);
+  const __m128 x = _mm_shuffle_ps(a, _mm_shuffle_ps(b, c, _MM_SHUFFLE(1, 1, 2, 2)), _MM_SHUFFLE(2, 0, 3, 0));
+  const __m128 y = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(0, 0, 1, 1)),
+                                  _mm_shuffle_ps(b, c, _MM_SHUFFLE(2, 2, 3, 3)), _MM_SHUFFLE(2, 0, 2, 0));
+  const __m128 z = _mm_shuffle_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(1, 1, 2, 2)),
+                                  _mm_shuffle_ps(c, c, _MM_SHUFFLE(3, 3, 0, 0)), _MM_SHUFFLE(2, 0, 2, 0));
+  return {x, y, z};
+}
+
+__m128 pick(__m128 mask, __m128 if_set, __m128 if_clear) {
+  return _mm_or_ps(_mm_and_ps(mask, if_set), _mm_andnot_ps(mask, if_clear));
+}
+
+Float3x4 pick(__m128 mask, const Float3x4& if_set, const Float3x4& if_clear) {
+  return {pick(mask, if_set.x, if_clear.x), pick(mask, if_set.y, if_clear.y), pick(mask, if_set.z, if_clear.z)};
+}
+
+Float3x4 minus(const Float3x4& a, const Float3x4& b) {
+  return {_mm_sub_ps(a.x, b.x), _mm_sub_ps(a.y, b.y), _mm_sub_ps(a.z, b.z)};
+}
+
+__m128 continues4(const Float3x4& centre, const Float3x4& neighbour, __m128 max_jump_rel) {
+  const __m128 jump = _mm_andnot_ps(_mm_set1_ps(-0.f), _mm_sub_ps(neighbour.z, centre.z));
+  return _mm_and_ps(_mm_cmpgt_ps(neighbour.z, _mm_setzero_ps()), _mm_cmple_ps(jump, _mm_mul_ps(max_jump_rel, centre.z)));
+}
+
+// The scalar pixel's rules for columns c..c+3, all of which have both column neighbours; a row
+// neighbour that does not exist is passed as nullptr. Same operations in the same order, hence
+// the same bits.
+void normals_of_four(const Float3* row, const Float3* below, const Float3* above, int c, int s, float max_jump_rel,
+                     Float3* out) {
+  const __m128 jump_rel = _mm_set1_ps(max_jump_rel);
+  const __m128 none = _mm_setzero_ps();
+  const Float3x4 p = load4(row + c);
+  const Float3x4 right = load4(row + c + s), left = load4(row + c - s);
+  const __m128 right_ok = continues4(p, right, jump_rel), left_ok = continues4(p, left, jump_rel);
+  const Float3x4 d_col = pick(right_ok, minus(right, p), minus(p, left));
+  const Float3x4 down = load4(below ? below + c : row + c), up = load4(above ? above + c : row + c);
+  const __m128 down_ok = below ? continues4(p, down, jump_rel) : none;
+  const __m128 up_ok = above ? continues4(p, up, jump_rel) : none;
+  const Float3x4 d_row = pick(down_ok, minus(down, p), minus(p, up));
+  const Float3x4 n = {_mm_sub_ps(_mm_mul_ps(d_col.y, d_row.z), _mm_mul_ps(d_col.z, d_row.y)),
+                      _mm_sub_ps(_mm_mul_ps(d_col.z, d_row.x), _mm_mul_ps(d_col.x, d_row.z)),
+                      _mm_sub_ps(_mm_mul_ps(d_col.x, d_row.y), _mm_mul_ps(d_col.y, d_row.x))};
+  const __m128 len =
+      _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(n.x, n.x), _mm_mul_ps(n.y, n.y)), _mm_mul_ps(n.z, n.z)));
+  const __m128 facing_away = _mm_cmpgt_ps(
+      _mm_add_ps(_mm_add_ps(_mm_mul_ps(n.x, p.x), _mm_mul_ps(n.y, p.y)), _mm_mul_ps(n.z, p.z)), none);
+  const __m128 scale = _mm_div_ps(pick(facing_away, _mm_set1_ps(-1.f), _mm_set1_ps(1.f)), len);
+  const __m128 valid = _mm_and_ps(_mm_and_ps(_mm_cmpnle_ps(p.z, none), _mm_or_ps(right_ok, left_ok)),
+                                  _mm_and_ps(_mm_or_ps(down_ok, up_ok), _mm_cmpgt_ps(len, none)));
+  alignas(16) float x[4], y[4], z[4];
+  _mm_store_ps(x, _mm_and_ps(valid, _mm_mul_ps(scale, n.x)));
+  _mm_store_ps(y, _mm_and_ps(valid, _mm_mul_ps(scale, n.y)));
+  _mm_store_ps(z, _mm_and_ps(valid, _mm_mul_ps(scale, n.z)));
+  for (int i = 0; i < 4; ++i) out[c + i] = {x[i], y[i], z[i]};
+}
+#endif
 
 }  // namespace
 
@@ -68,24 +141,30 @@ void normals_from_positions(const PositionMap& positions, NormalMap& normals, co
       const Float3* below = r + s < height ? positions.row(r + s).data() : nullptr;
       const Float3* above = r - s >= 0 ? positions.row(r - s).data() : nullptr;
       Float3* out = normals.row(r).data();
-      for (int c = 0; c < width; ++c) {
+      const auto pixel = [&](int c) {
         const Float3& p = row[c];
         out[c] = {};
-        if (p.z <= 0.f) continue;
+        if (p.z <= 0.f) return;
         Float3 d_col, d_row;
         if (!difference(c + s < width ? &row[c + s] : nullptr, c - s >= 0 ? &row[c - s] : nullptr, p,
                         options.max_jump_rel, d_col)) {
-          continue;
+          return;
         }
         if (!difference(below ? &below[c] : nullptr, above ? &above[c] : nullptr, p, options.max_jump_rel, d_row)) {
-          continue;
+          return;
         }
         Float3 n = cross(d_col, d_row);
         const float len = length(n);
-        if (!(len > 0.f)) continue;
+        if (!(len > 0.f)) return;
         n = ((dot(n, p) > 0.f ? -1.f : 1.f) / len) * n;  // towards the camera
         out[c] = n;
-      }
+      };
+      int c = 0;
+      for (; c < std::min(s, width); ++c) pixel(c);
+#if defined(__SSE2__)
+      for (; c + 3 + s < width; c += 4) normals_of_four(row, below, above, c, s, options.max_jump_rel, out);
+#endif
+      for (; c < width; ++c) pixel(c);
     }
   });
 }
