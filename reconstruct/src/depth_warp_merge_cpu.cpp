@@ -333,6 +333,41 @@ void rasterise_row(const WarpedVertex* top, const WarpedVertex* bottom, int widt
 
 double axial_sigma(double z) { return 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4); }
 
+#if defined(__SSE2__)
+// merge_depth's rules for four pixels with history, as selects; every lane performs the scalar
+// operations in their order (σ_z in double precision, as axial_sigma), so the bits are the same.
+void merge_four(const float* depth, const float* warped, const float* warped_weight,
+                const DepthWarpMergeOptions& options, float* merged, float* merged_weight) {
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.f);
+  const __m128 d = _mm_loadu_ps(depth), d_w = _mm_loadu_ps(warped), w = _mm_loadu_ps(warped_weight);
+  const __m128 new_valid = _mm_and_ps(_mm_cmpgt_ps(d, zero), _mm_cmple_ps(d, _mm_set1_ps(3.4e38f)));
+  const __m128 old_valid = _mm_and_ps(_mm_cmpgt_ps(d_w, zero), _mm_cmpgt_ps(w, zero));
+  const auto sigma = [](__m128d z) {
+    const __m128d offset = _mm_sub_pd(z, _mm_set1_pd(0.4));
+    return _mm_add_pd(_mm_set1_pd(0.0012), _mm_mul_pd(_mm_mul_pd(_mm_set1_pd(0.0019), offset), offset));
+  };
+  const __m128 sigma_d = _mm_movelh_ps(_mm_cvtpd_ps(sigma(_mm_cvtps_pd(d))),
+                                       _mm_cvtpd_ps(sigma(_mm_cvtps_pd(_mm_movehl_ps(d, d)))));
+  const __m128 tau = _mm_add_ps(_mm_set1_ps(options.merge_threshold_m), _mm_mul_ps(_mm_set1_ps(3.f), sigma_d));
+  const __m128 close = _mm_cmple_ps(_mm_andnot_ps(_mm_set1_ps(-0.f), _mm_sub_ps(d, d_w)), tau);
+  const __m128 w_plus = _mm_add_ps(w, one);
+  const __m128 average = _mm_div_ps(_mm_add_ps(_mm_mul_ps(w, d_w), d), w_plus);
+  // _mm_min_ps(a, b) is "a < b ? a : b", std::min(a, b) is "b < a ? b : a".
+  const __m128 capped = _mm_min_ps(_mm_set1_ps(options.max_weight), w_plus);
+  const __m128 both = _mm_and_ps(new_valid, old_valid);
+  const __m128 fuse = _mm_and_ps(both, close);
+  const __m128 fade = _mm_andnot_ps(new_valid, _mm_and_ps(old_valid, _mm_cmpgt_ps(w, one)));
+  // Priority: fuse, then any new depth (weight 1), then the fading history.
+  __m128 out = _mm_and_ps(fade, d_w), out_weight = _mm_and_ps(fade, _mm_sub_ps(w, one));
+  out = _mm_or_ps(_mm_and_ps(new_valid, d), _mm_andnot_ps(new_valid, out));
+  out_weight = _mm_or_ps(_mm_and_ps(new_valid, one), _mm_andnot_ps(new_valid, out_weight));
+  out = _mm_or_ps(_mm_and_ps(fuse, average), _mm_andnot_ps(fuse, out));
+  out_weight = _mm_or_ps(_mm_and_ps(fuse, capped), _mm_andnot_ps(fuse, out_weight));
+  _mm_storeu_ps(merged, out);
+  _mm_storeu_ps(merged_weight, out_weight);
+}
+#endif
+
 }  // namespace
 
 void warp_depth(const DepthMap& previous_depth, const DepthWeightMap& previous_weight,
@@ -458,7 +493,16 @@ void merge_depth(const DepthMap& depth, const DepthMap& warped, const DepthWeigh
   const bool has_history = warped.same_shape(depth) && warped_weight.same_shape(depth);
   const std::size_t width = static_cast<std::size_t>(depth.width());
   parallel_rows(depth.height(), options.threads, [&](int begin, int end) {
-    for (std::size_t i = static_cast<std::size_t>(begin) * width; i < static_cast<std::size_t>(end) * width; ++i) {
+    std::size_t i = static_cast<std::size_t>(begin) * width;
+#if defined(__SSE2__)
+    if (has_history) {
+      for (; i + 4 <= static_cast<std::size_t>(end) * width; i += 4) {
+        merge_four(depth.pixels().data() + i, warped.pixels().data() + i, warped_weight.pixels().data() + i, options,
+                   merged.pixels().data() + i, merged_weight.pixels().data() + i);
+      }
+    }
+#endif
+    for (; i < static_cast<std::size_t>(end) * width; ++i) {
       const float d = depth.pixels()[i];
       const bool new_valid = d > 0.f && d <= 3.4e38f;
       const float d_w = has_history ? warped.pixels()[i] : 0.f;
