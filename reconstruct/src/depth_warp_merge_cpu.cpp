@@ -266,24 +266,32 @@ __attribute__((target("avx"))) void cover_cell_avx(const WarpedVertex* upper, co
   const __m256 outside = _mm256_or_ps(
       _mm256_or_ps(_mm256_cmp_ps(w0, inclusive, _CMP_LT_OQ), _mm256_cmp_ps(w1, inclusive, _CMP_LT_OQ)),
       _mm256_cmp_ps(w2, inclusive, _CMP_LT_OQ));
-  const auto box = [](const TriangleSetup& t) { return (t.y1 > t.y0 ? 0xF : 0x3) & (t.x1 > t.x0 ? 0xF : 0x5); };
-  int inside = ~_mm256_movemask_ps(outside) & (box(tu) | box(tl) << 4);
+  const __m256 in_box =
+      _mm256_and_ps(_mm256_cmp_ps(px, halves(static_cast<float>(tu.x1), static_cast<float>(tl.x1)), _CMP_LE_OQ),
+                    _mm256_cmp_ps(py, halves(static_cast<float>(tu.y1), static_cast<float>(tl.y1)), _CMP_LE_OQ));
+  const __m256 lane_inside = _mm256_andnot_ps(outside, in_box);
+  const int inside = _mm256_movemask_ps(lane_inside);
   if (inside == 0) return;
+  // Lanes outside test +inf against the upper tile's first pixel, which lies in its box: eight
+  // z-tests as selects, without the branches whose outcome noisy depth makes unpredictable.
   alignas(32) float z[8];
-  _mm256_store_ps(z, _mm256_div_ps(one, _mm256_add_ps(_mm256_add_ps(_mm256_div_ps(w0, a_z), _mm256_div_ps(w1, b_z)),
-                                                      _mm256_div_ps(w2, c_z))));
+  const __m256 z_inside = _mm256_div_ps(
+      one, _mm256_add_ps(_mm256_add_ps(_mm256_div_ps(w0, a_z), _mm256_div_ps(w1, b_z)), _mm256_div_ps(w2, c_z)));
+  _mm256_store_ps(z, _mm256_blendv_ps(_mm256_set1_ps(kFar), z_inside, lane_inside));
   const std::size_t stride = static_cast<std::size_t>(width);
   const std::size_t base[2] = {static_cast<std::size_t>(tu.y0) * stride + static_cast<std::size_t>(tu.x0),
                                static_cast<std::size_t>(tl.y0) * stride + static_cast<std::size_t>(tl.x0)};
   const float weight[2] = {tu.weight, tl.weight};
-  for (; inside != 0; inside &= inside - 1) {
-    const int lane = __builtin_ctz(static_cast<unsigned>(inside));
-    const std::size_t index =
-        base[lane >> 2] + static_cast<std::size_t>(lane & 1) + static_cast<std::size_t>(lane >> 1 & 1) * stride;
-    if (z[lane] < target.z[index]) {
-      target.z[index] = z[lane];
-      target.weight[index] = weight[lane >> 2];
-    }
+  for (int lane = 0; lane < 8; ++lane) {
+    const std::size_t index = (inside >> lane & 1) != 0 ? base[lane >> 2] + static_cast<std::size_t>(lane & 1) +
+                                                              static_cast<std::size_t>(lane >> 1 & 1) * stride
+                                                        : base[0];
+    const __m128 z_new = _mm_set_ss(z[lane]);
+    const __m128 z_old = _mm_load_ss(&target.z[index]);
+    const __m128 wins = _mm_cmplt_ss(z_new, z_old);
+    _mm_store_ss(&target.z[index], _mm_min_ss(z_new, z_old));  // z < old ? z : old
+    _mm_store_ss(&target.weight[index],
+                 _mm_blendv_ps(_mm_load_ss(&target.weight[index]), _mm_set_ss(weight[lane >> 2]), wins));
   }
 }
 
