@@ -241,11 +241,11 @@ __attribute__((target("avx"))) __m256 halves(float low, float high) {
 // identity gives nearly everywhere): the upper triangle's tile in lanes 0–3, the lower one's in
 // lanes 4–7, each lane doing cover's operations. The z-tests then run upper before lower, as
 // in the scalar order. Only called where the CPU has AVX.
-__attribute__((target("avx"))) void cover_cell_avx(const WarpedVertex* upper, const TriangleSetup& tu,
-                                                   const WarpedVertex* lower, const TriangleSetup& tl, int width,
+__attribute__((target("avx"))) void cover_cell_avx(const WarpedVertex* top, const WarpedVertex* bottom,
+                                                   const TriangleSetup& tu, const TriangleSetup& tl, int width,
                                                    ZBuffer& target) {
-  const WarpedVertex &ua = upper[0], &ub = upper[1], &uc = upper[2];
-  const WarpedVertex &la = lower[0], &lb = lower[1], &lc = lower[2];
+  const WarpedVertex &ua = top[0], &ub = top[1], &uc = bottom[0];  // the cell's triangles, as rasterise_row
+  const WarpedVertex &la = top[1], &lb = bottom[1], &lc = bottom[0];
   const __m256 inclusive = _mm256_set1_ps(kInclusive);
   const __m256 one = _mm256_set1_ps(1.f);
   const __m256 inv_area = halves(tu.inv_area, tl.inv_area);
@@ -314,9 +314,7 @@ void rasterise_row(const WarpedVertex* top, const WarpedVertex* bottom, int widt
       if (has_avx && (upper.accepted & lower.accepted) >> i & 1) {
         const TriangleSetup tu = lane(upper, i), tl = lane(lower, i);
         if (single_tile(tu) && single_tile(tl)) {
-          const WarpedVertex upper_vertices[3] = {top[x], top[x + 1], bottom[x]};
-          const WarpedVertex lower_vertices[3] = {top[x + 1], bottom[x + 1], bottom[x]};
-          cover_cell_avx(upper_vertices, tu, lower_vertices, tl, width, target);
+          cover_cell_avx(top + x, bottom + x, tu, tl, width, target);
           continue;
         }
       }
