@@ -231,6 +231,7 @@ void rasterise(const WarpedVertex& a, const WarpedVertex& b, const WarpedVertex&
   if (set_up(a, b, c, width, height, options, t)) cover(a, b, c, t, width, target);
 }
 
+#if defined(__SSE2__)
 bool single_tile(const TriangleSetup& t) { return t.x1 - t.x0 <= 1 && t.y1 - t.y0 <= 1; }
 
 __attribute__((target("avx"))) __m256 halves(float low, float high) {
@@ -294,6 +295,8 @@ __attribute__((target("avx"))) void cover_cell_avx(const WarpedVertex* top, cons
                  _mm_blendv_ps(_mm_load_ss(&target.weight[index]), _mm_set_ss(weight[lane >> 2]), wins));
   }
 }
+
+#endif
 
 // Both triangles of every cell between source rows `top` and `bottom`, in the scalar order
 // (cell by cell, upper-left triangle first), so that ties of the z-test resolve the same way.
