@@ -159,7 +159,7 @@ TEST_F(TemporalSmoothingStageTest, CutsTheFlickerOfIndirectLightOnNoisyDepth) {
       // The geometry the dissertation renders with (§4.3.3, filtered depth). Measured: 75 % less.
       EXPECT_LT(with, 0.5 * without) << to_string(geometry);
     } else {
-      // Measured 44 % (exact normals) and 41 % (method 1) less: on raw depth the Kinect-like noise
+      // Measured 44 % (exact normals) and 40 % (method 1) less: on raw depth the Kinect-like noise
       // (sigma ~ 0.0015 z^2) alone gives eps_pos ~ 0.3-0.4 with the paper's w_p, so the
       // confidence stays near 0.55 instead of c_B = 0.9.
       EXPECT_LT(with, 0.7 * without) << to_string(geometry);

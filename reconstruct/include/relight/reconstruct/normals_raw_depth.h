@@ -47,7 +47,7 @@ struct NormalsRawDepthOptions {
   int stride = 4;                 ///< pixel distance of the cross-product differences (eq. 4.4–4.5)
   float blend_base = 0.9f;        ///< c_B of eq. 4.8
   float disocclusion_m = 0.1f;    ///< depth change that resets the history
-  int mip_levels = 4;             ///< half, quarter, eighth and sixteenth resolution
+  int mip_levels = 2;             ///< half and quarter resolution
   float max_jump_rel = 0.05f;     ///< discontinuity test of the cross products (relative to z)
   int threads = 0;                ///< 0 = all cores
   bool simd = true;               ///< AVX2 loops where available; false: the scalar loops (same maps)
