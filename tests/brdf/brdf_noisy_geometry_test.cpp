@@ -18,7 +18,8 @@
 //     24-51 % low at 1 degree, k_s 7-27 % and 58-76 % low). n within 20 % needs the sphere's
 //     normals within a quarter to half a degree, k_s within 10 % even better ones;
 //   - method 1's normals on the sphere are ~7 degrees off (mean, after ten frames; ~9 with a
-//     mip chain of four levels instead of the default two), and they are on exact depth too: the stride-4 forward differences give the normal of the point
+//     mip chain of four levels instead of the default two), and they are on exact depth too:
+//     the stride-4 forward differences give the normal of the point
 //     (2, 2) pixels away, ~9 degrees on a sphere of 27 pixels radius, and the history lookup
 //     (nearest coarse texel) keeps blurring the curved normal field, so that the error grew
 //     with the frame count (9 -> 30 degrees over 60 frames of exact depth when measured).
