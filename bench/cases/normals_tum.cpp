@@ -8,7 +8,6 @@
 // depth, normals from it) run over the same frames; "ms" is method 1's median time per frame.
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -20,16 +19,12 @@
 #include "relight/reconstruct/depth_warp_merge.h"
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
+#include "replay.h"
 
 namespace {
 
 using namespace relight;
 using relight::bench::Json;
-
-std::filesystem::path data_folder() {
-  if (const char* env = std::getenv("RELIGHT_DATA"); env && *env) return env;
-  return RELIGHT_BENCH_DATA_DIR;
-}
 
 struct Frame {
   DepthMap depth;
@@ -71,7 +66,7 @@ void add_change(const Frame& before, const NormalMap& normals_before, const Fram
 }
 
 Json tum_stability(const bench::Options& options) {
-  const std::filesystem::path folder = data_folder() / "tum_fr1_rpy";
+  const std::filesystem::path folder = app::default_sequence();  // data/tum_fr1_rpy, or under $RELIGHT_DATA
   const TumSequence sequence = TumSequence::open(folder);
   const PinholeIntrinsics& k = sequence.intrinsics();
   std::vector<Frame> frames;
