@@ -2,7 +2,6 @@
 #include "relight/brdf/specular_objective_vk.h"
 
 #include <algorithm>
-#include <cmath>
 #include <string>
 
 #include "relight/brdf/specular_shared.h"
@@ -14,6 +13,7 @@
 #include "relight/vk/context.h"
 #include "relight/vk/timer.h"
 #include "specular_model.h"
+#include "specular_terms.h"
 
 namespace relight::brdf {
 
@@ -114,16 +114,12 @@ std::vector<double> SpecularObjectiveVk::evaluate(const SpecularProblem& problem
 }
 
 std::vector<SpecularCandidate> specular_start_grid(const SpecularOptions& options, int exponents, int strengths) {
-  exponents = std::max(2, exponents);
   strengths = std::max(2, strengths);
-  const double low = std::log(static_cast<double>(options.n_min)), high = std::log(static_cast<double>(options.n_max));
   std::vector<SpecularCandidate> grid;
-  grid.reserve(static_cast<std::size_t>(exponents * strengths));
-  for (int e = 0; e < exponents; ++e) {
-    const auto n = static_cast<float>(std::exp(low + (high - low) * e / (exponents - 1)));
+  for (const double n : detail::log_spaced_exponents(options, exponents)) {
     for (int s = 0; s < strengths; ++s) {
       SpecularCandidate c;
-      c.n = n;
+      c.n = static_cast<float>(n);
       c.ks = options.ks_max * static_cast<float>(s) / static_cast<float>(strengths - 1);
       grid.push_back(c);
     }

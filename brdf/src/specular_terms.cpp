@@ -176,17 +176,29 @@ ShadingLights moved_lights(const ShadingLights& ordered, int moving, const doubl
   return moved;
 }
 
-StartShape start_shape_spacing(const SpecularOptions& options) {
-  const int count = std::max(2, options.start_exponents);
+namespace {
+
+double log_n_spacing(const SpecularOptions& options, int count) {
   const double low = std::log(static_cast<double>(options.n_min)), high = std::log(static_cast<double>(options.n_max));
+  return (high - low) / (std::max(2, count) - 1);
+}
+
+}  // namespace
+
+std::vector<double> log_spaced_exponents(const SpecularOptions& options, int count) {
+  const double low = std::log(static_cast<double>(options.n_min)), spacing = log_n_spacing(options, count);
+  std::vector<double> exponents(static_cast<std::size_t>(std::max(2, count)));
+  for (std::size_t k = 0; k < exponents.size(); ++k) exponents[k] = std::exp(low + static_cast<double>(k) * spacing);
+  return exponents;
+}
+
+StartShape start_shape_spacing(const SpecularOptions& options) {
   StartShape start;
-  start.log_n_spacing = (high - low) / (count - 1);
+  start.log_n_spacing = log_n_spacing(options, options.start_exponents);
   return start;
 }
 
 StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options) {
-  const int count = std::max(2, options.start_exponents);
-  const double low = std::log(static_cast<double>(options.n_min));
   StartShape best = start_shape_spacing(options);
   if (options.start) {
     best.ks = std::clamp(static_cast<double>(options.start->ks), 0.0, static_cast<double>(options.ks_max));
@@ -195,8 +207,8 @@ StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options) 
     return best;
   }
   double best_f = std::numeric_limits<double>::infinity();
-  for (int k = 0; k < count; ++k) {
-    const double n = std::exp(low + k * best.log_n_spacing);
+  const std::vector<double> exponents = log_spaced_exponents(options, options.start_exponents);
+  for (const double n : exponents) {
     const ShapeTerms::Projected p = terms.best_ks(n, options.ks_max);
     if (p.objective < best_f) {
       best_f = p.objective;
@@ -204,7 +216,7 @@ StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options) 
       best.n = n;
     }
   }
-  best.evaluations = count;
+  best.evaluations = static_cast<int>(exponents.size());
   return best;
 }
 

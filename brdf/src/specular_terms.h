@@ -80,6 +80,9 @@ struct StartShape {
   int evaluations = 0;
 };
 [[nodiscard]] StartShape start_shape(const ShapeTerms& terms, const SpecularOptions& options);
+/// `count` (at least 2) exponents spaced evenly in log n over [n_min, n_max]: the grid of
+/// start_shape() (count = options.start_exponents) and of the GPU start (specular_start_grid()).
+[[nodiscard]] std::vector<double> log_spaced_exponents(const SpecularOptions& options, int count);
 /// Only the grid's log n spacing (no evaluations).
 [[nodiscard]] StartShape start_shape_spacing(const SpecularOptions& options);
 
