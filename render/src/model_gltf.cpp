@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <sstream>
 
 #include "relight/core/atomic_file.h"
@@ -216,18 +217,36 @@ std::string first_line(std::string text) {
   return text;
 }
 
+// Textures are not used (materials are Phong constants), so images are neither decoded nor
+// checked: a broken or hostile image cannot fail or slow down loading the geometry.
+bool skip_image(tinygltf::Image*, int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+tinygltf::Model read_gltf(const std::filesystem::path& path, bool binary) {
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skip_image, nullptr);
+  tinygltf::Model gltf;
+  std::string error, warning;
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromFile(&gltf, &error, &warning, path.string())
+                : loader.LoadASCIIFromFile(&gltf, &error, &warning, path.string());
+  } catch (const std::exception& e) {
+    // tinygltf 2.7 indexes with vector::at() in places where it does not check sizes first
+    // (a GLB buffer of byteLength 0, an empty embedded image): a malformed file, not a bug here.
+    error = e.what();
+  }
+  if (!ok) throw Error(path.string() + ": cannot read glTF: " + (error.empty() ? "unknown error" : first_line(error)));
+  return gltf;
+}
+
 }  // namespace
 
 VirtualModel load_gltf(const std::filesystem::path& path) {
-  tinygltf::TinyGLTF loader;
-  tinygltf::Model gltf;
-  std::string error, warning;
   std::string extension = path.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
-  const bool binary = extension == ".glb";
-  const bool ok = binary ? loader.LoadBinaryFromFile(&gltf, &error, &warning, path.string())
-                         : loader.LoadASCIIFromFile(&gltf, &error, &warning, path.string());
-  if (!ok) throw Error(path.string() + ": cannot read glTF: " + (error.empty() ? "unknown error" : first_line(error)));
+  const tinygltf::Model gltf = read_gltf(path, extension == ".glb");
   VirtualModel model;
   model.name = path.stem().string();
   for (const tinygltf::Material& m : gltf.materials) model.materials.push_back(from_gltf(m));

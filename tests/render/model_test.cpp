@@ -27,6 +27,18 @@ void expect_same_geometry(const VirtualModel& a, const VirtualModel& b, float to
   }
 }
 
+// A binary glTF container: 12-byte header, JSON chunk (padded with spaces), BIN chunk.
+std::string glb(std::string json, const std::string& bin) {
+  while (json.size() % 4 != 0) json += ' ';
+  const auto u32 = [](std::size_t v) {
+    std::string bytes(4, '\0');
+    for (int i = 0; i < 4; ++i) bytes[static_cast<std::size_t>(i)] = static_cast<char>((v >> (8 * i)) & 0xffu);
+    return bytes;
+  };
+  const std::string body = u32(json.size()) + "JSON" + json + u32(bin.size()) + std::string("BIN\0", 4) + bin;
+  return "glTF" + u32(2) + u32(12 + body.size()) + body;
+}
+
 void expect_same_material(const PhongMaterial& a, const PhongMaterial& b) {
   EXPECT_TRUE(a.kd.isApprox(b.kd, 1e-5f)) << a.name;
   EXPECT_NEAR(a.ks, b.ks, 1e-5f);
@@ -114,6 +126,10 @@ TEST(ModelIo, BadFilesGiveOneLineErrorsNamingTheFile) {
   text.replace(count, 11, "\"count\": 99999");
   std::ofstream(dir.path() / "truncated.gltf") << text;
   expect_error(dir.path() / "truncated.gltf");
+  // A GLB whose buffer is empty: tinygltf 2.7 throws std::out_of_range on it (found by fuzzing).
+  std::ofstream(dir.path() / "empty_buffer.glb", std::ios::binary)
+      << glb(R"({"asset":{"version":"2.0"},"buffers":[{"byteLength":0}]})", std::string(4, '\0'));
+  expect_error(dir.path() / "empty_buffer.glb");
 }
 
 TEST(Placement, ParsesAndTurnsYUpIntoZUp) {
