@@ -34,22 +34,25 @@ bool continues(vec3 centre, vec3 neighbour) {
   return neighbour.z > 0.0 && abs(neighbour.z - centre.z) <= params.max_jump_rel * centre.z;
 }
 
-// Difference along one axis: forward if possible, else backward (keeps normals at object
-// borders); false when neither neighbour continues the surface.
+// Difference along one axis: central (params.centred) if both sides continue, else forward if
+// possible, else backward (keeps normals at object borders); false when neither neighbour
+// continues the surface.
 bool difference(ivec2 forward, bool has_forward, ivec2 backward, bool has_backward, vec3 centre, out vec3 d) {
-  if (has_forward) {
-    const vec3 f = position(forward.y, forward.x);
-    if (continues(centre, f)) {
-      d = f - centre;
-      return true;
-    }
+  const vec3 f = has_forward ? position(forward.y, forward.x) : vec3(0.0);
+  const vec3 b = has_backward ? position(backward.y, backward.x) : vec3(0.0);
+  const bool forward_ok = has_forward && continues(centre, f);
+  const bool backward_ok = has_backward && continues(centre, b);
+  if (forward_ok && backward_ok && params.centred != 0u) {
+    d = f - b;
+    return true;
   }
-  if (has_backward) {
-    const vec3 b = position(backward.y, backward.x);
-    if (continues(centre, b)) {
-      d = centre - b;
-      return true;
-    }
+  if (forward_ok) {
+    d = f - centre;
+    return true;
+  }
+  if (backward_ok) {
+    d = centre - b;
+    return true;
   }
   d = vec3(0.0);
   return false;

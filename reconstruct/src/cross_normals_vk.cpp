@@ -53,7 +53,8 @@ std::optional<double> CrossNormalsVk::run(const vk::VulkanBuffer& depth, vk::Vul
                                        static_cast<float>(1.0 / intrinsics.fx),
                                        static_cast<float>(1.0 / intrinsics.fy),
                                        static_cast<float>(intrinsics.cx),
-                                       static_cast<float>(intrinsics.cy)};
+                                       static_cast<float>(intrinsics.cy),
+                                       options.centred ? 1u : 0u};
   constexpr std::uint32_t local = RELIGHT_CROSS_NORMALS_LOCAL_SIZE;
   const auto set = pipeline_->compute.bind({&depth, &positions, &normals});
   context_.submit([&](VkCommandBuffer cmd) {

@@ -24,14 +24,21 @@ bool continues(const Float3& centre, const Float3& neighbour, float max_jump_rel
   return neighbour.z > 0.f && std::fabs(neighbour.z - centre.z) <= max_jump_rel * centre.z;
 }
 
-// Difference vector along one axis: forward if possible, else backward; false when neither exists.
-bool difference(const Float3* forward, const Float3* backward, const Float3& centre, float max_jump_rel,
+// Difference vector along one axis: central (when asked for) if both sides continue, else forward
+// if possible, else backward; false when neither exists.
+bool difference(const Float3* forward, const Float3* backward, const Float3& centre, float max_jump_rel, bool centred,
                 Float3& out) {
-  if (forward && continues(centre, *forward, max_jump_rel)) {
+  const bool forward_ok = forward && continues(centre, *forward, max_jump_rel);
+  const bool backward_ok = backward && continues(centre, *backward, max_jump_rel);
+  if (forward_ok && backward_ok && centred) {
+    out = *forward - *backward;
+    return true;
+  }
+  if (forward_ok) {
     out = *forward - centre;
     return true;
   }
-  if (backward && continues(centre, *backward, max_jump_rel)) {
+  if (backward_ok) {
     out = centre - *backward;
     return true;
   }
@@ -77,17 +84,20 @@ __m128 continues4(const Float3x4& centre, const Float3x4& neighbour, __m128 max_
 // neighbour that does not exist is passed as nullptr. Same operations in the same order, hence
 // the same bits.
 void normals_of_four(const Float3* row, const Float3* below, const Float3* above, int c, int s, float max_jump_rel,
-                     Float3* out) {
+                     bool centred, Float3* out) {
   const __m128 jump_rel = _mm_set1_ps(max_jump_rel);
   const __m128 none = _mm_setzero_ps();
   const Float3x4 p = load4(row + c);
   const Float3x4 right = load4(row + c + s), left = load4(row + c - s);
   const __m128 right_ok = continues4(p, right, jump_rel), left_ok = continues4(p, left, jump_rel);
-  const Float3x4 d_col = pick(right_ok, minus(right, p), minus(p, left));
+  const __m128 centred_mask = _mm_castsi128_ps(_mm_set1_epi32(centred ? -1 : 0));
+  const __m128 col_both = _mm_and_ps(centred_mask, _mm_and_ps(right_ok, left_ok));
+  const Float3x4 d_col = pick(col_both, minus(right, left), pick(right_ok, minus(right, p), minus(p, left)));
   const Float3x4 down = load4(below ? below + c : row + c), up = load4(above ? above + c : row + c);
   const __m128 down_ok = below ? continues4(p, down, jump_rel) : none;
   const __m128 up_ok = above ? continues4(p, up, jump_rel) : none;
-  const Float3x4 d_row = pick(down_ok, minus(down, p), minus(p, up));
+  const __m128 row_both = _mm_and_ps(centred_mask, _mm_and_ps(down_ok, up_ok));
+  const Float3x4 d_row = pick(row_both, minus(down, up), pick(down_ok, minus(down, p), minus(p, up)));
   const Float3x4 n = {_mm_sub_ps(_mm_mul_ps(d_col.y, d_row.z), _mm_mul_ps(d_col.z, d_row.y)),
                       _mm_sub_ps(_mm_mul_ps(d_col.z, d_row.x), _mm_mul_ps(d_col.x, d_row.z)),
                       _mm_sub_ps(_mm_mul_ps(d_col.x, d_row.y), _mm_mul_ps(d_col.y, d_row.x))};
@@ -147,10 +157,11 @@ void normals_from_positions(const PositionMap& positions, NormalMap& normals, co
         if (p.z <= 0.f) return;
         Float3 d_col, d_row;
         if (!difference(c + s < width ? &row[c + s] : nullptr, c - s >= 0 ? &row[c - s] : nullptr, p,
-                        options.max_jump_rel, d_col)) {
+                        options.max_jump_rel, options.centred, d_col)) {
           return;
         }
-        if (!difference(below ? &below[c] : nullptr, above ? &above[c] : nullptr, p, options.max_jump_rel, d_row)) {
+        if (!difference(below ? &below[c] : nullptr, above ? &above[c] : nullptr, p, options.max_jump_rel,
+                        options.centred, d_row)) {
           return;
         }
         Float3 n = cross(d_col, d_row);
@@ -162,7 +173,7 @@ void normals_from_positions(const PositionMap& positions, NormalMap& normals, co
       int c = 0;
       for (; c < std::min(s, width); ++c) pixel(c);
 #if defined(__SSE2__)
-      for (; c + 3 + s < width; c += 4) normals_of_four(row, below, above, c, s, options.max_jump_rel, out);
+      for (; c + 3 + s < width; c += 4) normals_of_four(row, below, above, c, s, options.max_jump_rel, options.centred, out);
 #endif
       for (; c < width; ++c) pixel(c);
     }

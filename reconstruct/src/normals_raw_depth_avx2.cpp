@@ -147,20 +147,24 @@ RELIGHT_AVX2 inline __m256 valid_depth(__m256 z) { return _mm256_and_ps(both(gt(
 RELIGHT_AVX2 inline V3 position8(__m256 x_scale, __m256 y_scale, __m256 z) { return {x_scale * z, y_scale * z, z}; }
 
 /// axis_difference for eight pixels.
-RELIGHT_AVX2 inline V3 axis_difference8(const V3& p, const V3& forward, const V3& backward, __m256 limit) {
+RELIGHT_AVX2 inline V3 axis_difference8(const V3& p, const V3& forward, const V3& backward, __m256 limit,
+                                        __m256 centred) {
   const __m256 zero = _mm256_setzero_ps();
   const __m256 use_forward = both(gt(forward.z, zero), le(abs8(forward.z - p.z), limit));
   const __m256 use_backward = both(gt(backward.z, zero), le(abs8(backward.z - p.z), limit));
-  return select(use_forward, V3{forward.x - p.x, forward.y - p.y, forward.z - p.z},
-                keep(use_backward, V3{p.x - backward.x, p.y - backward.y, p.z - backward.z}));
+  const V3 one_sided = select(use_forward, V3{forward.x - p.x, forward.y - p.y, forward.z - p.z},
+                              keep(use_backward, V3{p.x - backward.x, p.y - backward.y, p.z - backward.z}));
+  return select(both(centred, both(use_forward, use_backward)),
+                V3{forward.x - backward.x, forward.y - backward.y, forward.z - backward.z}, one_sided);
 }
 
 /// fresh_normal for eight pixels.
 RELIGHT_AVX2 inline V3 fresh_normal8(const V3& p, const V3& right, const V3& left, const V3& below, const V3& above,
-                                     float max_jump_rel) {
+                                     float max_jump_rel, bool centred) {
   const __m256 limit = splat(max_jump_rel) * p.z;
-  const V3 a = axis_difference8(p, right, left, limit);
-  const V3 b = axis_difference8(p, below, above, limit);
+  const __m256 centred_mask = _mm256_castsi256_ps(_mm256_set1_epi32(centred ? -1 : 0));
+  const V3 a = axis_difference8(p, right, left, limit, centred_mask);
+  const V3 b = axis_difference8(p, below, above, limit, centred_mask);
   const V3 n{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
   const __m256 len = _mm256_sqrt_ps(dot3(n, n));
   const __m256 sign = select(gt(dot3(n, p), _mm256_setzero_ps()), splat(-1.f), splat(1.f));
@@ -277,15 +281,20 @@ bool avx2_available() {
   return available;
 }
 
-/// Level-0 texels hc … hc+7 of one row. `p` is the centre pixel of texel hc; the texels read
-/// pixels p − 1 … p + 15 (and one float of p + 16) of their row and p … p + 14 (and one float of
-/// p + 15) of the rows above and below (null: outside the image).
-RELIGHT_AVX2 inline void level0_texels8(const Float3* p, const Float3* above_p, const Float3* below_p, float* x,
-                                        float* y, float* z, float* curvature) {
-  const V3 centre = load_stride2(p), left = load_stride2(p - 1), right = load_stride2(p + 1);
-  const V3 above = above_p ? load_stride2(above_p) : zero3();
-  const V3 below = below_p ? load_stride2(below_p) : zero3();
-  const V3 n = normalized_or_zero(plus(plus(plus(plus(centre, above), below), left), right));
+/// Level-0 texels hc … hc+7 of one row (level0_texel). `rows[1]` points at the top-left pixel
+/// of texel hc's 2x2 block, rows[0], rows[2] and rows[3] at the same column one row above, one
+/// and two rows below (null: outside the image). Reads pixels −1 … +17 of rows[1] and rows[2]
+/// (one float of +17) and 0 … +16 of rows[0] and rows[3] (one float of +16).
+RELIGHT_AVX2 inline void level0_texels8(const Float3* const rows[4], float* x, float* y, float* z, float* curvature) {
+  const auto at = [&](int row, int offset) RELIGHT_AVX2 { return rows[row] ? load_stride2(rows[row] + offset) : zero3(); };
+  const V3 centre = at(1, 0), left = at(1, -1), right = at(1, 1), above = at(0, 0), below = at(2, 0);
+  const V3 below_right = at(2, 1);
+  // cross_sum of level0_texel at the block's four pixels, in its order of additions.
+  const V3 top_left = plus(plus(plus(plus(centre, above), below), left), right);
+  const V3 top_right = plus(plus(plus(plus(right, at(0, 1)), below_right), centre), at(1, 2));
+  const V3 bottom_left = plus(plus(plus(plus(below, centre), at(3, 0)), at(2, -1)), below_right);
+  const V3 bottom_right = plus(plus(plus(plus(below_right, right), at(3, 1)), below), at(2, 2));
+  const V3 n = normalized_or_zero(plus(plus(plus(top_left, top_right), bottom_left), bottom_right));
   const __m256 pairs = both(both(valid_normal(left), valid_normal(right)), both(valid_normal(above), valid_normal(below)));
   // std::min(a, b) is b < a ? b : a, which is _mm256_min_ps(b, a).
   const __m256 curv = _mm256_and_ps(pairs, _mm256_min_ps(dot3(above, below), dot3(left, right)));
@@ -298,8 +307,8 @@ RELIGHT_AVX2 inline void level0_texels8(const Float3* p, const Float3* above_p, 
 RELIGHT_AVX2 void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out, int out_row) {
   const int r = 2 * hr;
   const Float3* row = previous + static_cast<std::ptrdiff_t>(r) * width;
-  const Float3* up = r >= 1 ? row - width : nullptr;
-  const Float3* down = r + 1 < height ? row + width : nullptr;
+  const Float3* const image_rows[4] = {r >= 1 ? row - width : nullptr, row, r + 1 < height ? row + width : nullptr,
+                                       r + 2 < height ? row + 2 * width : nullptr};
   const int texels = out.levels[0].width;
   const std::ptrdiff_t o = static_cast<std::ptrdiff_t>(out_row) * texels;
   float* x = out.x.data() + o;
@@ -313,22 +322,24 @@ RELIGHT_AVX2 void level0_row_avx2(const Float3* previous, int width, int height,
   // At the image's left and right edges: the same loop on a copy of the pixels read, with zeros
   // where they fall outside the image (as level0_texel reads them).
   const auto edge = [&](int hc) RELIGHT_AVX2 {
-    Float3 pixels[3][18] = {};
-    for (int j = 0; j < 18; ++j) {
-      const int c = 2 * hc - 1 + j;
-      if (c < 0 || c >= width) continue;
-      if (up) pixels[0][j] = up[c];
-      pixels[1][j] = row[c];
-      if (down) pixels[2][j] = down[c];
+    Float3 pixels[4][20] = {};
+    const Float3* rows[4] = {};
+    for (int i = 0; i < 4; ++i) {
+      if (!image_rows[i]) continue;
+      for (int j = 0; j < 20; ++j) {
+        const int c = 2 * hc - 1 + j;
+        if (c >= 0 && c < width) pixels[i][j] = image_rows[i][c];
+      }
+      rows[i] = &pixels[i][1];
     }
-    level0_texels8(&pixels[1][1], up ? &pixels[0][1] : nullptr, down ? &pixels[2][1] : nullptr, x + hc, y + hc,
-                   z + hc, curvature + hc);
+    level0_texels8(rows, x + hc, y + hc, z + hc, curvature + hc);
   };
   edge(0);
   int hc = 8;
-  for (; 2 * hc + 16 < width; hc += 8) {
-    level0_texels8(row + 2 * hc, up ? up + 2 * hc : nullptr, down ? down + 2 * hc : nullptr, x + hc, y + hc, z + hc,
-                   curvature + hc);
+  for (; 2 * hc + 17 < width; hc += 8) {
+    const Float3* rows[4];
+    for (int i = 0; i < 4; ++i) rows[i] = image_rows[i] ? image_rows[i] + 2 * hc : nullptr;
+    level0_texels8(rows, x + hc, y + hc, z + hc, curvature + hc);
   }
   if (hc < texels) edge(texels - 8);  // overlaps the last texels computed: same values
 }
@@ -435,7 +446,7 @@ RELIGHT_AVX2 void pass2_row_avx2(const Pass2& in, int r) {
         const V3 below = below_row ? position8(xs, ys_below, valid_depth(_mm256_loadu_ps(below_row + c))) : zero3();
         const V3 above = above_row ? position8(xs, ys_above, valid_depth(_mm256_loadu_ps(above_row + c))) : zero3();
         store_aos8(in.positions_out + row_start + c, b.p);
-        b.n = fresh_normal8(b.p, right, left, below, above, k.max_jump_rel);
+        b.n = fresh_normal8(b.p, right, left, below, above, k.max_jump_rel, k.centred);
       } else {
         b.p = load_aos8(in.positions_in + row_start + c);
         b.n = load_aos8(in.normals + row_start + c);

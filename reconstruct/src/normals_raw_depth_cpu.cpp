@@ -149,6 +149,17 @@ void build_history(const NormalMap& previous, const method1::Constants& k, int l
       1);
 }
 
+}  // namespace
+
+CrossNormalOptions cross_normal_options(const NormalsRawDepthOptions& options) {
+  return {.stride = options.stride,
+          .max_jump_rel = options.max_jump_rel,
+          .centred = options.centred_differences,
+          .threads = options.threads};
+}
+
+namespace {
+
 method1::Constants frame_constants(const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
                                    const NormalsHistory* previous, const NormalsRawDepthOptions& options, int width,
                                    int height) {
@@ -163,6 +174,7 @@ method1::Constants frame_constants(const PinholeIntrinsics& intrinsics, const Po
   k.fx = static_cast<float>(intrinsics.fx);
   k.fy = static_cast<float>(intrinsics.fy);
   k.max_jump_rel = options.max_jump_rel;
+  k.centred = options.centred_differences;
   k.blend_base = options.blend_base;
   k.disocclusion_m = options.disocclusion_m;
   if (previous) {

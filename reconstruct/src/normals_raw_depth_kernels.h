@@ -23,6 +23,7 @@ struct Constants {
   float inv_fx = 0, inv_fy = 0, cx = 0, cy = 0;  ///< back-projection, as positions_from_depth
   float fx = 0, fy = 0;                          ///< projection into the previous frame
   float max_jump_rel = 0.05f;
+  bool centred = true;  ///< central differences where both sides continue
   float prev_from_current[12] = {};  ///< row-major 3x4 rigid transform
   float current_from_prev[9] = {};   ///< row-major 3x3 rotation
   float blend_base = 0.9f, disocclusion_m = 0.1f;
@@ -105,7 +106,11 @@ inline void level0_texel(const Float3* previous, int width, int height, int hr, 
                : Float3{};
   };
   const Float3 up = at(r - 1, c), down = at(r + 1, c), left = at(r, c - 1), right = at(r, c + 1);
-  const Float3 n = normalized_or_zero(at(r, c) + up + down + left + right);  // missing ones are 0
+  const auto cross_sum = [&](int row, int col) {  // missing ones are 0
+    return at(row, col) + at(row - 1, col) + at(row + 1, col) + at(row, col - 1) + at(row, col + 1);
+  };
+  const Float3 n =
+      normalized_or_zero(cross_sum(r, c) + cross_sum(r, c + 1) + cross_sum(r + 1, c) + cross_sum(r + 1, c + 1));
   const bool horizontal = is_valid_normal(left) && is_valid_normal(right);
   const bool vertical = is_valid_normal(up) && is_valid_normal(down);
   const float curv = horizontal && vertical ? std::min(dot(left, right), dot(up, down)) : 0.f;
@@ -178,20 +183,26 @@ inline Float3 cross3(const Float3& a, const Float3& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 
-/// Difference along one axis (normals_from_positions): forward if it continues the surface, else
-/// backward, else zero (which makes the cross product zero: no normal).
-inline Float3 axis_difference(const Float3& centre, const Float3& forward, const Float3& backward, float limit) {
-  if (forward.z > 0.f && std::fabs(forward.z - centre.z) <= limit) return forward - centre;
-  if (backward.z > 0.f && std::fabs(backward.z - centre.z) <= limit) return centre - backward;
+/// Difference along one axis (normals_from_positions): central if asked for and both sides
+/// continue the surface, else forward if it does, else backward, else zero (which makes the cross
+/// product zero: no normal).
+inline Float3 axis_difference(const Float3& centre, const Float3& forward, const Float3& backward, float limit,
+                              bool centred) {
+  const bool forward_ok = forward.z > 0.f && std::fabs(forward.z - centre.z) <= limit;
+  const bool backward_ok = backward.z > 0.f && std::fabs(backward.z - centre.z) <= limit;
+  if (forward_ok && backward_ok && centred) return forward - backward;
+  if (forward_ok) return forward - centre;
+  if (backward_ok) return centre - backward;
   return {};
 }
 
 /// Stride-s cross-product normal from the positions of the pixel and its four neighbours (z = 0
 /// where a neighbour is outside the image or has no depth), towards the camera; zero without one.
 inline Float3 fresh_normal(const Float3& p, const Float3& right, const Float3& left, const Float3& below,
-                           const Float3& above, float max_jump_rel) {
+                           const Float3& above, float max_jump_rel, bool centred) {
   const float limit = max_jump_rel * p.z;
-  const Float3 n = cross3(axis_difference(p, right, left, limit), axis_difference(p, below, above, limit));
+  const Float3 n =
+      cross3(axis_difference(p, right, left, limit, centred), axis_difference(p, below, above, limit, centred));
   const float len = length(n);
   if (!(len > 0.f)) return {};
   return ((dot(n, p) > 0.f ? -1.f : 1.f) / len) * n;
@@ -287,7 +298,8 @@ inline void pass2_pixel(const Pass2& in, int r, int c) {
     const int s = k.stride;
     p = position(r, c);
     in.positions_out[i] = p;
-    n = fresh_normal(p, position(r, c + s), position(r, c - s), position(r + s, c), position(r - s, c), k.max_jump_rel);
+    n = fresh_normal(p, position(r, c + s), position(r, c - s), position(r + s, c), position(r - s, c), k.max_jump_rel,
+                     k.centred);
   } else {
     p = in.positions_in[i];
     n = in.normals[i];

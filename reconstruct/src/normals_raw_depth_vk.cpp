@@ -53,7 +53,7 @@ void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intr
   transfer.upload(depth.bytes(), depth_buffer);
   std::optional<double> total =
       cross_.run(depth_buffer, position_buffer, normal_buffer, width, height, intrinsics,
-                 {.stride = options.stride, .max_jump_rel = options.max_jump_rel});
+                 cross_normal_options(options));
 
   const bool usable_history = previous && previous->normals.same_shape(depth) && previous->positions.same_shape(depth);
   // Without history the blend is the identity: let the fill pass read the fresh normals directly.

@@ -75,8 +75,9 @@ TEST_F(CrossNormalsVkTest, MatchesCpuReferenceOnNoisySyntheticFrame) {
   const auto sequence = test::render_sequence(synth::Trajectory::Static, 1);  // 320x240, Kinect v1 noise
   const DepthMap& depth = sequence.frames.front().noisy;
   CrossNormalsVk gpu(context);
-  for (int stride : {4, 1}) {
-    const CrossNormalOptions options{.stride = stride};
+  for (const CrossNormalOptions options : {CrossNormalOptions{.stride = 4}, CrossNormalOptions{.stride = 4, .centred = true},
+                                           CrossNormalOptions{.stride = 1}}) {
+    const int stride = options.stride;
     PositionMap cpu_positions, vk_positions;
     NormalMap cpu_normals, vk_normals;
     positions_from_depth(depth, sequence.intrinsics, cpu_positions);
@@ -85,7 +86,7 @@ TEST_F(CrossNormalsVkTest, MatchesCpuReferenceOnNoisySyntheticFrame) {
     ASSERT_TRUE(vk_normals.same_shape(depth));
     ASSERT_TRUE(vk_positions.same_shape(depth));
     const Agreement a = compare(cpu_positions, cpu_normals, vk_positions, vk_normals);
-    expect_agreement(a, stride == 4 ? "stride 4" : "stride 1");
+    expect_agreement(a, (std::string("stride ") + std::to_string(stride) + (options.centred ? " centred" : "")).c_str());
     EXPECT_GT(a.both_valid, depth.size() / 2);  // the frame is mostly surface, not an empty comparison
   }
 }
@@ -144,7 +145,7 @@ TEST_F(CrossNormalsVkTest, Method1WithGpuCrossProductsEqualsCpuOverThreeFrames) 
     const NormalsHistory vk_history{vk_normals[prev], vk_positions[prev], previous_pose};
     normals_raw_depth(frame.noisy, sequence.intrinsics, frame.camera_to_world, i > 0 ? &cpu_history : nullptr, options,
                       cpu_positions[cur], cpu_normals[cur]);
-    gpu.run(frame.noisy, sequence.intrinsics, {.stride = options.stride, .max_jump_rel = options.max_jump_rel},
+    gpu.run(frame.noisy, sequence.intrinsics, cross_normal_options(options),
             vk_positions[cur], vk_normals[cur]);
     normals_raw_depth_blend(sequence.intrinsics, frame.camera_to_world, i > 0 ? &vk_history : nullptr, options,
                             vk_positions[cur], vk_normals[cur]);

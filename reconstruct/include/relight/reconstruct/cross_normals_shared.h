@@ -13,7 +13,7 @@ namespace relight::gpu {
 using uint = std::uint32_t;
 #endif
 
-/// Push constants of cross_normals.comp (std430: eight 4-byte members, 32 bytes). The float
+/// Push constants of cross_normals.comp (std430: nine 4-byte members, 36 bytes). The float
 /// intrinsics are computed on the host exactly as positions_from_depth does (1/fx in double,
 /// then rounded), so both backends multiply the same float values.
 struct CrossNormalsParams {
@@ -25,10 +25,11 @@ struct CrossNormalsParams {
   float inv_fy;        ///< float(1.0 / fy)
   float cx;            ///< principal point, pixels
   float cy;
+  uint centred;        ///< CrossNormalOptions::centred (0 or 1)
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(CrossNormalsParams) == 32);
+static_assert(sizeof(CrossNormalsParams) == 36);
 }  // namespace relight::gpu
 #endif
 

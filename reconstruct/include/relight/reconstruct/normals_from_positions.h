@@ -10,6 +10,12 @@
 // oriented towards the camera (N·V < 0). Where the forward neighbour is missing or across a
 // depth discontinuity (|Δz| > max_jump_rel · z) the backward difference V(r, c) − V(r, c−s) is
 // used instead, so that object borders keep normals; with neither, the pixel has no normal.
+// With `centred`, a pixel whose neighbours on both sides continue the surface uses the central
+// difference V(r, c+s) − V(r, c−s) (and likewise for rows) instead: the forward difference
+// describes the surface half a stride away, (r + s/2, c + s/2), which on curved surfaces tilts
+// every normal by the curvature times s/2, and the longer baseline halves the effect of depth
+// noise. Only the length of a difference changes with the choice of side, never the rule for
+// borders, and a cross product's direction does not depend on those lengths.
 //
 // Stage NormalsFromPositionsCpuStage reads DepthMap "depth_filtered" and FrameInfo "frame"
 // (intrinsics) and writes PositionMap "positions" and NormalMap "normals".
@@ -25,6 +31,7 @@ namespace relight {
 struct CrossNormalOptions {
   int stride = 1;              ///< s: pixel distance of the difference vectors
   float max_jump_rel = 0.05f;  ///< neighbour farther than this fraction of z: a discontinuity
+  bool centred = false;        ///< central differences where both sides continue (see above)
   int threads = 0;             ///< 0 = all cores
 };
 

@@ -3,13 +3,21 @@
 //
 //   positions = φ⁻¹(depth)                                  (raw, unfiltered; eq. 4.9)
 //   Pass 1, on the previous frame's filtered normals N' (camera frame of that frame):
-//     A(i,j)  = normalize(sum of valid N' over (i,j) and its 4-neighbourhood)
+//     S(i,j)  = sum of valid N' over (i,j) and its 4-neighbourhood (eq. 4.1's average)
 //     curv_H  = N'(i−1,j)·N'(i+1,j), curv_V = N'(i,j−1)·N'(i,j+1)                (eq. 4.1–4.2)
 //     curv    = clamp(min(curv_H, curv_V), 0, 1)^128 (0 when a pair is missing)    (eq. 4.3)
-//     evaluated at every second pixel (half resolution), then a mip chain of `mip_levels`
-//     levels (2×2 means of the valid texels: normal renormalised, curvature averaged).
+//     at half resolution: texel (h, k) holds normalize(S(2h,2k) + S(2h,2k+1) + S(2h+1,2k) +
+//     S(2h+1,2k+1)), the average over the 2×2 block of pixels that look it up, and the
+//     curvature of pixel (2h, 2k); then a mip chain of `mip_levels` levels (2×2 means of the
+//     valid texels: normal renormalised, curvature averaged). A texel that held only S(2h, 2k)
+//     would describe the surface half a pixel up and left of the pixels that read it, and the
+//     blend below would add that offset to the history every frame: on curved surfaces the
+//     error then grows with the frame count.
 //   Pass 2, per pixel with depth:
-//     N = normals_from_positions with stride 4 (eq. 4.4–4.6, towards the camera);
+//     N = normals_from_positions with stride 4 (eq. 4.4–4.6, towards the camera), by default
+//         with central differences V(i, j±4) where both sides continue the surface
+//         (CrossNormalOptions::centred: the paper's forward differences tilt normals on curved
+//         surfaces by half a stride's curvature);
 //     p' = T_prev_from_current · p, where T_prev_from_current = camera_to_world_prev⁻¹ ·
 //          camera_to_world_current maps current camera-frame points into the previous camera
 //          frame; (u', v') = nearest pixel of φ(p') (floor(x + 0.5) per coordinate);
@@ -40,6 +48,7 @@
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/reconstruct/normals_from_positions.h"
 
 namespace relight {
 
@@ -49,6 +58,7 @@ struct NormalsRawDepthOptions {
   float disocclusion_m = 0.1f;    ///< depth change that resets the history
   int mip_levels = 2;             ///< half and quarter resolution
   float max_jump_rel = 0.05f;     ///< discontinuity test of the cross products (relative to z)
+  bool centred_differences = true;  ///< CrossNormalOptions::centred; false: the paper's forward ones
   int threads = 0;                ///< 0 = all cores
   bool simd = true;               ///< AVX2 loops where available; false: the scalar loops (same maps)
 };
@@ -88,6 +98,9 @@ class NormalsRawDepthCpu {
 void normals_raw_depth(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
                        const NormalsHistory* previous, const NormalsRawDepthOptions& options,
                        PositionMap& positions, NormalMap& normals);
+
+/// The cross products of pass 2 as normals_from_positions / CrossNormalsVk options.
+[[nodiscard]] CrossNormalOptions cross_normal_options(const NormalsRawDepthOptions& options);
 
 /// Whether this CPU runs method 1's AVX2 loops (options.simd); otherwise the scalar loops run.
 [[nodiscard]] bool normals_raw_depth_simd_available();
