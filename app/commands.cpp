@@ -50,6 +50,15 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                      "then the --virtual-light ones; missing weights are 1)")
       ->delimiter(',')
       ->check(CLI::NonNegativeNumber);
+  command.add_option("--vpl-bounces", options.vpl_bounces,
+                     "Indirect bounces the VPLs carry: 1 = light reflected once, 2 adds VPLs lit by VPLs")
+      ->check(CLI::Range(1, 4))
+      ->capture_default_str();
+  command.add_option("--bounce-method", options.bounce_method,
+                     "How bounces after the first find their surface: rays (ray traced) or cone (the nearest of "
+                     "the surface points within 5 degrees of the sampled direction, no ray tracing)")
+      ->check(CLI::IsMember({"rays", "cone"}))
+      ->capture_default_str();
   command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

@@ -226,6 +226,8 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.count = options.vpls;
   dir.vpls.budget = vpl_budget(options.vpl_budget);
   dir.vpls.light_weights = options.vpl_weights;
+  dir.vpls.bounces = options.vpl_bounces;
+  dir.vpls.bounce_method = options.bounce_method == "cone" ? render::BounceMethod::PointCone : render::BounceMethod::RayTraced;
   dir.tone_map.exposure = options.exposure;
   dir.materials_buffer = "materials";
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view

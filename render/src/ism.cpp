@@ -67,7 +67,8 @@ std::vector<IsmPoint> sample_layer(const MrScene& scene, bool real, const IsmOpt
       const Vec3 n = ((1.f - a - b) * mesh.normals[tri[0]] + a * mesh.normals[tri[1]] + b * mesh.normals[tri[2]]);
       if (n.squaredNorm() > 0.f) normal = n.normalized();
     }
-    points.push_back({(1.f - a - b) * p0 + a * p1 + b * p2, normal, half_size});
+    points.push_back({(1.f - a - b) * p0 + a * p1 + b * p2, normal, half_size,
+                      mesh.triangle_material[triangles[pick].index]});
   }
   return points;  // already in random order: every contiguous run is a uniform subset
 }

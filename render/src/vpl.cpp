@@ -7,6 +7,7 @@
 
 #include "relight/core/error.h"
 #include "relight/render/hierarchical_warp.h"
+#include "relight/render/ism.h"
 #include "relight/render/phong_brdf.h"
 #include "relight/render/reflective_shadow_map.h"
 #include "relight/render/sampler.h"
@@ -109,10 +110,67 @@ std::optional<Cone> cone_towards(const BoundingSphere& sphere, const Vec3& from)
   return cone;
 }
 
+/// BounceMethod::PointCone's search: the nearest candidate point of each layer within a cone.
+class ConeSearch {
+ public:
+  ConeSearch(const MrScene& scene, const VplOptions& options)
+      : points_(sample_ism_points(scene, {.points_per_vpl = options.cone_points, .pool_factor = 1, .seed = options.seed})),
+        tan_half_(std::tan(options.cone_half_angle_deg * kPi / 180.f)),
+        sin_half_(std::sin(options.cone_half_angle_deg * kPi / 180.f)) {}
+
+  /// Where the ray from `origin` along `direction` meets the surface of `layer`, as far as the
+  /// points tell: among the points within the cone around it (above the tangent plane of
+  /// `normal` by the cone's angle; near the apex the cone is widened to the points' spacing,
+  /// twice their splat half-size, or a short hop into a corner would find no point inside the
+  /// narrow tip), the one whose tangent plane the ray meets first, if before `max_t`.
+  [[nodiscard]] std::optional<SurfaceHit> nearest(Layer layer, const Vec3& origin, const Vec3& direction,
+                                                  const Vec3& normal, float max_t) const {
+    const std::vector<IsmPoint>& pool = layer == Layer::Real ? points_.real : points_.virtual_points;
+    const IsmPoint* best = nullptr;
+    float best_t = max_t;
+    for (const IsmPoint& point : pool) {
+      const Vec3 offset = point.position - origin;
+      const float along = offset.dot(direction);
+      if (!(along > 0.f)) continue;
+      const float distance = offset.norm();
+      const float across_squared = std::max(0.f, distance * distance - along * along);
+      const float radius = std::max(tan_half_ * along, 2.f * point.half_size);
+      if (across_squared > radius * radius || offset.dot(normal) < sin_half_ * distance) continue;
+      const float t = plane_depth(point, offset, along, direction);
+      if (!(t < best_t)) continue;
+      best = &point;
+      best_t = t;
+    }
+    if (!best) return std::nullopt;
+    return SurfaceHit{best_t, origin + best_t * direction, best->normal, best->normal, best->material,
+                      layer == Layer::Real};
+  }
+
+ private:
+  /// The ray's distance to the point's tangent plane. The dissertation's depth test compares the
+  /// points' own distances; in a cone that meets a wall obliquely, the nearest point lies at the
+  /// footprint's near end, up to distance x tan(5°) / sin(elevation) away from where the ray
+  /// lands, which moved bounce light towards its source (0.23 relative error of the 2-bounce
+  /// differential image against the path tracer in DirCpu.TwoBouncesAgreeWithThePathTracer,
+  /// against 0.05 with rays). On a plane every point now gives the ray's exact hit. Where the
+  /// ray grazes the point's plane, or the plane lies behind, the point's own depth stands.
+  static float plane_depth(const IsmPoint& point, const Vec3& offset, float along, const Vec3& direction) {
+    const float facing = direction.dot(point.normal);
+    if (std::fabs(facing) < 0.2f) return along;
+    const float t = offset.dot(point.normal) / facing;
+    return t > 0.f ? t : along;
+  }
+
+  IsmPointPools points_;
+  float tan_half_, sin_half_;
+};
+
 class VplTracer {
  public:
   VplTracer(const MrScene& scene, const RayTracer& tracer, const VplOptions& options, std::vector<Vpl>& out)
-      : scene_(scene), tracer_(tracer), options_(options), out_(out) {}
+      : scene_(scene), tracer_(tracer), options_(options), out_(out) {
+    if (options.bounces > 1 && options.bounce_method == BounceMethod::PointCone) cone_.emplace(scene, options);
+  }
 
   /// The primary light whose paths the following emit() calls follow.
   void set_light(std::size_t light) { light_ = static_cast<std::uint32_t>(light); }
@@ -124,6 +182,24 @@ class VplTracer {
     const std::optional<SurfaceHit> real = tracer_.intersect(Layer::Real, origin, direction);
     const std::optional<SurfaceHit> virtual_hit =
         tracer_.intersect(Layer::Virtual, origin, direction, real ? real->t : std::numeric_limits<float>::infinity());
+    record(real, virtual_hit, direction, flux, in_real_virtual, in_real, bounce, rng);
+  }
+
+  /// emit() with the hits found by the cone search from a VPL at `origin` with `normal`.
+  void emit_cone(const Vec3& origin, const Vec3& normal, const Vec3& direction, const Vec3& flux, bool in_real_virtual,
+                 bool in_real, int bounce, Pcg32& rng) {
+    if (flux.maxCoeff() <= 0.f || (!in_real_virtual && !in_real)) return;
+    constexpr float kUnbounded = std::numeric_limits<float>::infinity();
+    const std::optional<SurfaceHit> real = cone_->nearest(Layer::Real, origin, direction, normal, kUnbounded);
+    const std::optional<SurfaceHit> virtual_hit =
+        cone_->nearest(Layer::Virtual, origin, direction, normal, real ? real->t : kUnbounded);
+    record(real, virtual_hit, direction, flux, in_real_virtual, in_real, bounce, rng);
+  }
+
+  /// The VPL(s) a path segment ends in, given what it reached in each layer (the virtual hit
+  /// only when nearer than the real one).
+  void record(const std::optional<SurfaceHit>& real, const std::optional<SurfaceHit>& virtual_hit, const Vec3& direction,
+              const Vec3& flux, bool in_real_virtual, bool in_real, int bounce, Pcg32& rng) {
     if (virtual_hit) {
       // The two worlds part here: the virtual surface is lit with the virtual objects present,
       // the real surface behind it only without them.
@@ -157,9 +233,13 @@ class VplTracer {
     const float u1 = rng.uniform(), u2 = rng.uniform();
     const auto sample = sample_phong(scene_.materials[vpl.material], vpl.normal, vpl.incident, u1, u2);
     if (!sample || sample->wi.dot(geometric) <= 0.f) return;
+    const Vec3 next_flux = flux.cwiseProduct(sample->weight);
+    if (cone_) {
+      emit_cone(vpl.position, geometric, sample->wi, next_flux, vpl.in_real_virtual, vpl.in_real, bounce + 1, rng);
+      return;
+    }
     const float offset = 1e-4f * (1.f + vpl.position.cwiseAbs().maxCoeff());
-    emit(vpl.position + offset * geometric, sample->wi, flux.cwiseProduct(sample->weight), vpl.in_real_virtual,
-         vpl.in_real, bounce + 1, rng);
+    emit(vpl.position + offset * geometric, sample->wi, next_flux, vpl.in_real_virtual, vpl.in_real, bounce + 1, rng);
   }
 
  private:
@@ -168,6 +248,7 @@ class VplTracer {
   const VplOptions& options_;
   std::vector<Vpl>& out_;
   std::uint32_t light_ = 0;
+  std::optional<ConeSearch> cone_;
 };
 
 double power_weight(const MrLight& light, const BoundingSphere& bounds) {
@@ -323,6 +404,10 @@ std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t
 std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options) {
   if (options.count < 0) throw Error("the VPL count must not be negative");
   if (options.bounces < 1) throw Error("VPLs need at least one bounce");
+  if (options.bounce_method == BounceMethod::PointCone &&
+      (!(options.cone_half_angle_deg > 0.f && options.cone_half_angle_deg < 90.f) || options.cone_points < 1 ||
+       options.cone_points > 65536))
+    throw Error("the bounce cone needs an angle in (0, 90) degrees and 1 to 65536 points per layer");
   if (options.source == VplSource::ReflectiveShadowMaps &&
       (options.rsm_size < 1 || options.rsm_size > 4096 || !std::has_single_bit(static_cast<unsigned>(options.rsm_size))))
     throw Error("the RSM size must be a power of two in [1, 4096]");

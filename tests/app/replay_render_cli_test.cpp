@@ -72,12 +72,13 @@ TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
   EXPECT_NE(report.dump().find("\"dir\""), std::string::npos) << "the DIR stage is timed";
 }
 
+// Also runs two VPL bounces by the point-cone method, which this scene exercises nowhere else.
 TEST(ReplayRenderCli, ColormapNoneWritesOnlyTheUnmappedComposite) {
   TempDir dir;
   const auto out = dir.path() / "out";
   const auto result = relight("replay --quiet --frames 1 --no-video --colormap none " + two_frame_sequence().string() +
-                              " --object " + (kData / "models" / "glossy_pebble.gltf").string() + " --vpls 16 --out " +
-                              out.string());
+                              " --object " + (kData / "models" / "glossy_pebble.gltf").string() +
+                              " --vpls 16 --vpl-bounces 2 --bounce-method cone --out " + out.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000000_composite.png"));
   EXPECT_FALSE(std::filesystem::exists(out / "frames" / "000000_composite_mapped.png"));
@@ -104,6 +105,8 @@ TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
   expect_one_line_error(relight("replay" + seq + pebble + " --colormap sample --colormap-model cubic" + out), 2);
   expect_one_line_error(relight("replay" + seq + pebble + " --vpl-budget most" + out), 2);
   expect_one_line_error(relight("replay" + seq + pebble + " --vpl-budget weights --vpl-weights 1,-2" + out), 2);
+  expect_one_line_error(relight("replay" + seq + pebble + " --vpl-bounces 0" + out), 2);
+  expect_one_line_error(relight("replay" + seq + pebble + " --bounce-method photons" + out), 2);
   // A recorded sequence needs its lights and a placement.
   expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + " --place 0,0,1" + out), 1);
   expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + out), 1);

@@ -54,6 +54,7 @@ struct IsmPoint {
   Eigen::Vector3f position;
   Eigen::Vector3f normal;
   float half_size = 0.f;  ///< half the side of the point's square splat (metres)
+  std::uint32_t material = 0;  ///< of the triangle the point lies on (MrScene::materials)
 };
 
 struct IsmPointPools {

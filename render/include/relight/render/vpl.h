@@ -16,7 +16,22 @@
 // RSMs of a real spot light). If the real hit is nearer, one VPL holds both flags of its parent;
 // if a virtual object is in front, the virtual hit becomes a VPL of the real+virtual world and
 // the real hit a VPL of the real-only world. Multi-bounce VPLs continue from a VPL by importance
-// sampling its Phong BRDF (phong_brdf.h), and flags multiply along the path.
+// sampling its Phong BRDF (phong_brdf.h), and flags multiply along the path. Where the sampled
+// direction lands is found by a ray (BounceMethod::RayTraced) or, as in the dissertation's
+// GPU-friendly multi-bounce method (§5.2.7), among surface points (BounceMethod::PointCone):
+// area-uniform points on the real and on the virtual surfaces (sample_ism_points) are the
+// candidates, those within `cone_half_angle_deg` of the direction (widened near the apex to the
+// points' spacing; and above the VPL's tangent plane by the cone's angle, so that its own
+// surface does not catch a grazing direction) compete, and the nearest wins, per layer, with the
+// same two-world rule as a ray: a virtual candidate nearer than the real one takes the
+// real+virtual flags and the real one the real-only flags. "Nearest" is the ray's distance to
+// the candidate's tangent plane, and the VPL lies where the ray meets that plane, with the
+// candidate's normal and material (the dissertation compares the points' own distances, which
+// moves the hit to the near end of the cone's footprint; see ConeSearch in vpl.cpp).
+// No ray tracer is needed beyond the first bounce, and the search is a min-reduction over
+// points, which a GPU does with an atomic min. A direction whose cone holds no point ends the
+// path (a ray would have found a surface there), so sparse points lose energy: the pool must
+// hold enough points that a cone's footprint at the scene's distances covers several.
 //
 // Virtual focus: the differential image lives where virtual objects reflect or block light, and
 // they are small, so uniformly spread light samples put few VPLs on them. A share of each light's
@@ -76,6 +91,9 @@ enum class VplBudget { Equal, ByPower, ByWeight, ByPreviousFlux };
 ///                         75 degrees) stay ray traced. Further bounces are traced as above.
 enum class VplSource { RayTraced, ReflectiveShadowMaps };
 
+/// How a VPL's continued light path finds its next surface (bounces ≥ 2; see the header comment).
+enum class BounceMethod { RayTraced, PointCone };
+
 struct VplOptions {
   int count = 256;      ///< first-bounce light samples (each may yield two VPLs, see above)
   int bounces = 1;      ///< 1 = one indirect bounce; 2 adds VPLs lit by VPLs
@@ -86,6 +104,9 @@ struct VplOptions {
   std::vector<double> previous_flux{};  ///< VplBudget::ByPreviousFlux
   VplSource source = VplSource::RayTraced;
   int rsm_size = 256;  ///< VplSource::ReflectiveShadowMaps: texels per side, a power of two
+  BounceMethod bounce_method = BounceMethod::RayTraced;
+  float cone_half_angle_deg = 5.f;  ///< BounceMethod::PointCone: the dissertation's 5 degrees
+  int cone_points = 16384;          ///< BounceMethod::PointCone: candidate points per layer (<= 65536)
 };
 
 /// Per light of the scene, the luminance of the flux its first-bounce VPLs carry (the input of
