@@ -233,7 +233,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view
   // keep their shadows, at a quarter of the rasterisation and memory of 512.
   dir.renderer.shadow_tile = 256;
-  graph.emplace<render::DirStage>(pipeline.vulkan.get(), std::move(content), dir);
+  render::add_dir_stages(graph, pipeline.vulkan.get(), std::move(content), dir);
   graph.keep("composite");
   pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, dir.tone_map);
   if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", pipeline.final_composite);

@@ -6,24 +6,6 @@
 
 namespace relight::render {
 
-DirStage::DirStage(vk::VulkanContext* context, DirSceneContent content, DirStageOptions options)
-    : context_(context), content_(std::move(content)), options_(std::move(options)) {}
-
-DirStage::~DirStage() = default;
-
-void DirStage::declare(StageBuilder& builder) {
-  frame_ = builder.read<FrameInfo>("frame");
-  color_ = builder.read<ColorImage>("color");
-  positions_ = builder.read<PositionMap>("positions");
-  normals_ = builder.read<NormalMap>("normals");
-  if (!options_.materials_buffer.empty()) materials_ = builder.read<brdf::Materials>(options_.materials_buffer);
-  composite_ = builder.write<ColorImage>("composite");
-  real_virtual_ = builder.write<RadianceImage>("L_rv");
-  real_ = builder.write<RadianceImage>("L_r");
-  coverage_ = builder.write<CoverageImage>("virtual_coverage");
-  indirect_ = builder.write<RadianceImage>("L_rv_indirect");
-}
-
 namespace {
 
 /// The clusters as MrScene materials (index = cluster), and the fallback for pixels without one.
@@ -47,64 +29,163 @@ void add_cluster_materials(MrScene& scene, const brdf::Materials& materials, Dep
   mesh_materials.labels = &materials.ids;
 }
 
+/// The frame's camera for images of the given size.
+MrCamera frame_camera(const FrameInfo& frame, int width, int height) {
+  MrCamera camera{frame.intrinsics, frame.camera_to_world.value_or(Pose::Identity())};
+  camera.intrinsics.width = width;
+  camera.intrinsics.height = height;
+  return camera;
+}
+
 }  // namespace
 
-void DirStage::build_scene(const PositionMap& positions, const NormalMap& normals, const Pose& camera_to_world,
-                           const brdf::Materials* cluster_materials) {
-  scene_ = MrScene{};
+void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneContent content,
+                    const DirStageOptions& options) {
+  graph.emplace<MrSceneStage>(std::move(content), options);
+  graph.emplace<VplStage>(options.vpls);
+  graph.emplace<DirRenderStage>(context, options.renderer);
+  graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
+  graph.emplace<DifferentialCompositeStage>(options.tone_map);
+}
+
+// ---- mr_scene ----------------------------------------------------------------------------------
+
+MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& options)
+    : content_(std::move(content)),
+      mesh_(options.mesh),
+      reconstruction_material_(options.reconstruction_material),
+      materials_buffer_(options.materials_buffer) {}
+
+void MrSceneStage::declare(StageBuilder& builder) {
+  frame_ = builder.read<FrameInfo>("frame");
+  positions_ = builder.read<PositionMap>("positions");
+  normals_ = builder.read<NormalMap>("normals");
+  if (!materials_buffer_.empty()) materials_ = builder.read<brdf::Materials>(materials_buffer_);
+  scene_ = builder.write<MrScene>("mr_scene");
+}
+
+void MrSceneStage::run(StageContext& context) {
+  const PositionMap& positions = context.get(positions_);
+  const brdf::Materials* cluster_materials = materials_buffer_.empty() ? nullptr : &context.get(materials_);
+  MrScene& scene = context.get(scene_);
+  scene = MrScene{};
   DepthMeshMaterials materials;
   if (cluster_materials && cluster_materials->ids.width() == positions.width() &&
       cluster_materials->ids.height() == positions.height())
-    add_cluster_materials(scene_, *cluster_materials, materials, options_.reconstruction_material);
+    add_cluster_materials(scene, *cluster_materials, materials, reconstruction_material_);
   else
-    materials.material = scene_.add_material(options_.reconstruction_material);
-  TriangleMesh mesh = mesh_from_positions(positions, &normals, camera_to_world, materials, options_.mesh);
+    materials.material = scene.add_material(reconstruction_material_);
+  const Pose camera_to_world = context.get(frame_).camera_to_world.value_or(Pose::Identity());
+  TriangleMesh mesh = mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, mesh_);
   mesh.name = "reconstruction";
-  scene_.meshes.push_back(std::move(mesh));
-  scene_.lights = content_.lights;
-  for (const auto& [model, placement] : content_.objects) add_virtual_model(scene_, model, placement);
+  scene.meshes.push_back(std::move(mesh));
+  scene.lights = content_.lights;
+  for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
 }
 
-void DirStage::run(StageContext& context) {
-  const FrameInfo& frame = context.get(frame_);
-  const ColorImage& color = context.get(color_);
-  const PositionMap& positions = context.get(positions_);
-  const int width = positions.width(), height = positions.height();
-  if (color.width() != width || color.height() != height)
-    throw Error("dir: the colour image (" + std::to_string(color.width()) + "x" + std::to_string(color.height()) +
-                ") and the position map (" + std::to_string(width) + "x" + std::to_string(height) + ") differ in size");
-  const Pose camera_to_world = frame.camera_to_world.value_or(Pose::Identity());
-  build_scene(positions, context.get(normals_), camera_to_world,
-              options_.materials_buffer.empty() ? nullptr : &context.get(materials_));
+// ---- vpls --------------------------------------------------------------------------------------
 
-  const std::vector<Vpl> vpls = generate_vpls(scene_, RayTracer(scene_, RayTracer::Build::Fast), options_.vpls);
-  vpl_count_ = vpls.size();
-  if (options_.vpls.budget == VplBudget::ByPreviousFlux)
-    options_.vpls.previous_flux = vpl_flux_per_light(vpls, scene_.lights.size());
-  MrCamera camera{frame.intrinsics, camera_to_world};
-  camera.intrinsics.width = width;
-  camera.intrinsics.height = height;
-  DifferentialImages images;
-  GBuffer cpu_gbuffer;
-  if (context_) {
-    if (!renderer_ || renderer_size_ != std::pair{width, height}) {
-      renderer_ = std::make_unique<DirRendererVk>(*context_, width, height);
-      renderer_size_ = {width, height};
-    }
-    renderer_->set_scene(scene_, options_.renderer);
-    images = renderer_->render(camera, vpls, options_.renderer);
-  } else {
-    images = render_dir_cpu(scene_, camera, vpls, options_.renderer, &cpu_gbuffer);
+void VplStage::declare(StageBuilder& builder) {
+  scene_ = builder.read<MrScene>("mr_scene");
+  if (options_.budget == VplBudget::ByPreviousFlux) previous_ = builder.read_previous<VplSet>("vpls");
+  vpls_ = builder.write<VplSet>("vpls");
+}
+
+void VplStage::run(StageContext& context) {
+  const MrScene& scene = context.get(scene_);
+  if (options_.budget == VplBudget::ByPreviousFlux) {
+    const VplSet* previous = context.get(previous_);
+    options_.previous_flux = previous ? vpl_flux_per_light(previous->vpls, scene.lights.size()) : std::vector<double>{};
   }
-  if (options_.temporal_smoothing)
-    history_ = smooth_indirect(images, context_ ? renderer_->last_gbuffer() : cpu_gbuffer, camera,
-                               history_ ? &*history_ : nullptr, options_.temporal);
-  context.get(composite_) =
-      differential_composite(color, images.real_virtual, images.real, images.virtual_coverage, options_.tone_map);
+  context.get(vpls_).vpls = generate_vpls(scene, RayTracer(scene, RayTracer::Build::Fast), options_);
+}
+
+// ---- dir ---------------------------------------------------------------------------------------
+
+DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirVkOptions options)
+    : context_(context), options_(std::move(options)) {}
+
+DirRenderStage::~DirRenderStage() = default;
+
+void DirRenderStage::declare(StageBuilder& builder) {
+  frame_ = builder.read<FrameInfo>("frame");
+  color_ = builder.read<ColorImage>("color");
+  positions_ = builder.read<PositionMap>("positions");
+  scene_ = builder.read<MrScene>("mr_scene");
+  vpls_ = builder.read<VplSet>("vpls");
+  images_ = builder.write<DifferentialImages>("dir_images");
+  gbuffer_ = builder.write<GBuffer>("dir_gbuffer");
+}
+
+void DirRenderStage::run(StageContext& context) {
+  const ColorImage& color = context.get(color_);
+  const int width = color.width(), height = color.height();
+  const PositionMap& positions = context.get(positions_);
+  if (positions.width() != width || positions.height() != height)
+    throw Error("dir: the colour image (" + std::to_string(width) + "x" + std::to_string(height) +
+                ") and the position map (" + std::to_string(positions.width()) + "x" +
+                std::to_string(positions.height()) + ") differ in size");
+  const MrCamera camera = frame_camera(context.get(frame_), width, height);
+  const MrScene& scene = context.get(scene_);
+  const std::vector<Vpl>& vpls = context.get(vpls_).vpls;
+  DifferentialImages& images = context.get(images_);
+  GBuffer& gbuffer = context.get(gbuffer_);
+  if (!context_) {
+    images = render_dir_cpu(scene, camera, vpls, options_, &gbuffer);
+    return;
+  }
+  if (!renderer_ || renderer_size_ != std::pair{width, height}) {
+    renderer_ = std::make_unique<DirRendererVk>(*context_, width, height);
+    renderer_size_ = {width, height};
+  }
+  renderer_->set_scene(scene, options_);
+  images = renderer_->render(camera, vpls, options_);
+  gbuffer = renderer_->last_gbuffer();
+}
+
+// ---- indirect_smoothing ------------------------------------------------------------------------
+
+void IndirectSmoothingStage::declare(StageBuilder& builder) {
+  images_ = builder.read<DifferentialImages>("dir_images");
+  gbuffer_ = builder.read<GBuffer>("dir_gbuffer");
+  frame_ = builder.read<FrameInfo>("frame");
+  real_virtual_ = builder.write<RadianceImage>("L_rv");
+  real_ = builder.write<RadianceImage>("L_r");
+  indirect_ = builder.write<RadianceImage>("L_rv_indirect");
+  coverage_ = builder.write<CoverageImage>("virtual_coverage");
+}
+
+void IndirectSmoothingStage::run(StageContext& context) {
+  DifferentialImages images = context.get(images_);
+  if (enabled_) {
+    const MrCamera camera = frame_camera(context.get(frame_), images.real_virtual.width(), images.real_virtual.height());
+    history_ = smooth_indirect(images, context.get(gbuffer_), camera, history_ ? &*history_ : nullptr, options_);
+  }
   context.get(real_virtual_) = std::move(images.real_virtual);
   context.get(real_) = std::move(images.real);
-  context.get(coverage_) = std::move(images.virtual_coverage);
   context.get(indirect_) = std::move(images.indirect_real_virtual);
+  context.get(coverage_) = std::move(images.virtual_coverage);
+}
+
+// ---- differential_composite --------------------------------------------------------------------
+
+void DifferentialCompositeStage::declare(StageBuilder& builder) {
+  color_ = builder.read<ColorImage>("color");
+  real_virtual_ = builder.read<RadianceImage>("L_rv");
+  real_ = builder.read<RadianceImage>("L_r");
+  coverage_ = builder.read<CoverageImage>("virtual_coverage");
+  composite_ = builder.write<ColorImage>("composite");
+}
+
+void DifferentialCompositeStage::run(StageContext& context) {
+  const ColorImage& color = context.get(color_);
+  const RadianceImage& real_virtual = context.get(real_virtual_);
+  if (color.width() != real_virtual.width() || color.height() != real_virtual.height())
+    throw Error("differential_composite: the colour image (" + std::to_string(color.width()) + "x" +
+                std::to_string(color.height()) + ") and the rendered image (" + std::to_string(real_virtual.width()) +
+                "x" + std::to_string(real_virtual.height()) + ") differ in size");
+  context.get(composite_) =
+      differential_composite(color, real_virtual, context.get(real_), context.get(coverage_), tone_map_);
 }
 
 }  // namespace relight::render

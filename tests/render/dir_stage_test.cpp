@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "../reconstruct/vulkan_test_env.h"
 #include "relight/render/procedural_models.h"
 #include "relight/render/scene_from_synth.h"
@@ -12,6 +14,7 @@
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
 #include "synthetic_frame_stage.h"
+#include "test_scenes.h"
 #include "relight/vk/transfer.h"
 
 namespace relight::render {
@@ -35,12 +38,18 @@ StageRun run_stage(vk::VulkanContext* context) {
   DirStageOptions options;
   options.renderer.shadow_tile = 256;
   options.renderer.ism.tile = 32;
-  DirStage& stage = graph.emplace<DirStage>(context, std::move(content), options);
+  add_dir_stages(graph, context, std::move(content), options);
   graph.keep("composite");
+  graph.keep("mr_scene");
+  graph.keep("vpls");
   graph.compile();
+  EXPECT_EQ(graph.execution_order(),
+            (std::vector<std::string>{"synthetic_frame", "mr_scene", "vpls", "dir", "indirect_smoothing",
+                                      "differential_composite"}));
   EXPECT_TRUE(graph.run_frame());
   StageRun out{*graph.find<ColorImage>("color"), *graph.find<ColorImage>("composite"),
-               *graph.find<CoverageImage>("virtual_coverage"), stage.last_scene().meshes.size(), stage.last_vpl_count()};
+               *graph.find<CoverageImage>("virtual_coverage"), graph.find<MrScene>("mr_scene")->meshes.size(),
+               graph.find<VplSet>("vpls")->vpls.size()};
   return out;
 }
 
@@ -79,6 +88,44 @@ TEST_F(DirStageTest, CpuFallbackMatchesTheVulkanRenderer) {
     if (channel_difference(gpu.composite.pixels()[i], cpu.composite.pixels()[i]) <= 3) ++close;
   // Rasterised and ray-cast G-buffers and shadow maps differ at a few edge pixels.
   EXPECT_GT(close, static_cast<int>(gpu.composite.pixels().size()) * 97 / 100);
+}
+
+// The VPL stage's flux budget reads the previous frame's VPLs from the graph's history: a light
+// whose paths miss the scene gets only the floor share from the second frame on.
+class FixedSceneStage final : public Stage {
+ public:
+  explicit FixedSceneStage(MrScene scene) : scene_(std::move(scene)) {}
+  [[nodiscard]] std::string name() const override { return "fixed_scene"; }
+  void declare(StageBuilder& builder) override { out_ = builder.write<MrScene>("mr_scene"); }
+  void run(StageContext& context) override { context.get(out_) = scene_; }
+
+ private:
+  MrScene scene_;
+  Write<MrScene> out_;
+};
+
+TEST(VplStage, FluxBudgetComesFromThePreviousFramesVpls) {
+  MrScene scene = test::floor_scene(Eigen::Vector3f::Constant(0.5f), {0.f, 0.f, 1.f}, 1.f);
+  MrLight far_away = scene.lights.front();
+  far_away.position = {40.f, 0.f, 1.f};  // its light mostly misses the 2 m floor
+  scene.lights.push_back(far_away);
+  FrameGraph graph;
+  graph.emplace<FixedSceneStage>(scene);
+  graph.emplace<VplStage>(VplOptions{.count = 400, .budget = VplBudget::ByPreviousFlux});
+  graph.keep("vpls");
+  graph.compile();
+  const auto near_light_vpls = [&] {
+    EXPECT_TRUE(graph.run_frame());
+    const std::vector<Vpl>& vpls = graph.find<VplSet>("vpls")->vpls;
+    return std::count_if(vpls.begin(), vpls.end(), [](const Vpl& v) { return v.light == 0; });
+  };
+  // First frame: no history, so by power: 200 samples each. Second: the far light's VPLs
+  // carried almost nothing, it keeps the floor share (1/16 of the mean weight) and the near
+  // light gets about 388 of the 400 samples, so nearly twice the VPLs.
+  const auto first = near_light_vpls();
+  const auto second = near_light_vpls();
+  EXPECT_GT(first, 20);
+  EXPECT_GT(static_cast<double>(second), 1.7 * static_cast<double>(first));
 }
 
 }  // namespace

@@ -126,7 +126,7 @@ double flicker(vk::VulkanContext& context, bool smoothing, Geometry geometry) {
   options.renderer.shadow_tile = 256;
   options.renderer.ism.tile = 32;
   options.temporal_smoothing = smoothing;
-  graph.emplace<DirStage>(&context, std::move(content), options);
+  add_dir_stages(graph, &context, std::move(content), options);
   graph.keep("L_rv_indirect");
   graph.compile();
   RadianceImage previous;

@@ -1,24 +1,41 @@
 #pragma once
-// Frame-graph stage of differential instant radiosity (dir_vk.h): every frame it builds the
-// mixed-reality scene - the reconstruction's position map as the real mesh, the configured real
-// and virtual lights, the configured virtual objects - generates the VPLs, renders L_rv and L_r
-// and composites them into the camera image (composite.h, eq. 5.1).
+// Differential instant radiosity (dir_vk.h) as frame-graph stages, one per step, so that the
+// graph times each step and keeps each step's output (add_dir_stages() adds all five):
 //
-// Reads:  FrameInfo "frame" (intrinsics, camera_to_world: identity when absent), ColorImage
-//         "color", PositionMap "positions" and NormalMap "normals" (camera frame, reconstruct/),
-//         and, when `materials_buffer` is set, brdf::Materials (the BRDF stages' clusters).
-// Writes: ColorImage "composite", RadianceImage "L_rv" and "L_r", CoverageImage
-//         "virtual_coverage", RadianceImage "L_rv_indirect" (the VPL part of L_rv, smoothed).
+//   mr_scene                 reads  FrameInfo "frame" (camera_to_world: identity when absent),
+//                                   PositionMap "positions" and NormalMap "normals" (camera frame,
+//                                   reconstruct/), brdf::Materials when `materials_buffer` is set
+//                            writes MrScene "mr_scene": the reconstruction's position map as the
+//                                   real mesh, the configured real and virtual lights, the
+//                                   configured virtual objects
+//   vpls                     reads  MrScene "mr_scene"; with VplBudget::ByPreviousFlux also the
+//                                   previous frame's VplSet "vpls" (its flux per light)
+//                            writes VplSet "vpls" (vpl.h)
+//   dir                      reads  FrameInfo "frame", ColorImage "color" and PositionMap
+//                                   "positions" (the image size, which they must share),
+//                                   MrScene "mr_scene", VplSet "vpls"
+//                            writes DifferentialImages "dir_images" (L_rv, L_r, coverage and
+//                                   their indirect parts, one shading pass) and GBuffer
+//                                   "dir_gbuffer"
+//   indirect_smoothing       reads  DifferentialImages "dir_images", GBuffer "dir_gbuffer",
+//                                   FrameInfo "frame"
+//                            writes RadianceImage "L_rv", "L_r", "L_rv_indirect" (the VPL part
+//                                   of L_rv) and CoverageImage "virtual_coverage", the indirect
+//                                   light smoothed over time (temporal_smoothing.h, eq.
+//                                   5.11-5.15) with the stage's own history of the last frame
+//                                   (G-buffer, camera, indirect light); unchanged when off
+//   differential_composite   reads  ColorImage "color", RadianceImage "L_rv", "L_r",
+//                                   CoverageImage "virtual_coverage"
+//                            writes ColorImage "composite" (composite.h, eq. 5.1)
 //
-// With a Vulkan context it renders with DirRendererVk (made on the first frame, remade when the
-// frame size changes); without one, with render_dir_cpu() (same algorithm, much slower).
-// The indirect light is smoothed over time (temporal_smoothing.h) with the stage's own history
-// of the last frame (G-buffer, camera, indirect light).
+// With a Vulkan context `dir` renders with DirRendererVk (made on the first frame, remade when
+// the frame size changes); without one, with render_dir_cpu() (same algorithm, much slower).
 // Real surfaces take the material of their pixel's BRDF cluster; pixels without one (shadows,
 // too dark to estimate) take the pixel-weighted mean of the clusters, and without any Materials
 // every real surface is `reconstruction_material`. The real materials matter for the picture:
 // the differential adds TM(L_rv) - TM(L_r) to the camera image, so a virtual shadow computed
 // with a grey albedo on a brown table subtracts grey and tints the shadow orange.
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -38,7 +55,6 @@ namespace relight::render {
 
 struct DirStageOptions {
   DirVkOptions renderer{};
-  /// With VplBudget::ByPreviousFlux the stage feeds each frame's flux per light into the next.
   VplOptions vpls{.count = 64};
   DepthMeshOptions mesh{.stride = 2};
   PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
@@ -48,48 +64,110 @@ struct DirStageOptions {
   TemporalOptions temporal{};
 };
 
-/// What the stage adds to every frame's real geometry.
+/// What the stages add to every frame's real geometry.
 struct DirSceneContent {
   std::vector<MrLight> lights;  ///< real (measured) and virtual lights
   std::vector<std::pair<VirtualModel, Placement>> objects;
 };
 
-class DirStage final : public Stage {
- public:
-  /// `context` may be null (CPU fallback); it must outlive the stage.
-  DirStage(vk::VulkanContext* context, DirSceneContent content, DirStageOptions options = {});
-  ~DirStage() override;
+/// Adds the five stages above. `context` may be null (CPU rendering); it must outlive the graph.
+void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneContent content,
+                    const DirStageOptions& options = {});
 
+/// Step 1 (scene): the mixed-reality scene of the frame.
+class MrSceneStage final : public Stage {
+ public:
+  MrSceneStage(DirSceneContent content, const DirStageOptions& options);
+  [[nodiscard]] std::string name() const override { return "mr_scene"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  DirSceneContent content_;
+  DepthMeshOptions mesh_;
+  PhongMaterial reconstruction_material_;
+  std::string materials_buffer_;
+  Read<FrameInfo> frame_;
+  Read<PositionMap> positions_;
+  Read<NormalMap> normals_;
+  Read<brdf::Materials> materials_;
+  Write<MrScene> scene_;
+};
+
+/// Step 2 (primary lights and VPLs).
+class VplStage final : public Stage {
+ public:
+  explicit VplStage(VplOptions options) : options_(std::move(options)) {}
+  [[nodiscard]] std::string name() const override { return "vpls"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  VplOptions options_;
+  Read<MrScene> scene_;
+  ReadPrevious<VplSet> previous_;
+  Write<VplSet> vpls_;
+};
+
+/// Steps 3-4 (G-buffer, shadow maps, ISMs, one-pass shading of L_rv and L_r).
+class DirRenderStage final : public Stage {
+ public:
+  DirRenderStage(vk::VulkanContext* context, DirVkOptions options);
+  ~DirRenderStage() override;
   [[nodiscard]] std::string name() const override { return "dir"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
-  /// The scene of the last frame (for tests and reports).
-  [[nodiscard]] const MrScene& last_scene() const { return scene_; }
-  [[nodiscard]] std::size_t last_vpl_count() const { return vpl_count_; }
-
  private:
-  void build_scene(const PositionMap& positions, const NormalMap& normals, const Pose& camera_to_world,
-                   const brdf::Materials* materials);
-
   vk::VulkanContext* context_;
-  DirSceneContent content_;
-  DirStageOptions options_;
+  DirVkOptions options_;
   std::unique_ptr<DirRendererVk> renderer_;
   std::pair<int, int> renderer_size_{0, 0};
-  MrScene scene_;
-  std::size_t vpl_count_ = 0;
-  std::optional<TemporalHistory> history_;
   Read<FrameInfo> frame_;
   Read<ColorImage> color_;
   Read<PositionMap> positions_;
-  Read<NormalMap> normals_;
-  Read<brdf::Materials> materials_;
-  Write<ColorImage> composite_;
+  Read<MrScene> scene_;
+  Read<VplSet> vpls_;
+  Write<DifferentialImages> images_;
+  Write<GBuffer> gbuffer_;
+};
+
+/// Step 6 (temporal smoothing of the indirect light).
+class IndirectSmoothingStage final : public Stage {
+ public:
+  IndirectSmoothingStage(bool enabled, TemporalOptions options) : enabled_(enabled), options_(options) {}
+  [[nodiscard]] std::string name() const override { return "indirect_smoothing"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  bool enabled_;
+  TemporalOptions options_;
+  std::optional<TemporalHistory> history_;
+  Read<DifferentialImages> images_;
+  Read<GBuffer> gbuffer_;
+  Read<FrameInfo> frame_;
   Write<RadianceImage> real_virtual_;
   Write<RadianceImage> real_;
-  Write<CoverageImage> coverage_;
   Write<RadianceImage> indirect_;
+  Write<CoverageImage> coverage_;
+};
+
+/// Step 7 (tone mapping and differential composite).
+class DifferentialCompositeStage final : public Stage {
+ public:
+  explicit DifferentialCompositeStage(colormap::ToneMap tone_map) : tone_map_(tone_map) {}
+  [[nodiscard]] std::string name() const override { return "differential_composite"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  colormap::ToneMap tone_map_;
+  Read<ColorImage> color_;
+  Read<RadianceImage> real_virtual_;
+  Read<RadianceImage> real_;
+  Read<CoverageImage> coverage_;
+  Write<ColorImage> composite_;
 };
 
 }  // namespace relight::render

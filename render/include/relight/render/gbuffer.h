@@ -16,6 +16,8 @@ struct GBuffer {
   LabelImage material;   ///< MrScene material index + 1; 0 where nothing is seen
   Mask virtual_surface;  ///< 1 where the surface belongs to a virtual object (r(p) = 0)
   DepthMap distance;     ///< from the camera centre, metres; 0 where nothing is seen
+
+  static constexpr const char* type_name = "GBuffer";
 };
 
 [[nodiscard]] GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads = 0);

@@ -88,6 +88,8 @@ struct MrScene {
   /// Throws relight::Error when a mesh refers to a missing material or vertex, or has a
   /// non-finite position, or a normal array of the wrong size.
   void validate() const;
+
+  static constexpr const char* type_name = "MrScene";
 };
 
 /// The camera of one frame: pinhole intrinsics (with the image size) and camera-to-world pose

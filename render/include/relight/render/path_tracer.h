@@ -57,6 +57,8 @@ struct DifferentialImages {
   /// (dir_vk.h) for temporal smoothing, empty otherwise.
   RadianceImage indirect_real_virtual;
   RadianceImage indirect_real;
+
+  static constexpr const char* type_name = "DifferentialImages";
 };
 
 /// Called after each progressive pass with (samples done, samples wanted).

@@ -109,6 +109,12 @@ struct VplOptions {
   int cone_points = 16384;          ///< BounceMethod::PointCone: candidate points per layer (<= 65536)
 };
 
+/// One frame's VPLs, as a frame-graph buffer.
+struct VplSet {
+  std::vector<Vpl> vpls;
+  static constexpr const char* type_name = "VplSet";
+};
+
 /// Per light of the scene, the luminance of the flux its first-bounce VPLs carry (the input of
 /// VplBudget::ByPreviousFlux for the next frame).
 [[nodiscard]] std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t light_count);
