@@ -270,24 +270,16 @@ TEST(Vpls, VirtualFocusPutsManyMoreVplsOnVirtualObjectsWithoutChangingTheirFlux)
 TEST(DirCpu, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions) {
   // One indirect bounce in both; no sky, so both estimate the same light transport.
   const MrScene scene = cube_scene();
-  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 48, 36);
-  PathTracerOptions pt_options;
-  pt_options.max_bounces = 1;
-  pt_options.roulette_from = 10;
-  const DifferentialImages pt = render_reference(scene, camera, 256, pt_options);
+  const MrCamera camera = test::comparison_camera();
+  const DifferentialImages pt = test::reference_images(scene, camera, 1);
   DirOptions options;
   options.min_distance = 0.02f;
   // Half of the light samples aim at the cube (vpl.h): ~250 VPLs on it.
   const Rendered dir = render_dir(scene, camera, 1024, options);
-  const auto compare = [&](const Eigen::Vector2f& lo, const Eigen::Vector2f& hi) {
-    const auto pixels = floor_pixels(scene, camera, lo, hi);
-    EXPECT_GT(pixels.size(), 8u);
-    const Eigen::Vector3d d_pt = mean_over(pt.real_virtual, pixels) - mean_over(pt.real, pixels);
-    const Eigen::Vector3d d_dir = mean_over(dir.images.real_virtual, pixels) - mean_over(dir.images.real, pixels);
-    return (d_dir - d_pt).norm() / d_pt.norm();
-  };
-  EXPECT_LT(compare({-0.45f, -0.12f}, {-0.25f, 0.12f}), 0.15) << "shadow region";
-  EXPECT_LT(compare({0.22f, -0.15f}, {0.45f, 0.15f}), 0.15) << "bleeding region";
+  EXPECT_LT(test::delta_error_on_floor(scene, camera, pt, dir.images, test::kShadowLo, test::kShadowHi), 0.15)
+      << "shadow region";
+  EXPECT_LT(test::delta_error_on_floor(scene, camera, pt, dir.images, test::kBleedingLo, test::kBleedingHi), 0.15)
+      << "bleeding region";
 }
 
 // The point-cone continuation (BounceMethod::PointCone, vpl.h) against rays, VPL by VPL: in a
@@ -356,11 +348,8 @@ TEST(Vpls, ConeBounceLandsNearTheRayTracedHit) {
 // 0.010 (shadow) and 0.054 (bleeding), point cone 0.007 and 0.114.
 TEST(DirCpu, TwoBouncesAgreeWithThePathTracer) {
   const MrScene scene = cube_scene();
-  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 48, 36);
-  PathTracerOptions pt_options;
-  pt_options.max_bounces = 2;
-  pt_options.roulette_from = 10;
-  const DifferentialImages pt = render_reference(scene, camera, 256, pt_options);
+  const MrCamera camera = test::comparison_camera();
+  const DifferentialImages pt = test::reference_images(scene, camera, 2);
   DirOptions options;
   options.min_distance = 0.02f;
   for (const BounceMethod method : {BounceMethod::RayTraced, BounceMethod::PointCone}) {
@@ -368,15 +357,9 @@ TEST(DirCpu, TwoBouncesAgreeWithThePathTracer) {
     vpl_options.bounces = 2;
     vpl_options.bounce_method = method;
     const Rendered dir = render_dir(scene, camera, 1024, options, vpl_options);
-    const auto relative_error = [&](const Eigen::Vector2f& lo, const Eigen::Vector2f& hi) {
-      const auto pixels = floor_pixels(scene, camera, lo, hi);
-      EXPECT_GT(pixels.size(), 8u);
-      const Eigen::Vector3d d_pt = mean_over(pt.real_virtual, pixels) - mean_over(pt.real, pixels);
-      const Eigen::Vector3d d_dir = mean_over(dir.images.real_virtual, pixels) - mean_over(dir.images.real, pixels);
-      return (d_dir - d_pt).norm() / d_pt.norm();
-    };
-    const double shadow = relative_error({-0.45f, -0.12f}, {-0.25f, 0.12f});
-    const double bleeding = relative_error({0.22f, -0.15f}, {0.45f, 0.15f});
+    const double shadow = test::delta_error_on_floor(scene, camera, pt, dir.images, test::kShadowLo, test::kShadowHi);
+    const double bleeding =
+        test::delta_error_on_floor(scene, camera, pt, dir.images, test::kBleedingLo, test::kBleedingHi);
     const char* name = method == BounceMethod::RayTraced ? "rays" : "point cone";
     std::printf("two bounces, %s: delta-L error %.3f in the shadow, %.3f in the bleeding region\n", name, shadow,
                 bleeding);

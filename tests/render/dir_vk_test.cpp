@@ -203,11 +203,8 @@ TEST_F(DirVkTest, VirtualCubeShadowsAndBleedsOnlyWhereFig57Says) {
 TEST_F(DirVkTest, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const MrScene scene = open_cube_scene();
-  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 48, 36);
-  PathTracerOptions pt_options;
-  pt_options.max_bounces = 1;
-  pt_options.roulette_from = 10;
-  const DifferentialImages pt = render_reference(scene, camera, 256, pt_options);
+  const MrCamera camera = test::comparison_camera();
+  const DifferentialImages pt = test::reference_images(scene, camera, 1);
   DirVkOptions options;
   options.shading.min_distance = 0.02f;
   options.shadow_tile = 512;
@@ -215,15 +212,9 @@ TEST_F(DirVkTest, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions)
   DirRendererVk renderer(context, 48, 36);
   renderer.set_scene(scene, options);
   const DifferentialImages dir = renderer.render(camera, make_vpls(scene, 1024), options);
-  const auto relative_error = [&](const Eigen::Vector2f& lo, const Eigen::Vector2f& hi) {
-    const auto pixels = test::floor_pixels(scene, camera, lo, hi);
-    EXPECT_GT(pixels.size(), 8u);
-    const Eigen::Vector3d d_pt = test::mean_over(pt.real_virtual, pixels) - test::mean_over(pt.real, pixels);
-    const Eigen::Vector3d d_dir = test::mean_over(dir.real_virtual, pixels) - test::mean_over(dir.real, pixels);
-    return (d_dir - d_pt).norm() / d_pt.norm();
-  };
-  EXPECT_LT(relative_error({-0.45f, -0.12f}, {-0.25f, 0.12f}), 0.15) << "shadow region";
-  EXPECT_LT(relative_error({0.22f, -0.15f}, {0.45f, 0.15f}), 0.15) << "bleeding region";
+  EXPECT_LT(test::delta_error_on_floor(scene, camera, pt, dir, test::kShadowLo, test::kShadowHi), 0.15) << "shadow region";
+  EXPECT_LT(test::delta_error_on_floor(scene, camera, pt, dir, test::kBleedingLo, test::kBleedingHi), 0.15)
+      << "bleeding region";
 }
 
 TEST_F(DirVkTest, CpuAndGpuBackendsAgreeAndAutoPicksTheCpuOnASoftwareDevice) {

@@ -1,11 +1,14 @@
 #pragma once
 // Small analytic mixed-reality scenes with known answers for the renderer tests.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <utility>
 #include <vector>
 
 #include "relight/core/image.h"
 #include "relight/render/mr_scene.h"
+#include "relight/render/path_tracer.h"
 #include "relight/render/ray_tracer.h"
 #include "relight/render/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
@@ -75,5 +78,33 @@ inline std::vector<std::pair<int, int>> floor_pixels(const MrScene& scene, const
     }
   return pixels;
 }
+
+/// Relative error of the differential image ΔL = L_rv − L_r of `dir` against `reference`,
+/// averaged over the real floor pixels inside [lo, hi] (at least 9 of them are expected).
+inline double delta_error_on_floor(const MrScene& scene, const MrCamera& camera, const DifferentialImages& reference,
+                                   const DifferentialImages& dir, const Eigen::Vector2f& lo, const Eigen::Vector2f& hi) {
+  const auto pixels = floor_pixels(scene, camera, lo, hi);
+  EXPECT_GT(pixels.size(), 8u);
+  const Eigen::Vector3d d_ref = mean_over(reference.real_virtual, pixels) - mean_over(reference.real, pixels);
+  const Eigen::Vector3d d_dir = mean_over(dir.real_virtual, pixels) - mean_over(dir.real, pixels);
+  return (d_dir - d_ref).norm() / d_ref.norm();
+}
+
+/// The view of the cube scenes' floor that the path-tracer comparisons use (48 x 36).
+inline MrCamera comparison_camera() { return camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 48, 36); }
+
+/// The path tracer's L_rv and L_r with `bounces` indirect bounces and no Russian roulette
+/// before them (256 samples per pixel): what DIR with as many bounces estimates.
+inline DifferentialImages reference_images(const MrScene& scene, const MrCamera& camera, int bounces) {
+  PathTracerOptions options;
+  options.max_bounces = bounces;
+  options.roulette_from = 10;
+  return render_reference(scene, camera, 256, options);
+}
+
+/// The floor regions of the cube scenes that the virtual cube changes: its umbra (away from the
+/// light) and its red bleeding (towards the light).
+inline const Eigen::Vector2f kShadowLo{-0.45f, -0.12f}, kShadowHi{-0.25f, 0.12f};
+inline const Eigen::Vector2f kBleedingLo{0.22f, -0.15f}, kBleedingHi{0.45f, 0.15f};
 
 }  // namespace relight::render::test
