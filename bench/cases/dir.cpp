@@ -13,6 +13,10 @@
 // CPU, then G-buffer, shadow maps, ISMs and shading on the GPU), with the GPU time per step.
 // dir/one_vs_two_pass: one render writing L_rv and L_r against two renders of the same
 // renderer writing one each (what a renderer without the differential pass would need).
+// dir/two_bounces_vs_reference: the same comparison at 160x120 against a path tracer with two
+// indirect bounces, for DIR (Vulkan, 256 light samples) with one bounce, with two whose second
+// bounce is ray traced, and with two found by the point-cone method (vpl.h); median of 3 runs.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -153,6 +157,52 @@ bench::Json vs_reference(const bench::Options&) {
                                     {"by_vpl_count", cpu_curve}}}};
 }
 
+bench::Json two_bounces_vs_reference(const bench::Options&) {
+  auto context = vk::try_create_vulkan();
+  if (!context) return {{"skipped", "no Vulkan device"}};
+  const render::MrScene scene = bench_scene();
+  render::MrCamera camera = bench_camera();
+  render::PathTracerOptions pt_options;
+  pt_options.max_bounces = 2;
+  pt_options.seed = 99;
+  const int reference_spp = 256;
+  const render::DifferentialImages reference = render::render_reference(scene, camera, reference_spp, pt_options);
+  const render::RayTracer tracer(scene);
+  render::DirVkOptions vk_options;
+  vk_options.shading.min_distance = 0.05f;
+  render::DirRendererVk renderer(*context, camera.intrinsics.width, camera.intrinsics.height);
+  renderer.set_scene(scene, vk_options);
+  (void)renderer.render(camera, {}, vk_options);  // warm-up: pipelines, buffers
+  bench::Json json{{"renderer", "dir_vulkan"}, {"device", context->device_info().name}, {"light_samples", 256},
+                   {"reference_spp", reference_spp}, {"reference_bounces", 2}};
+  const auto run = [&](int bounces, render::BounceMethod method) {
+    render::VplOptions vpl_options;
+    vpl_options.count = 256;
+    vpl_options.bounces = bounces;
+    vpl_options.bounce_method = method;
+    std::vector<double> ms, vpl_ms;
+    Errors errors;
+    std::size_t vpl_count = 0;
+    for (int repetition = 0; repetition < 3; ++repetition) {
+      const auto start = Clock::now();
+      const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options);
+      vpl_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+      errors = compare(renderer.render(camera, vpls, vk_options), reference);
+      ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+      vpl_count = vpls.size();
+    }
+    std::sort(ms.begin(), ms.end());
+    std::sort(vpl_ms.begin(), vpl_ms.end());
+    return bench::Json{{"ms", ms[1]}, {"vpl_generation_ms", vpl_ms[1]}, {"vpls", vpl_count},
+                       {"delta_rel_error", errors.delta_rel}, {"composite_rmse", errors.composite_rmse}};
+  };
+  json["one_bounce"] = run(1, render::BounceMethod::RayTraced);
+  json["two_bounces_rays"] = run(2, render::BounceMethod::RayTraced);
+  json["two_bounces_cone"] = run(2, render::BounceMethod::PointCone);
+  json["ms"] = json["two_bounces_cone"]["ms"];
+  return json;
+}
+
 render::MrCamera kinect_camera() {
   render::MrCamera camera = bench_camera();
   camera.intrinsics = PinholeIntrinsics{};  // Kinect v1, 640x480
@@ -257,3 +307,4 @@ RELIGHT_BENCH_CASE("dir/gbuffer_640x480", gbuffer_640x480);
 RELIGHT_BENCH_CASE("dir/frame_640x480_64vpl", [](const bench::Options& o) { return frame_640x480(o, 64); });
 RELIGHT_BENCH_CASE("dir/frame_640x480_256vpl", [](const bench::Options& o) { return frame_640x480(o, 256); });
 RELIGHT_BENCH_CASE("dir/one_vs_two_pass", one_vs_two_pass);
+RELIGHT_BENCH_CASE("dir/two_bounces_vs_reference", two_bounces_vs_reference);
