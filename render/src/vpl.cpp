@@ -6,8 +6,8 @@
 #include <numbers>
 
 #include "relight/core/error.h"
+#include "relight/render/cone_search.h"
 #include "relight/render/hierarchical_warp.h"
-#include "relight/render/ism.h"
 #include "relight/render/phong_brdf.h"
 #include "relight/render/reflective_shadow_map.h"
 #include "relight/render/sampler.h"
@@ -110,59 +110,27 @@ std::optional<Cone> cone_towards(const BoundingSphere& sphere, const Vec3& from)
   return cone;
 }
 
-/// BounceMethod::PointCone's search: the nearest candidate point of each layer within a cone.
+/// BounceMethod::PointCone's search (cone_search.h) over each layer's points.
 class ConeSearch {
  public:
   ConeSearch(const MrScene& scene, const VplOptions& options)
       : points_(sample_ism_points(scene, {.points_per_vpl = options.cone_points, .pool_factor = 1, .seed = options.seed})),
-        tan_half_(std::tan(options.cone_half_angle_deg * kPi / 180.f)),
-        sin_half_(std::sin(options.cone_half_angle_deg * kPi / 180.f)) {}
+        cone_(options.cone_half_angle_deg) {}
 
-  /// Where the ray from `origin` along `direction` meets the surface of `layer`, as far as the
-  /// points tell: among the points within the cone around it (above the tangent plane of
-  /// `normal` by the cone's angle; near the apex the cone is widened to the points' spacing,
-  /// twice their splat half-size, or a short hop into a corner would find no point inside the
-  /// narrow tip), the one whose tangent plane the ray meets first, if before `max_t`.
+  /// Where the ray meets the surface of `layer` before max_t, if its points tell.
   [[nodiscard]] std::optional<SurfaceHit> nearest(Layer layer, const Vec3& origin, const Vec3& direction,
                                                   const Vec3& normal, float max_t) const {
     const std::vector<IsmPoint>& pool = layer == Layer::Real ? points_.real : points_.virtual_points;
-    const IsmPoint* best = nullptr;
-    float best_t = max_t;
-    for (const IsmPoint& point : pool) {
-      const Vec3 offset = point.position - origin;
-      const float along = offset.dot(direction);
-      if (!(along > 0.f)) continue;
-      const float distance = offset.norm();
-      const float across_squared = std::max(0.f, distance * distance - along * along);
-      const float radius = std::max(tan_half_ * along, 2.f * point.half_size);
-      if (across_squared > radius * radius || offset.dot(normal) < sin_half_ * distance) continue;
-      const float t = plane_depth(point, offset, along, direction);
-      if (!(t < best_t)) continue;
-      best = &point;
-      best_t = t;
-    }
-    if (!best) return std::nullopt;
-    return SurfaceHit{best_t, origin + best_t * direction, best->normal, best->normal, best->material,
+    const ConeHit hit = cone_search(pool, {origin, normal, direction, max_t}, cone_);
+    if (hit.point == ConeHit::kNone) return std::nullopt;
+    const IsmPoint& point = pool[hit.point];
+    return SurfaceHit{hit.t, origin + hit.t * direction, point.normal, point.normal, point.material,
                       layer == Layer::Real};
   }
 
  private:
-  /// The ray's distance to the point's tangent plane. The dissertation's depth test compares the
-  /// points' own distances; in a cone that meets a wall obliquely, the nearest point lies at the
-  /// footprint's near end, up to distance x tan(5°) / sin(elevation) away from where the ray
-  /// lands, which moved bounce light towards its source (0.23 relative error of the 2-bounce
-  /// differential image against the path tracer in DirCpu.TwoBouncesAgreeWithThePathTracer,
-  /// against 0.05 with rays). On a plane every point now gives the ray's exact hit. Where the
-  /// ray grazes the point's plane, or the plane lies behind, the point's own depth stands.
-  static float plane_depth(const IsmPoint& point, const Vec3& offset, float along, const Vec3& direction) {
-    const float facing = direction.dot(point.normal);
-    if (std::fabs(facing) < 0.2f) return along;
-    const float t = offset.dot(point.normal) / facing;
-    return t > 0.f ? t : along;
-  }
-
   IsmPointPools points_;
-  float tan_half_, sin_half_;
+  ConeShape cone_;
 };
 
 class VplTracer {

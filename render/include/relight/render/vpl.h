@@ -20,18 +20,14 @@
 // direction lands is found by a ray (BounceMethod::RayTraced) or, as in the dissertation's
 // GPU-friendly multi-bounce method (§5.2.7), among surface points (BounceMethod::PointCone):
 // area-uniform points on the real and on the virtual surfaces (sample_ism_points) are the
-// candidates, those within `cone_half_angle_deg` of the direction (widened near the apex to the
-// points' spacing; and above the VPL's tangent plane by the cone's angle, so that its own
-// surface does not catch a grazing direction) compete, and the nearest wins, per layer, with the
-// same two-world rule as a ray: a virtual candidate nearer than the real one takes the
-// real+virtual flags and the real one the real-only flags. "Nearest" is the ray's distance to
-// the candidate's tangent plane, and the VPL lies where the ray meets that plane, with the
-// candidate's normal and material (the dissertation compares the points' own distances, which
-// moves the hit to the near end of the cone's footprint; see ConeSearch in vpl.cpp).
-// No ray tracer is needed beyond the first bounce, and the search is a min-reduction over
-// points, which a GPU does with an atomic min. A direction whose cone holds no point ends the
-// path (a ray would have found a surface there), so sparse points lose energy: the pool must
-// hold enough points that a cone's footprint at the scene's distances covers several.
+// candidates, those within `cone_half_angle_deg` of the direction compete and the nearest wins
+// (cone_search.h has the exact rules), per layer, with the same two-world rule as a ray: a
+// virtual candidate nearer than the real one takes the real+virtual flags and the real one the
+// real-only flags. No ray tracer is needed beyond the first bounce, and the search is a
+// min-reduction over points, which a GPU does in one work group per query (cone_search_vk.h).
+// A direction whose cone holds no point ends the path (a ray would have found a surface there),
+// so sparse points lose energy: the pool must hold enough points that a cone's footprint at the
+// scene's distances covers several.
 //
 // Virtual focus: the differential image lives where virtual objects reflect or block light, and
 // they are small, so uniformly spread light samples put few VPLs on them. A share of each light's
