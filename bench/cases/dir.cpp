@@ -15,12 +15,14 @@
 // renderer writing one each (what a renderer without the differential pass would need).
 // dir/two_bounces_vs_reference: the same comparison at 160x120 against a path tracer with two
 // indirect bounces, for DIR (Vulkan, 256 light samples) with one bounce, with two whose second
-// bounce is ray traced, and with two found by the point-cone method (vpl.h); median of 3 runs.
+// bounce is ray traced, and with two found by the point-cone method (vpl.h), its search on the
+// CPU and on Vulkan (cone_search_vk.h); median of 3 runs.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 
 #include "bench.h"
+#include "relight/render/cone_search_vk.h"
 #include "relight/render/dir_cpu.h"
 #include "relight/render/dir_vk.h"
 #include "relight/render/gbuffer_vk.h"
@@ -175,7 +177,8 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
   (void)renderer.render(camera, {}, vk_options);  // warm-up: pipelines, buffers
   bench::Json json{{"renderer", "dir_vulkan"}, {"device", context->device_info().name}, {"light_samples", 256},
                    {"reference_spp", reference_spp}, {"reference_bounces", 2}};
-  const auto run = [&](int bounces, render::BounceMethod method) {
+  render::ConeSearchVk cone_search(*context);
+  const auto run = [&](int bounces, render::BounceMethod method, render::ConeSearchVk* gpu = nullptr) {
     render::VplOptions vpl_options;
     vpl_options.count = 256;
     vpl_options.bounces = bounces;
@@ -185,7 +188,7 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
     std::size_t vpl_count = 0;
     for (int repetition = 0; repetition < 3; ++repetition) {
       const auto start = Clock::now();
-      const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options);
+      const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options, gpu);
       vpl_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
       errors = compare(renderer.render(camera, vpls, vk_options), reference);
       ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
@@ -199,7 +202,8 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
   json["one_bounce"] = run(1, render::BounceMethod::RayTraced);
   json["two_bounces_rays"] = run(2, render::BounceMethod::RayTraced);
   json["two_bounces_cone"] = run(2, render::BounceMethod::PointCone);
-  json["ms"] = json["two_bounces_cone"]["ms"];
+  json["two_bounces_cone_search_on_vulkan"] = run(2, render::BounceMethod::PointCone, &cone_search);
+  json["ms"] = json["two_bounces_cone_search_on_vulkan"]["ms"];
   return json;
 }
 

@@ -42,7 +42,7 @@ MrCamera frame_camera(const FrameInfo& frame, int width, int height) {
 void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneContent content,
                     const DirStageOptions& options) {
   graph.emplace<MrSceneStage>(std::move(content), options);
-  graph.emplace<VplStage>(options.vpls);
+  graph.emplace<VplStage>(options.vpls, context);
   graph.emplace<DirRenderStage>(context, options.renderer);
   graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
   graph.emplace<DifferentialCompositeStage>(options.tone_map);
@@ -85,6 +85,13 @@ void MrSceneStage::run(StageContext& context) {
 
 // ---- vpls --------------------------------------------------------------------------------------
 
+VplStage::VplStage(VplOptions options, vk::VulkanContext* context) : options_(std::move(options)) {
+  if (context && options_.bounces > 1 && options_.bounce_method == BounceMethod::PointCone)
+    cone_search_ = std::make_unique<ConeSearchVk>(*context);
+}
+
+VplStage::~VplStage() = default;
+
 void VplStage::declare(StageBuilder& builder) {
   scene_ = builder.read<MrScene>("mr_scene");
   if (options_.budget == VplBudget::ByPreviousFlux) previous_ = builder.read_previous<VplSet>("vpls");
@@ -97,7 +104,8 @@ void VplStage::run(StageContext& context) {
     const VplSet* previous = context.get(previous_);
     options_.previous_flux = previous ? vpl_flux_per_light(previous->vpls, scene.lights.size()) : std::vector<double>{};
   }
-  context.get(vpls_).vpls = generate_vpls(scene, RayTracer(scene, RayTracer::Build::Fast), options_);
+  context.get(vpls_).vpls =
+      generate_vpls(scene, RayTracer(scene, RayTracer::Build::Fast), options_, cone_search_.get());
 }
 
 // ---- dir ---------------------------------------------------------------------------------------

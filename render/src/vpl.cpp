@@ -4,9 +4,11 @@
 #include <bit>
 #include <cmath>
 #include <numbers>
+#include <utility>
 
 #include "relight/core/error.h"
 #include "relight/render/cone_search.h"
+#include "relight/render/cone_search_vk.h"
 #include "relight/render/hierarchical_warp.h"
 #include "relight/render/phong_brdf.h"
 #include "relight/render/reflective_shadow_map.h"
@@ -110,34 +112,70 @@ std::optional<Cone> cone_towards(const BoundingSphere& sphere, const Vec3& from)
   return cone;
 }
 
-/// BounceMethod::PointCone's search (cone_search.h) over each layer's points.
+/// A continued path segment waiting for the point-cone search of its bounce.
+struct PendingSegment {
+  Vec3 origin, normal, direction, flux;
+  bool in_real_virtual = true, in_real = true;
+  int bounce = 2;
+  std::uint32_t light = 0, parent = Vpl::kNoParent;
+  Pcg32 rng;
+};
+
+/// BounceMethod::PointCone's search (cone_search.h) over each layer's points, for all segments
+/// of one bounce at once: on the GPU when there is one, else on the CPU.
 class ConeSearch {
  public:
-  ConeSearch(const MrScene& scene, const VplOptions& options)
+  ConeSearch(const MrScene& scene, const VplOptions& options, ConeSearchVk* gpu)
       : points_(sample_ism_points(scene, {.points_per_vpl = options.cone_points, .pool_factor = 1, .seed = options.seed})),
-        cone_(options.cone_half_angle_deg) {}
+        half_angle_deg_(options.cone_half_angle_deg),
+        gpu_(gpu) {}
 
-  /// Where the ray meets the surface of `layer` before max_t, if its points tell.
-  [[nodiscard]] std::optional<SurfaceHit> nearest(Layer layer, const Vec3& origin, const Vec3& direction,
-                                                  const Vec3& normal, float max_t) const {
-    const std::vector<IsmPoint>& pool = layer == Layer::Real ? points_.real : points_.virtual_points;
-    const ConeHit hit = cone_search(pool, {origin, normal, direction, max_t}, cone_);
-    if (hit.point == ConeHit::kNone) return std::nullopt;
-    const IsmPoint& point = pool[hit.point];
-    return SurfaceHit{hit.t, origin + hit.t * direction, point.normal, point.normal, point.material,
-                      layer == Layer::Real};
+  struct Hits {
+    std::optional<SurfaceHit> real, virtual_hit;  ///< the virtual one only when nearer
+  };
+
+  [[nodiscard]] std::vector<Hits> resolve(const std::vector<PendingSegment>& segments) const {
+    std::vector<ConeQuery> queries;
+    queries.reserve(segments.size());
+    for (const PendingSegment& s : segments) queries.push_back({s.origin, s.normal, s.direction});
+    const std::vector<ConeHit> real = search(points_.real, queries);
+    for (std::size_t i = 0; i < queries.size(); ++i) queries[i].max_t = real[i].t;
+    const std::vector<ConeHit> virtual_hits = search(points_.virtual_points, queries);
+    std::vector<Hits> hits(segments.size());
+    for (std::size_t i = 0; i < segments.size(); ++i) {
+      hits[i].real = surface_hit(points_.real, segments[i], real[i], true);
+      hits[i].virtual_hit = surface_hit(points_.virtual_points, segments[i], virtual_hits[i], false);
+    }
+    return hits;
   }
 
  private:
+  [[nodiscard]] std::vector<ConeHit> search(const std::vector<IsmPoint>& points,
+                                            const std::vector<ConeQuery>& queries) const {
+    if (!gpu_ || points.empty()) return cone_search_cpu(points, queries, half_angle_deg_);
+    gpu_->set_points(points);
+    return gpu_->search(queries, half_angle_deg_);
+  }
+
+  static std::optional<SurfaceHit> surface_hit(const std::vector<IsmPoint>& points, const PendingSegment& segment,
+                                               const ConeHit& hit, bool real) {
+    if (hit.point == ConeHit::kNone) return std::nullopt;
+    const IsmPoint& point = points[hit.point];
+    return SurfaceHit{hit.t, segment.origin + hit.t * segment.direction, point.normal, point.normal, point.material,
+                      real};
+  }
+
   IsmPointPools points_;
-  ConeShape cone_;
+  float half_angle_deg_;
+  ConeSearchVk* gpu_;
 };
 
 class VplTracer {
  public:
-  VplTracer(const MrScene& scene, const RayTracer& tracer, const VplOptions& options, std::vector<Vpl>& out)
+  VplTracer(const MrScene& scene, const RayTracer& tracer, const VplOptions& options, std::vector<Vpl>& out,
+            ConeSearchVk* gpu)
       : scene_(scene), tracer_(tracer), options_(options), out_(out) {
-    if (options.bounces > 1 && options.bounce_method == BounceMethod::PointCone) cone_.emplace(scene, options);
+    if (options.bounces > 1 && options.bounce_method == BounceMethod::PointCone) cone_.emplace(scene, options, gpu);
   }
 
   /// The primary light whose paths the following emit() calls follow.
@@ -145,42 +183,45 @@ class VplTracer {
 
   /// Follows one light path segment and records the VPL(s) it ends in.
   void emit(const Vec3& origin, const Vec3& direction, const Vec3& flux, bool in_real_virtual, bool in_real, int bounce,
-            Pcg32& rng) {
+            Pcg32& rng, std::uint32_t parent = Vpl::kNoParent) {
     if (flux.maxCoeff() <= 0.f || (!in_real_virtual && !in_real)) return;
     const std::optional<SurfaceHit> real = tracer_.intersect(Layer::Real, origin, direction);
     const std::optional<SurfaceHit> virtual_hit =
         tracer_.intersect(Layer::Virtual, origin, direction, real ? real->t : std::numeric_limits<float>::infinity());
-    record(real, virtual_hit, direction, flux, in_real_virtual, in_real, bounce, rng);
+    record(real, virtual_hit, direction, flux, in_real_virtual, in_real, bounce, rng, parent);
   }
 
-  /// emit() with the hits found by the cone search from a VPL at `origin` with `normal`.
-  void emit_cone(const Vec3& origin, const Vec3& normal, const Vec3& direction, const Vec3& flux, bool in_real_virtual,
-                 bool in_real, int bounce, Pcg32& rng) {
-    if (flux.maxCoeff() <= 0.f || (!in_real_virtual && !in_real)) return;
-    constexpr float kUnbounded = std::numeric_limits<float>::infinity();
-    const std::optional<SurfaceHit> real = cone_->nearest(Layer::Real, origin, direction, normal, kUnbounded);
-    const std::optional<SurfaceHit> virtual_hit =
-        cone_->nearest(Layer::Virtual, origin, direction, normal, real ? real->t : kUnbounded);
-    record(real, virtual_hit, direction, flux, in_real_virtual, in_real, bounce, rng);
+  /// BounceMethod::PointCone: resolves the waiting segments bounce by bounce until none is left.
+  void finish() {
+    while (!pending_.empty()) {
+      const std::vector<PendingSegment> segments = std::exchange(pending_, {});
+      const std::vector<ConeSearch::Hits> hits = cone_->resolve(segments);
+      for (std::size_t i = 0; i < segments.size(); ++i) {
+        PendingSegment s = segments[i];
+        light_ = s.light;
+        record(hits[i].real, hits[i].virtual_hit, s.direction, s.flux, s.in_real_virtual, s.in_real, s.bounce, s.rng,
+               s.parent);
+      }
+    }
   }
 
   /// The VPL(s) a path segment ends in, given what it reached in each layer (the virtual hit
   /// only when nearer than the real one).
   void record(const std::optional<SurfaceHit>& real, const std::optional<SurfaceHit>& virtual_hit, const Vec3& direction,
-              const Vec3& flux, bool in_real_virtual, bool in_real, int bounce, Pcg32& rng) {
+              const Vec3& flux, bool in_real_virtual, bool in_real, int bounce, Pcg32& rng, std::uint32_t parent) {
     if (virtual_hit) {
       // The two worlds part here: the virtual surface is lit with the virtual objects present,
       // the real surface behind it only without them.
-      add(*virtual_hit, direction, flux, in_real_virtual, false, bounce, rng);
-      if (real) add(*real, direction, flux, false, in_real, bounce, rng);
+      add(*virtual_hit, direction, flux, in_real_virtual, false, bounce, rng, parent);
+      if (real) add(*real, direction, flux, false, in_real, bounce, rng, parent);
     } else if (real) {
-      add(*real, direction, flux, in_real_virtual, in_real, bounce, rng);
+      add(*real, direction, flux, in_real_virtual, in_real, bounce, rng, parent);
     }
   }
 
   /// Records a VPL at `hit`, lit along `direction`, and continues its path.
   void add(const SurfaceHit& hit, const Vec3& direction, const Vec3& flux, bool in_real_virtual, bool in_real, int bounce,
-           Pcg32& rng) {
+           Pcg32& rng, std::uint32_t parent = Vpl::kNoParent) {
     if (!in_real_virtual && !in_real) return;
     Vpl vpl;
     vpl.position = hit.point;
@@ -195,6 +236,8 @@ class VplTracer {
     vpl.in_real = in_real;
     vpl.bounce = bounce;
     vpl.light = light_;
+    vpl.parent = parent;
+    const auto index = static_cast<std::uint32_t>(out_.size());
     out_.push_back(vpl);
     if (bounce >= options_.bounces) return;
     // Continue the light path by sampling the VPL's BRDF (reciprocity: wo = where light came from).
@@ -203,11 +246,14 @@ class VplTracer {
     if (!sample || sample->wi.dot(geometric) <= 0.f) return;
     const Vec3 next_flux = flux.cwiseProduct(sample->weight);
     if (cone_) {
-      emit_cone(vpl.position, geometric, sample->wi, next_flux, vpl.in_real_virtual, vpl.in_real, bounce + 1, rng);
+      if (next_flux.maxCoeff() > 0.f)
+        pending_.push_back({vpl.position, geometric, sample->wi, next_flux, vpl.in_real_virtual, vpl.in_real, bounce + 1,
+                            light_, index, rng});
       return;
     }
     const float offset = 1e-4f * (1.f + vpl.position.cwiseAbs().maxCoeff());
-    emit(vpl.position + offset * geometric, sample->wi, next_flux, vpl.in_real_virtual, vpl.in_real, bounce + 1, rng);
+    emit(vpl.position + offset * geometric, sample->wi, next_flux, vpl.in_real_virtual, vpl.in_real, bounce + 1, rng,
+         index);
   }
 
  private:
@@ -217,6 +263,7 @@ class VplTracer {
   std::vector<Vpl>& out_;
   std::uint32_t light_ = 0;
   std::optional<ConeSearch> cone_;
+  std::vector<PendingSegment> pending_;
 };
 
 double power_weight(const MrLight& light, const BoundingSphere& bounds) {
@@ -369,7 +416,8 @@ std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t
   return flux;
 }
 
-std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options) {
+std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options,
+                               ConeSearchVk* gpu) {
   if (options.count < 0) throw Error("the VPL count must not be negative");
   if (options.bounces < 1) throw Error("VPLs need at least one bounce");
   if (options.bounce_method == BounceMethod::PointCone &&
@@ -380,7 +428,7 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
       (options.rsm_size < 1 || options.rsm_size > 4096 || !std::has_single_bit(static_cast<unsigned>(options.rsm_size))))
     throw Error("the RSM size must be a power of two in [1, 4096]");
   std::vector<Vpl> vpls;
-  VplTracer vpl_tracer(scene, tracer, options, vpls);
+  VplTracer vpl_tracer(scene, tracer, options, vpls, gpu);
   if (options.virtual_share < 0.f || options.virtual_share >= 1.f) throw Error("the virtual VPL share must be in [0, 1)");
   const BoundingSphere bounds = bounding_sphere(scene);
   const std::vector<int> budget = light_budget(scene, bounds, options);
@@ -418,6 +466,7 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
                       light.real, 1, rng);
     }
   }
+  vpl_tracer.finish();
   return vpls;
 }
 

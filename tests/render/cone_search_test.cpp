@@ -12,6 +12,10 @@
 #include "relight/core/error.h"
 #include "relight/render/cone_search_vk.h"
 #include "relight/render/phong_brdf.h"
+#include "relight/render/procedural_models.h"
+#include "relight/render/ray_tracer.h"
+#include "relight/render/virtual_model.h"
+#include "relight/render/vpl.h"
 #include "relight/render/sampler.h"
 #include "relight/render/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
@@ -86,6 +90,34 @@ TEST_F(ConeSearchVkTest, MatchesTheCpuOnTheSceneSurfacePoints) {
   EXPECT_GT(hits, 150);  // not an empty comparison (measured 196 of 300; every fifth query stops at 1 m)
   EXPECT_GE(same, 297) << "the same winner for all but depth ties within rounding";
   EXPECT_THROW((void)gpu.search(queries, 90.f), Error);
+}
+
+// Second bounces by the point cone with the search on the GPU equal those with the CPU search
+// (the same paths resolved in the same order), on the indoor scene with the pebble.
+TEST_F(ConeSearchVkTest, VplsFromTheGpuSearchEqualTheCpuOnes) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  MrScene scene = scene_from_synth(synth::default_indoor_scene());
+  add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
+  const RayTracer tracer(scene, RayTracer::Build::Fast);
+  VplOptions options;
+  options.count = 256;
+  options.bounces = 2;
+  options.bounce_method = BounceMethod::PointCone;
+  const std::vector<Vpl> cpu = generate_vpls(scene, tracer, options);
+  ConeSearchVk gpu_search(context);
+  const std::vector<Vpl> gpu = generate_vpls(scene, tracer, options, &gpu_search);
+  ASSERT_EQ(gpu.size(), cpu.size());
+  int second = 0, same = 0;
+  for (std::size_t i = 0; i < cpu.size(); ++i) {
+    if (cpu[i].bounce != 2) continue;
+    ++second;
+    same += (gpu[i].position - cpu[i].position).norm() < 1e-4f && gpu[i].in_real == cpu[i].in_real &&
+                    gpu[i].in_real_virtual == cpu[i].in_real_virtual
+                ? 1
+                : 0;
+  }
+  EXPECT_GT(second, 100);
+  EXPECT_GE(same, second - second / 50);
 }
 
 }  // namespace

@@ -301,28 +301,41 @@ TEST(Vpls, ConeBounceLandsNearTheRayTracedHit) {
   const std::vector<Vpl> rays = generate_vpls(scene, tracer, options);
   options.bounce_method = BounceMethod::PointCone;
   const std::vector<Vpl> cones = generate_vpls(scene, tracer, options);
-  // Pair the paths: each starts with its first-bounce VPL, identical in both lists.
+  // Pair the paths by their first-bounce VPL (the k-th one of each list; they are identical).
+  const auto second_bounce_by_path = [](const std::vector<Vpl>& vpls) {
+    std::vector<std::uint32_t> path_of(vpls.size(), 0);
+    std::vector<const Vpl*> second;
+    for (std::size_t i = 0; i < vpls.size(); ++i) {
+      if (vpls[i].bounce == 1) {
+        EXPECT_EQ(vpls[i].parent, Vpl::kNoParent);
+        path_of[i] = static_cast<std::uint32_t>(second.size());
+        second.push_back(nullptr);
+      } else {
+        EXPECT_EQ(vpls[vpls[i].parent].bounce, 1);
+        second[path_of[vpls[i].parent]] = &vpls[i];
+      }
+    }
+    return second;
+  };
+  const std::vector<const Vpl*> by_ray = second_bounce_by_path(rays), by_cone = second_bounce_by_path(cones);
+  ASSERT_EQ(by_ray.size(), by_cone.size());
+  const int paths = static_cast<int>(by_ray.size());
+  int ended = 0;
   std::vector<double> offsets;
   Eigen::Vector3d ray_flux = Eigen::Vector3d::Zero(), cone_flux = Eigen::Vector3d::Zero();
-  int paths = 0, ended = 0;
-  for (std::size_t i = 0, j = 0; i < rays.size(); ++i, ++j) {
-    ASSERT_LT(j, cones.size());
-    ASSERT_EQ(rays[i].bounce, 1);
-    ASSERT_EQ(cones[j].bounce, 1);
-    ASSERT_TRUE(rays[i].position == cones[j].position);
-    ++paths;
-    if (i + 1 == rays.size() || rays[i + 1].bounce != 2) continue;
-    ++i;
-    const float distance = (rays[i].position - rays[i - 1].position).norm();  // from its first-bounce VPL
-    ray_flux += rays[i].flux.cast<double>();
-    if (j + 1 == cones.size() || cones[j + 1].bounce != 2) {
+  for (int k = 0; k < paths; ++k) {
+    const Vpl* ray = by_ray[static_cast<std::size_t>(k)];
+    const Vpl* cone = by_cone[static_cast<std::size_t>(k)];
+    if (!ray) continue;
+    ray_flux += ray->flux.cast<double>();
+    if (!cone) {
       ++ended;
       continue;
     }
-    ++j;
-    offsets.push_back((cones[j].position - rays[i].position).norm() / distance);
-    cone_flux += cones[j].flux.cast<double>();
-    EXPECT_GT(cones[j].normal.dot(cones[j].incident), 0.f);
+    const float distance = (ray->position - rays[ray->parent].position).norm();
+    offsets.push_back((cone->position - ray->position).norm() / distance);
+    cone_flux += cone->flux.cast<double>();
+    EXPECT_GT(cone->normal.dot(cone->incident), 0.f);
   }
   ASSERT_EQ(paths, 400);
   std::printf("paths %d, no point in the cone %d\n", paths, ended);

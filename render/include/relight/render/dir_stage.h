@@ -45,6 +45,7 @@
 #include "relight/colormap/tone_map.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/render/cone_search_vk.h"
 #include "relight/render/depth_mesh.h"
 #include "relight/render/dir_vk.h"
 #include "relight/render/temporal_smoothing.h"
@@ -94,16 +95,19 @@ class MrSceneStage final : public Stage {
   Write<MrScene> scene_;
 };
 
-/// Step 2 (primary lights and VPLs).
+/// Step 2 (primary lights and VPLs). With a Vulkan context (may be null) and
+/// BounceMethod::PointCone, the cone searches of bounces >= 2 run on the GPU.
 class VplStage final : public Stage {
  public:
-  explicit VplStage(VplOptions options) : options_(std::move(options)) {}
+  explicit VplStage(VplOptions options, vk::VulkanContext* context = nullptr);
+  ~VplStage() override;
   [[nodiscard]] std::string name() const override { return "vpls"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
  private:
   VplOptions options_;
+  std::unique_ptr<ConeSearchVk> cone_search_;
   Read<MrScene> scene_;
   ReadPrevious<VplSet> previous_;
   Write<VplSet> vpls_;

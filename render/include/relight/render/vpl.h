@@ -59,6 +59,8 @@ struct Vpl {
   bool in_real = true;
   int bounce = 1;  ///< 1 = lit directly by a primary light
   std::uint32_t light = 0;  ///< index of the primary light (MrScene::lights) the path started at
+  static constexpr std::uint32_t kNoParent = 0xffffffffu;
+  std::uint32_t parent = kNoParent;  ///< index (in the generated list) of the VPL this one continues
 };
 
 /// How the `count` light samples are shared among the lights (dissertation §5.2.3). Whatever the
@@ -111,13 +113,20 @@ struct VplSet {
   static constexpr const char* type_name = "VplSet";
 };
 
+class ConeSearchVk;
+
 /// Per light of the scene, the luminance of the flux its first-bounce VPLs carry (the input of
 /// VplBudget::ByPreviousFlux for the next frame).
 [[nodiscard]] std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t light_count);
 
 /// VPLs of every light of `scene`. A directional light (the environment lights of the light-
 /// extraction stage) shoots parallel rays from a disk facing it that covers the scene's bounding
-/// sphere, each carrying irradiance x disk area / samples.
-[[nodiscard]] std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options);
+/// sphere, each carrying irradiance x disk area / samples. Ray-traced bounces follow each path to
+/// its end before the next (a VPL's continuations come right after it); BounceMethod::PointCone
+/// resolves all paths of one bounce together, one search per layer, on `gpu` when given (its
+/// points are replaced), so the list holds all first bounces, then all second bounces, and so
+/// on. Vpl::parent links them either way.
+[[nodiscard]] std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options,
+                                             ConeSearchVk* gpu = nullptr);
 
 }  // namespace relight::render
