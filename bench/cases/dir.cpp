@@ -107,17 +107,23 @@ bench::Json vpl_curve(const render::MrScene& scene, const render::DifferentialIm
   return curve;
 }
 
+constexpr int kReferenceSpp = 256;
+
+/// The path tracer's images with `bounces` indirect bounces, kReferenceSpp samples per pixel.
+render::DifferentialImages reference_images(const render::MrScene& scene, const render::MrCamera& camera, int bounces) {
+  render::PathTracerOptions options;
+  options.max_bounces = bounces;
+  options.seed = 99;
+  return render::render_reference(scene, camera, kReferenceSpp, options);
+}
+
 bench::Json vs_reference(const bench::Options&) {
   auto context = vk::try_create_vulkan();
   if (!context) return {{"skipped", "no Vulkan device"}};
   const render::MrScene scene = bench_scene();
   render::MrCamera camera = bench_camera();
   camera.intrinsics = PinholeIntrinsics{525.0, 525.0, 159.5, 119.5, 320, 240};  // bench_camera() at twice the size
-  render::PathTracerOptions pt_options;
-  pt_options.max_bounces = 1;
-  pt_options.seed = 99;
-  const int reference_spp = 256;
-  const render::DifferentialImages reference = render::render_reference(scene, camera, reference_spp, pt_options);
+  const render::DifferentialImages reference = reference_images(scene, camera, 1);
 
   const render::RayTracer tracer(scene);
   render::DirOptions cpu_options;
@@ -138,6 +144,8 @@ bench::Json vs_reference(const bench::Options&) {
   }, vk_256);
 
   // The path tracer with the Vulkan renderer's (256 light samples) wall time.
+  render::PathTracerOptions pt_options;
+  pt_options.max_bounces = 1;
   pt_options.seed = 7;
   render::DifferentialPathTracer pt(scene, pt_options);
   pt.reset(camera);
@@ -151,7 +159,7 @@ bench::Json vs_reference(const bench::Options&) {
           {"pt_equal_time_rmse", pt_errors.composite_rmse},
           {"pt_equal_time_spp", pt.samples_done()},
           {"pt_equal_time_delta_rel_error", pt_errors.delta_rel},
-          {"reference_spp", reference_spp},
+          {"reference_spp", kReferenceSpp},
           {"by_vpl_count", vk_curve},
           {"cpu_exact_visibility", {{"ms", cpu_256.ms},
                                     {"delta_rel_error", cpu_256.errors.delta_rel},
@@ -164,11 +172,7 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
   if (!context) return {{"skipped", "no Vulkan device"}};
   const render::MrScene scene = bench_scene();
   render::MrCamera camera = bench_camera();
-  render::PathTracerOptions pt_options;
-  pt_options.max_bounces = 2;
-  pt_options.seed = 99;
-  const int reference_spp = 256;
-  const render::DifferentialImages reference = render::render_reference(scene, camera, reference_spp, pt_options);
+  const render::DifferentialImages reference = reference_images(scene, camera, 2);
   const render::RayTracer tracer(scene);
   render::DirVkOptions vk_options;
   vk_options.shading.min_distance = 0.05f;
@@ -176,7 +180,7 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
   renderer.set_scene(scene, vk_options);
   (void)renderer.render(camera, {}, vk_options);  // warm-up: pipelines, buffers
   bench::Json json{{"renderer", "dir_vulkan"}, {"device", context->device_info().name}, {"light_samples", 256},
-                   {"reference_spp", reference_spp}, {"reference_bounces", 2}};
+                   {"reference_spp", kReferenceSpp}, {"reference_bounces", 2}};
   render::ConeSearchVk cone_search(*context);
   const auto run = [&](int bounces, render::BounceMethod method, render::ConeSearchVk* gpu = nullptr) {
     render::VplOptions vpl_options;
