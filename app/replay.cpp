@@ -19,10 +19,13 @@
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
 #include "relight/core/progress.h"
+#include "relight/reconstruct/cross_normals_vk.h"
 #include "relight/reconstruct/depth_box_filter.h"
 #include "relight/reconstruct/depth_warp_merge.h"
+#include "relight/reconstruct/depth_warp_merge_vk.h"
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
+#include "relight/reconstruct/normals_raw_depth_vk.h"
 #include "relight/vk/backend.h"
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
@@ -290,11 +293,18 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   const std::int64_t total_frames = source->size_hint();
   graph.emplace<SourceStage>(std::move(source));
   graph.add(make_depth_box_filter_stage(per_pixel, pipeline.vulkan.get()));
-  // Geometry (positions + normals) runs on the CPU: its Vulkan versions are not written yet.
+  // Geometry (positions + normals) follows the per-pixel backend; method 1's
+  // pass-1 pyramid stays on the CPU either way (normals_raw_depth_vk.h).
   const bool method2 = options.geometry == "method2";
-  if (method2) {
+  const bool geometry_on_gpu = per_pixel == Backend::Vulkan && pipeline.vulkan;
+  if (method2 && geometry_on_gpu) {
+    graph.emplace<DepthWarpMergeVkStage>(*pipeline.vulkan);
+    graph.emplace<NormalsFromPositionsVkStage>(*pipeline.vulkan);
+  } else if (method2) {
     graph.emplace<DepthWarpMergeCpuStage>();
     graph.emplace<NormalsFromPositionsCpuStage>();
+  } else if (geometry_on_gpu) {
+    graph.emplace<NormalsRawDepthVkStage>(*pipeline.vulkan);
   } else {
     graph.emplace<NormalsRawDepthCpuStage>();
   }

@@ -14,7 +14,8 @@
 // the CPU; "ms" is one frame end to end (pyramid, buffer allocation, uploads, three dispatches,
 // downloads), "gpu_ms" the dispatches alone (timestamp queries), "gpu_passes" names what ran
 // on the GPU.
-// normals/method2_vulkan is not implemented yet.
+// normals/method2_vulkan: method 2 on the GPU (DepthWarpMergeVk: warp by compute scatter and
+// merge; CrossNormalsVk: positions and stride-1 normals), the same fields as method1_vulkan.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -23,7 +24,9 @@
 
 #include "bench.h"
 #include "relight/core/error.h"
+#include "relight/reconstruct/cross_normals_vk.h"
 #include "relight/reconstruct/depth_warp_merge.h"
+#include "relight/reconstruct/depth_warp_merge_vk.h"
 #include "relight/reconstruct/normal_error.h"
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
@@ -257,6 +260,44 @@ Json method2_cpu(const bench::Options& options) {
   return json;
 }
 
+Json method2_vulkan(const bench::Options& options) {
+  std::string why;
+  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);  // no validation in timings
+  if (!context) throw Error("no Vulkan device: " + why);
+  const BenchSequence& s = sequence();
+  DepthWarpMergeVk warp_merge(*context);
+  CrossNormalsVk cross(*context);
+  std::vector<double> gpu_ms;
+  DepthMap filtered, merged;
+  DepthWeightMap weight, merged_weight;
+  PositionMap positions;
+  NormalMap normals;
+  const auto frame = [&](const DepthMap& depth, bool history) {
+    warp_merge.run(depth, history ? &filtered : nullptr, history ? &weight : nullptr, s.intrinsics, Pose::Identity(), {},
+                   merged, merged_weight);
+    cross.run(merged, s.intrinsics, {}, positions, normals);
+    if (warp_merge.last_gpu_ms() && cross.last_gpu_ms()) gpu_ms.push_back(*warp_merge.last_gpu_ms() + *cross.last_gpu_ms());
+  };
+  for (int i = 0; i < kFrames; ++i) {
+    frame(s.noisy[static_cast<std::size_t>(i)], i > 0);
+    filtered = merged;
+    weight = merged_weight;
+  }
+  const AngularError error = angular_error(normals, s.truth);
+  const NormalMap evaluated = normals;  // the timed frames below overwrite `normals`
+  gpu_ms.clear();
+  Json json = compare_with_pcl([&] { frame(s.noisy.back(), true); }, evaluated, options);
+  json["angular_error_deg"] = error.mean_deg;
+  json["coverage"] = error.coverage;
+  std::sort(gpu_ms.begin(), gpu_ms.end());
+  json["gpu_ms"] = gpu_ms.empty() ? -1.0 : gpu_ms[gpu_ms.size() / 2];  // -1: no timestamp queries
+  json["device"] = context->device_info().name;
+  json["device_type"] = vk::to_string(context->device_info().type);
+  json["gpu_passes"] = "warp (z-buffer clear, depth scatter by atomic min, weight scatter), merge, positions + "
+                       "stride-1 cross products";
+  return json;
+}
+
 #ifdef RELIGHT_HAVE_PCL
 Json pcl_omp(const bench::Options& options) {
   const BenchSequence& s = sequence();
@@ -296,6 +337,7 @@ Json pcl_omp(const bench::Options& options) {
 RELIGHT_BENCH_CASE("normals/method1_cpu", method1_cpu);
 RELIGHT_BENCH_CASE("normals/method1_vulkan", method1_vulkan);
 RELIGHT_BENCH_CASE("normals/method2_cpu", method2_cpu);
+RELIGHT_BENCH_CASE("normals/method2_vulkan", method2_vulkan);
 #ifdef RELIGHT_HAVE_PCL
 RELIGHT_BENCH_CASE("normals/pcl_omp", pcl_omp);
 #endif

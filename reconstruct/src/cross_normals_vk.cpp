@@ -81,4 +81,17 @@ void CrossNormalsVk::run(const DepthMap& depth, const PinholeIntrinsics& intrins
   transfer.download(normal_buffer, normals.bytes());
 }
 
+void NormalsFromPositionsVkStage::declare(StageBuilder& builder) {
+  depth_ = builder.read<DepthMap>("depth_filtered");
+  frame_ = builder.read<FrameInfo>("frame");
+  positions_ = builder.write<PositionMap>("positions");
+  normals_ = builder.write<NormalMap>("normals");
+}
+
+void NormalsFromPositionsVkStage::run(StageContext& context) {
+  cross_.run(context.get(depth_), context.get(frame_).intrinsics, options_, context.get(positions_),
+             context.get(normals_));
+  if (const auto ms = cross_.last_gpu_ms()) context.report_device_ms(*ms);
+}
+
 }  // namespace relight

@@ -540,7 +540,7 @@ void merge_depth(const DepthMap& depth, const DepthMap& warped, const DepthWeigh
   });
 }
 
-void DepthWarpMergeCpuStage::declare(StageBuilder& builder) {
+void DepthWarpMergeStageBase::declare(StageBuilder& builder) {
   depth_ = builder.read<DepthMap>("depth");
   frame_ = builder.read<FrameInfo>("frame");
   previous_depth_ = builder.read_previous<DepthMap>("depth_filtered");
@@ -550,23 +550,31 @@ void DepthWarpMergeCpuStage::declare(StageBuilder& builder) {
   weight_ = builder.write<DepthWeightMap>("depth_weight");
 }
 
-void DepthWarpMergeCpuStage::run(StageContext& context) {
+void DepthWarpMergeStageBase::run(StageContext& context) {
   const FrameInfo& frame = context.get(frame_);
   const DepthMap* previous_depth = context.get(previous_depth_);
   const DepthWeightMap* previous_weight = context.get(previous_weight_);
   const FrameInfo* previous_frame = context.get(previous_frame_);
   const DepthMap& depth = context.get(depth_);
-  if (previous_depth && previous_weight && previous_depth->same_shape(depth)) {
-    const Pose current = frame.camera_to_world.value_or(Pose::Identity());
-    const Pose previous =
-        previous_frame && previous_frame->camera_to_world ? *previous_frame->camera_to_world : Pose::Identity();
-    warp_depth(*previous_depth, *previous_weight, frame.intrinsics, current.inverse() * previous, options_, warped_,
-               warped_weight_);
+  const bool usable = previous_depth && previous_weight && previous_depth->same_shape(depth);
+  const Pose current = frame.camera_to_world.value_or(Pose::Identity());
+  const Pose previous =
+      previous_frame && previous_frame->camera_to_world ? *previous_frame->camera_to_world : Pose::Identity();
+  warp_and_merge(context, depth, usable ? previous_depth : nullptr, usable ? previous_weight : nullptr,
+                 frame.intrinsics, current.inverse() * previous, context.get(filtered_), context.get(weight_));
+}
+
+void DepthWarpMergeCpuStage::warp_and_merge(StageContext&, const DepthMap& depth, const DepthMap* previous_depth,
+                                            const DepthWeightMap* previous_weight, const PinholeIntrinsics& intrinsics,
+                                            const Pose& current_from_prev, DepthMap& merged,
+                                            DepthWeightMap& merged_weight) {
+  if (previous_depth) {
+    warp_depth(*previous_depth, *previous_weight, intrinsics, current_from_prev, options(), warped_, warped_weight_);
   } else {
     warped_.resize(0, 0);
     warped_weight_.resize(0, 0);
   }
-  merge_depth(depth, warped_, warped_weight_, options_, context.get(filtered_), context.get(weight_));
+  merge_depth(depth, warped_, warped_weight_, options(), merged, merged_weight);
 }
 
 }  // namespace relight

@@ -17,8 +17,12 @@
 #include <memory>
 #include <optional>
 
+#include <string>
+
 #include "relight/core/camera.h"
+#include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
+#include "relight/core/rgbd_frame.h"
 #include "relight/reconstruct/normals_from_positions.h"
 
 namespace relight {
@@ -54,6 +58,26 @@ class CrossNormalsVk {
   vk::VulkanContext& context_;
   std::unique_ptr<Pipeline> pipeline_;
   std::optional<double> last_gpu_ms_;
+};
+
+/// Method 2's normal stage on Vulkan, a drop-in for NormalsFromPositionsCpuStage (same name and
+/// buffers: reads DepthMap "depth_filtered" and FrameInfo "frame", writes PositionMap "positions"
+/// and NormalMap "normals"), on the graph's host buffers with its own upload and download.
+class NormalsFromPositionsVkStage final : public Stage {
+ public:
+  explicit NormalsFromPositionsVkStage(vk::VulkanContext& context, CrossNormalOptions options = {})
+      : cross_(context), options_(options) {}
+  [[nodiscard]] std::string name() const override { return "normals_from_positions"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  CrossNormalsVk cross_;
+  CrossNormalOptions options_;
+  Read<DepthMap> depth_;
+  Read<FrameInfo> frame_;
+  Write<PositionMap> positions_;
+  Write<NormalMap> normals_;
 };
 
 }  // namespace relight

@@ -57,13 +57,23 @@ void warp_depth(const DepthMap& previous_depth, const DepthWeightMap& previous_w
 void merge_depth(const DepthMap& depth, const DepthMap& warped, const DepthWeightMap& warped_weight,
                  const DepthWarpMergeOptions& options, DepthMap& merged, DepthWeightMap& merged_weight);
 
-/// Frame-graph stage of method 2's warp and merge (buffers in the header comment).
-class DepthWarpMergeCpuStage final : public Stage {
+/// What the CPU and Vulkan stages of method 2's warp and merge share: the buffers (header
+/// comment) and how the previous frame's buffers and poses become the warp's inputs (identity
+/// poses when a frame has none; no history when the previous depth is missing or differs in
+/// shape). Subclasses only warp and merge.
+class DepthWarpMergeStageBase : public Stage {
  public:
-  explicit DepthWarpMergeCpuStage(DepthWarpMergeOptions options = {}) : options_(options) {}
-  [[nodiscard]] std::string name() const override { return "depth_warp_merge"; }
-  void declare(StageBuilder& builder) override;
-  void run(StageContext& context) override;
+  explicit DepthWarpMergeStageBase(DepthWarpMergeOptions options) : options_(options) {}
+  [[nodiscard]] std::string name() const final { return "depth_warp_merge"; }
+  void declare(StageBuilder& builder) final;
+  void run(StageContext& context) final;
+
+ protected:
+  /// previous_depth and previous_weight are null without usable history.
+  virtual void warp_and_merge(StageContext& context, const DepthMap& depth, const DepthMap* previous_depth,
+                              const DepthWeightMap* previous_weight, const PinholeIntrinsics& intrinsics,
+                              const Pose& current_from_prev, DepthMap& merged, DepthWeightMap& merged_weight) = 0;
+  [[nodiscard]] const DepthWarpMergeOptions& options() const { return options_; }
 
  private:
   DepthWarpMergeOptions options_;
@@ -74,6 +84,17 @@ class DepthWarpMergeCpuStage final : public Stage {
   ReadPrevious<FrameInfo> previous_frame_;
   Write<DepthMap> filtered_;
   Write<DepthWeightMap> weight_;
+};
+
+/// Frame-graph stage of method 2's warp and merge on the CPU (the reference).
+class DepthWarpMergeCpuStage final : public DepthWarpMergeStageBase {
+ public:
+  explicit DepthWarpMergeCpuStage(DepthWarpMergeOptions options = {}) : DepthWarpMergeStageBase(options) {}
+
+ private:
+  void warp_and_merge(StageContext& context, const DepthMap& depth, const DepthMap* previous_depth,
+                      const DepthWeightMap* previous_weight, const PinholeIntrinsics& intrinsics,
+                      const Pose& current_from_prev, DepthMap& merged, DepthWeightMap& merged_weight) override;
   DepthMap warped_;              // scratch, kept to avoid reallocating every frame
   DepthWeightMap warped_weight_;
 };
