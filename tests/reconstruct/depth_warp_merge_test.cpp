@@ -156,9 +156,10 @@ NormalMap method1_normals(const test::SyntheticSequence& sequence) {
 // Measured (320x240, Kinect v1 noise, 10 static frames): depth RMSE on continuous surfaces raw
 // 18.3 mm -> method 2 6.8 mm (everywhere, edges included: 74.4 -> 72.4 mm, dominated by lateral
 // noise at discontinuities); normals raw 58.7 deg -> method 2 31.2 deg. On flat regions method 1
-// reaches 6.4 deg while method 2's stride-1 normals (the dissertation's equation) stay at 31.3 deg
-// (stride 2/3/4 on the same filtered depth: 17.6/12.2/9.4 deg): the claim "method 2 better than
-// method 1 on flat regions" does NOT hold here and is not asserted.
+// reaches 2.8 deg (6.4 with forward differences) while method 2's stride-1 normals (the
+// dissertation's equation) stay at 31.3 deg (stride 2/3/4 on the same filtered depth:
+// 17.6/12.2/9.4 deg): the claim "method 2 better than method 1 on flat regions" does NOT hold
+// here and is not asserted.
 TEST(DepthWarpMerge, StaticCameraTenFramesCutsDepthRmseAndNormalError) {
   const auto sequence = test::render_sequence(synth::Trajectory::Static, 10);
   const auto& last = sequence.frames.back();
