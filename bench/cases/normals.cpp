@@ -187,6 +187,19 @@ Json method1_cpu(const bench::Options& options) {
   return json;
 }
 
+/// The fields every normals/*_vulkan line adds: the error after 10 frames, the median GPU time
+/// of the dispatches (-1: no timestamp queries), the device and what ran on it.
+void add_vulkan_fields(Json& json, const AngularError& error, std::vector<double>& gpu_ms,
+                       const vk::VulkanContext& context, const char* passes) {
+  json["angular_error_deg"] = error.mean_deg;
+  json["coverage"] = error.coverage;
+  std::sort(gpu_ms.begin(), gpu_ms.end());
+  json["gpu_ms"] = gpu_ms.empty() ? -1.0 : gpu_ms[gpu_ms.size() / 2];
+  json["device"] = context.device_info().name;
+  json["device_type"] = vk::to_string(context.device_info().type);
+  json["gpu_passes"] = passes;
+}
+
 Json method1_vulkan(const bench::Options& options) {
   std::string why;
   auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);  // no validation in timings
@@ -215,14 +228,9 @@ Json method1_vulkan(const bench::Options& options) {
   gpu_ms.clear();
   Json json = compare_with_pcl([&] { frame(s.noisy.back(), &history, scratch_positions, scratch_normals); },
                                normals[last], options);
-  json["angular_error_deg"] = error.mean_deg;
-  json["coverage"] = error.coverage;
-  std::sort(gpu_ms.begin(), gpu_ms.end());
-  json["gpu_ms"] = gpu_ms.empty() ? -1.0 : gpu_ms[gpu_ms.size() / 2];  // -1: no timestamp queries
-  json["device"] = context->device_info().name;
-  json["device_type"] = vk::to_string(context->device_info().type);
-  json["gpu_passes"] = "positions + stride-4 cross products (eq. 4.4-4.6), temporal blend (eq. 4.7-4.8), "
-                       "hole filling; pass 1 pyramid (eq. 4.1-4.3) on the CPU, uploaded";
+  add_vulkan_fields(json, error, gpu_ms, *context,
+                    "positions + stride-4 cross products (eq. 4.4-4.6), temporal blend (eq. 4.7-4.8), "
+                    "hole filling; pass 1 pyramid (eq. 4.1-4.3) on the CPU, uploaded");
   return json;
 }
 
@@ -287,14 +295,9 @@ Json method2_vulkan(const bench::Options& options) {
   const NormalMap evaluated = normals;  // the timed frames below overwrite `normals`
   gpu_ms.clear();
   Json json = compare_with_pcl([&] { frame(s.noisy.back(), true); }, evaluated, options);
-  json["angular_error_deg"] = error.mean_deg;
-  json["coverage"] = error.coverage;
-  std::sort(gpu_ms.begin(), gpu_ms.end());
-  json["gpu_ms"] = gpu_ms.empty() ? -1.0 : gpu_ms[gpu_ms.size() / 2];  // -1: no timestamp queries
-  json["device"] = context->device_info().name;
-  json["device_type"] = vk::to_string(context->device_info().type);
-  json["gpu_passes"] = "warp (z-buffer clear, depth scatter by atomic min, weight scatter), merge, positions + "
-                       "stride-1 cross products";
+  add_vulkan_fields(json, error, gpu_ms, *context,
+                    "warp (z-buffer clear, depth scatter by atomic min, weight scatter), merge, positions + "
+                    "stride-1 cross products");
   return json;
 }
 
