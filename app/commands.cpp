@@ -26,9 +26,18 @@ void add_compute_options(CLI::App& command, ReplayOptions& options) {
                      "(warped and merged depth, normals from its positions)")
       ->check(CLI::IsMember({"method1", "method2"}))
       ->capture_default_str();
+  add_method2_normals_option(command, options);
 }
 
 }  // namespace
+
+void add_method2_normals_option(CLI::App& command, ReplayOptions& options) {
+  command.add_option("--method2-normals", options.method2_normals,
+                     "method2's normals: filtered (method1's temporal filter on the merged depth) or plain "
+                     "(stride-1 cross products of the merged positions)")
+      ->check(CLI::IsMember({"filtered", "plain"}))
+      ->capture_default_str();
+}
 
 void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--object", options.objects, "Virtual object to render into every frame: .obj, .gltf, .glb (repeatable)");

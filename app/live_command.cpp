@@ -262,6 +262,7 @@ void add_live_compute_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--geometry", options.geometry, "normal estimation: method1 or method2 (as in replay)")
       ->check(CLI::IsMember({"method1", "method2"}))
       ->capture_default_str();
+  add_method2_normals_option(command, options);
 }
 
 }  // namespace

@@ -279,6 +279,9 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   if (options.geometry != "method1" && options.geometry != "method2") {
     throw Error("--geometry '" + options.geometry + "' is not one of method1, method2");
   }
+  if (options.method2_normals != "filtered" && options.method2_normals != "plain") {
+    throw Error("--method2-normals '" + options.method2_normals + "' is not one of filtered, plain");
+  }
   const auto policy = vk::parse_backend_policy(options.backend);
   if (!policy) throw Error("--backend '" + options.backend + "' is not one of auto, cpu, vulkan");
   ReplayPipeline pipeline;
@@ -299,14 +302,20 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   const bool geometry_on_gpu = per_pixel == Backend::Vulkan && pipeline.vulkan;
   if (method2 && geometry_on_gpu) {
     graph.emplace<DepthWarpMergeVkStage>(*pipeline.vulkan);
-    graph.emplace<NormalsFromPositionsVkStage>(*pipeline.vulkan);
   } else if (method2) {
     graph.emplace<DepthWarpMergeCpuStage>();
-    graph.emplace<NormalsFromPositionsCpuStage>();
+  }
+  const auto input = method2 ? NormalsDepthInput::Filtered : NormalsDepthInput::Raw;
+  if (method2 && options.method2_normals == "plain") {
+    if (geometry_on_gpu) {
+      graph.emplace<NormalsFromPositionsVkStage>(*pipeline.vulkan);
+    } else {
+      graph.emplace<NormalsFromPositionsCpuStage>();
+    }
   } else if (geometry_on_gpu) {
-    graph.emplace<NormalsRawDepthVkStage>(*pipeline.vulkan);
+    graph.emplace<NormalsRawDepthVkStage>(*pipeline.vulkan, NormalsRawDepthOptions{}, input);
   } else {
-    graph.emplace<NormalsRawDepthCpuStage>();
+    graph.emplace<NormalsRawDepthCpuStage>(NormalsRawDepthOptions{}, input);
   }
   graph.keep("normals");
   graph.keep("positions");

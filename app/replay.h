@@ -31,7 +31,10 @@ struct ReplayOptions {
   /// "none", or a layout/scene JSON file.
   std::string markers = "auto";
   bool skip_bad_frames = false;  ///< TUM frames that cannot be read: warn and skip instead of failing
-  std::string geometry = "method1";  ///< normals: method1 (NormalsRawDepth) | method2 (DepthWarpMerge + NormalsFromPositions)
+  std::string geometry = "method1";  ///< normals: method1 (NormalsRawDepth) | method2 (DepthWarpMerge + normals below)
+  /// Method 2's normals: "filtered" (method 1's estimator on the merged depth, §4.3.3's filtered
+  /// normal) | "plain" (stride-1 cross products of the merged positions, NormalsFromPositions).
+  std::string method2_normals = "filtered";
   /// Differential rendering (render/dir_stage.h) runs when there is an object or a virtual light.
   std::vector<std::filesystem::path> objects;  ///< .obj / .gltf / .glb
   std::vector<std::string> places;             ///< one x,y,z[,yaw[,scale]] per object

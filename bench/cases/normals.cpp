@@ -1,4 +1,4 @@
-// normals/*: method 1 (NormalsRawDepth) and method 2 (DepthWarpMerge + NormalsFromPositions) on
+// normals/*: method 1 (NormalsRawDepth) and method 2 (DepthWarpMerge + filtered normals) on
 // the CPU against PCL's IntegralImageNormalEstimation (AVERAGE_3D_GRADIENT, max depth change
 // 0.02, smoothing 10: the dissertation's comparison), and normals/pcl_omp (NormalEstimationOMP,
 // k = 10) as its own line. Same process, same 640x480 synthetic frames (static camera, Kinect v1
@@ -14,11 +14,15 @@
 // the CPU; "ms" is one frame end to end (pyramid, buffer allocation, uploads, three dispatches,
 // downloads), "gpu_ms" the dispatches alone (timestamp queries), "gpu_passes" names what ran
 // on the GPU.
-// normals/method2_vulkan: method 2 on the GPU (DepthWarpMergeVk: warp by compute scatter and
-// merge; CrossNormalsVk: positions and stride-1 normals), the same fields as method1_vulkan.
+// normals/method2_*: method 2 as relight replay runs it: warp and merge, then method 1's
+// estimator on the merged depth (the "filtered normal" of §4.3.3; NormalsDepthInput::Filtered);
+// plain_angular_error_deg is the error of the stride-1 cross products of the same positions.
+// normals/method2_vulkan: DepthWarpMergeVk (warp by compute scatter, merge) + NormalsRawDepthVk,
+// the same fields as method1_vulkan.
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -234,37 +238,53 @@ Json method1_vulkan(const bench::Options& options) {
   return json;
 }
 
-Json method2_cpu(const bench::Options& options) {
-  const BenchSequence& s = sequence();
-  DepthMap filtered, warped;
-  DepthWeightMap weight, warped_weight;
-  for (int i = 0; i < kFrames; ++i) {
-    if (i > 0) warp_depth(filtered, weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight);
-    DepthMap merged;
-    DepthWeightMap merged_weight;
-    merge_depth(s.noisy[static_cast<std::size_t>(i)], warped, warped_weight, {}, merged, merged_weight);
-    filtered = std::move(merged);
-    weight = std::move(merged_weight);
-  }
+// Method 2 as the product runs it: warp and merge, then method 1's estimator on the merged depth
+// (NormalsDepthInput::Filtered), both with the previous frame's outputs as history.
+// "plain_angular_error_deg": the stride-1 cross products of the same merged positions.
+struct Method2State {
+  DepthMap filtered;
+  DepthWeightMap weight;
   PositionMap positions;
   NormalMap normals;
-  positions_from_depth(filtered, s.intrinsics, positions);
-  normals_from_positions(positions, normals);
-  const AngularError error = angular_error(normals, s.truth);
-  const NormalMap evaluated = normals;  // the timed frame below overwrites `normals`
+};
 
-  DepthMap scratch_depth;
-  DepthWeightMap scratch_weight;
-  Json json = compare_with_pcl(
-      [&] {
-        warp_depth(filtered, weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight);
-        merge_depth(s.noisy.back(), warped, warped_weight, {}, scratch_depth, scratch_weight);
-        positions_from_depth(scratch_depth, s.intrinsics, positions);
-        normals_from_positions(positions, normals);
-      },
-      evaluated, options);
+double plain_normals_error(const Method2State& state, const BenchSequence& s) {
+  PositionMap positions;
+  NormalMap normals;
+  positions_from_depth(state.filtered, s.intrinsics, positions);
+  normals_from_positions(positions, normals);
+  return angular_error(normals, s.truth).mean_deg;
+}
+
+Json method2_cpu(const bench::Options& options) {
+  const BenchSequence& s = sequence();
+  NormalsRawDepthCpu normals_method;  // as the stage: scratch memory kept between frames
+  DepthMap warped;
+  DepthWeightMap warped_weight;
+  // One frame from `previous` (null: the first) into `next`.
+  const auto frame = [&](const DepthMap& depth, const Method2State* previous, Method2State& next) {
+    if (previous) {
+      warp_depth(previous->filtered, previous->weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight);
+    } else {
+      warped = DepthMap();  // no history: merge_depth takes the depth alone
+    }
+    merge_depth(depth, warped, warped_weight, {}, next.filtered, next.weight);
+    std::optional<NormalsHistory> history;
+    if (previous) history.emplace(NormalsHistory{previous->normals, previous->positions, s.pose});
+    normals_method.run(next.filtered, s.intrinsics, s.pose, history ? &*history : nullptr, {}, next.positions,
+                       next.normals);
+  };
+  Method2State states[2];
+  for (int i = 0; i < kFrames; ++i) {
+    frame(s.noisy[static_cast<std::size_t>(i)], i > 0 ? &states[1 - i % 2] : nullptr, states[i % 2]);
+  }
+  const Method2State& last = states[(kFrames - 1) % 2];
+  const AngularError error = angular_error(last.normals, s.truth);
+  Method2State scratch;
+  Json json = compare_with_pcl([&] { frame(s.noisy.back(), &last, scratch); }, last.normals, options);
   json["angular_error_deg"] = error.mean_deg;
   json["coverage"] = error.coverage;
+  json["plain_angular_error_deg"] = plain_normals_error(last, s);
   return json;
 }
 
@@ -274,30 +294,32 @@ Json method2_vulkan(const bench::Options& options) {
   if (!context) throw Error("no Vulkan device: " + why);
   const BenchSequence& s = sequence();
   DepthWarpMergeVk warp_merge(*context);
-  CrossNormalsVk cross(*context);
+  NormalsRawDepthVk normals_method(*context);
   std::vector<double> gpu_ms;
-  DepthMap filtered, merged;
-  DepthWeightMap weight, merged_weight;
-  PositionMap positions;
-  NormalMap normals;
-  const auto frame = [&](const DepthMap& depth, bool history) {
-    warp_merge.run(depth, history ? &filtered : nullptr, history ? &weight : nullptr, s.intrinsics, Pose::Identity(), {},
-                   merged, merged_weight);
-    cross.run(merged, s.intrinsics, {}, positions, normals);
-    if (warp_merge.last_gpu_ms() && cross.last_gpu_ms()) gpu_ms.push_back(*warp_merge.last_gpu_ms() + *cross.last_gpu_ms());
+  const auto frame = [&](const DepthMap& depth, const Method2State* previous, Method2State& next) {
+    warp_merge.run(depth, previous ? &previous->filtered : nullptr, previous ? &previous->weight : nullptr, s.intrinsics,
+                   Pose::Identity(), {}, next.filtered, next.weight);
+    std::optional<NormalsHistory> history;
+    if (previous) history.emplace(NormalsHistory{previous->normals, previous->positions, s.pose});
+    normals_method.run(next.filtered, s.intrinsics, s.pose, history ? &*history : nullptr, {}, next.positions,
+                       next.normals);
+    if (warp_merge.last_gpu_ms() && normals_method.last_gpu_ms()) {
+      gpu_ms.push_back(*warp_merge.last_gpu_ms() + *normals_method.last_gpu_ms());
+    }
   };
+  Method2State states[2];
   for (int i = 0; i < kFrames; ++i) {
-    frame(s.noisy[static_cast<std::size_t>(i)], i > 0);
-    filtered = merged;
-    weight = merged_weight;
+    frame(s.noisy[static_cast<std::size_t>(i)], i > 0 ? &states[1 - i % 2] : nullptr, states[i % 2]);
   }
-  const AngularError error = angular_error(normals, s.truth);
-  const NormalMap evaluated = normals;  // the timed frames below overwrite `normals`
+  const Method2State& last = states[(kFrames - 1) % 2];
+  const AngularError error = angular_error(last.normals, s.truth);
+  Method2State scratch;
   gpu_ms.clear();
-  Json json = compare_with_pcl([&] { frame(s.noisy.back(), true); }, evaluated, options);
+  Json json = compare_with_pcl([&] { frame(s.noisy.back(), &last, scratch); }, last.normals, options);
   add_vulkan_fields(json, error, gpu_ms, *context,
-                    "warp (z-buffer clear, depth scatter by atomic min, weight scatter), merge, positions + "
-                    "stride-1 cross products");
+                    "warp (z-buffer clear, depth scatter by atomic min, weight scatter), merge; on the merged depth "
+                    "positions + stride-4 cross products, temporal blend, hole filling (pass 1 pyramid on the CPU)");
+  json["plain_angular_error_deg"] = plain_normals_error(last, s);
   return json;
 }
 

@@ -324,8 +324,12 @@ void normals_raw_depth_blend(const PinholeIntrinsics& intrinsics, const Pose& ca
   NormalsRawDepthCpu().blend(intrinsics, camera_to_world, previous, options, positions, normals);
 }
 
+std::string NormalsRawDepthStageBase::name() const {
+  return input_ == NormalsDepthInput::Raw ? "normals_raw_depth" : "normals_filtered_depth";
+}
+
 void NormalsRawDepthStageBase::declare(StageBuilder& builder) {
-  depth_ = builder.read<DepthMap>("depth");
+  depth_ = builder.read<DepthMap>(input_ == NormalsDepthInput::Raw ? "depth" : "depth_filtered");
   frame_ = builder.read<FrameInfo>("frame");
   previous_normals_ = builder.read_previous<NormalMap>("normals");
   previous_positions_ = builder.read_previous<PositionMap>("positions");

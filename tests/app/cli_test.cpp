@@ -142,19 +142,21 @@ TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
   expect_one_line_error(relight("replay --backend quantum --out " + dir.path().string()), 1);
 }
 
-// The geometry stages follow the per-pixel backend: with --backend vulkan both methods report
-// device time for each of their stages.
+// The geometry stages follow the per-pixel backend: with --backend vulkan both methods (and
+// both kinds of method-2 normals) report device time for each of their stages.
 TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
   TempDir dir;
-  for (const std::string geometry : {"method1", "method2"}) {
-    const auto out = dir.path() / geometry;
+  const std::vector<std::pair<std::string, std::vector<std::string>>> runs = {
+      {"--geometry method1", {"normals_raw_depth"}},
+      {"--geometry method2", {"depth_warp_merge", "normals_filtered_depth"}},
+      {"--geometry method2 --method2-normals plain", {"depth_warp_merge", "normals_from_positions"}}};
+  for (std::size_t run = 0; run < runs.size(); ++run) {
+    const auto& [arguments, stages] = runs[run];
+    const auto out = dir.path() / std::to_string(run);
     const auto result =
-        relight("replay --quiet --no-frames --frames 0:2 --backend vulkan --geometry " + geometry + " --out " + out.string());
+        relight("replay --quiet --no-frames --frames 0:2 --backend vulkan " + arguments + " --out " + out.string());
     ASSERT_EQ(result.exit_code, 0) << result.err;
     const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
-    const std::vector<std::string> stages = geometry == "method1"
-                                                ? std::vector<std::string>{"normals_raw_depth"}
-                                                : std::vector<std::string>{"depth_warp_merge", "normals_from_positions"};
     for (const std::string& name : stages) {
       bool found = false;
       for (const auto& stage : report["stages"]) {
@@ -162,7 +164,7 @@ TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
         found = true;
         EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0) << name;
       }
-      EXPECT_TRUE(found) << name;
+      EXPECT_TRUE(found) << arguments << ": " << name;
     }
   }
 }

@@ -48,7 +48,7 @@ class NormalsRawDepthVk {
 };
 
 /// Frame-graph stage of method 1 on Vulkan, a drop-in for NormalsRawDepthCpuStage (same name and
-/// buffers: reads DepthMap "depth", FrameInfo "frame" and the previous frame's "normals",
+/// buffers, also for NormalsDepthInput::Filtered: reads DepthMap "depth", FrameInfo "frame" and the previous frame's "normals",
 /// "positions" and "frame"; writes NormalMap "normals" and PositionMap "positions").
 /// It works on the graph's host buffers and does its own uploads and downloads, because the
 /// graph hands previous-frame buffers to stages on the host only and pass 1 runs on the CPU
@@ -56,8 +56,9 @@ class NormalsRawDepthVk {
 /// reported to the graph's timing table.
 class NormalsRawDepthVkStage final : public NormalsRawDepthStageBase {
  public:
-  explicit NormalsRawDepthVkStage(vk::VulkanContext& context, NormalsRawDepthOptions options = {})
-      : NormalsRawDepthStageBase(options), method_(context) {}
+  explicit NormalsRawDepthVkStage(vk::VulkanContext& context, NormalsRawDepthOptions options = {},
+                                  NormalsDepthInput input = NormalsDepthInput::Raw)
+      : NormalsRawDepthStageBase(options, input), method_(context) {}
 
  private:
   void estimate(StageContext& context, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
