@@ -285,6 +285,17 @@ Json method2_cpu(const bench::Options& options) {
   json["angular_error_deg"] = error.mean_deg;
   json["coverage"] = error.coverage;
   json["plain_angular_error_deg"] = plain_normals_error(last, s);
+  // The two halves on their own: warp + merge, and the normals of the merged depth.
+  json["warp_ms"] = bench::median_ms(
+      [&] { warp_depth(last.filtered, last.weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight); },
+      options.repetitions);
+  json["merge_ms"] = bench::median_ms(
+      [&] { merge_depth(s.noisy.back(), warped, warped_weight, {}, scratch.filtered, scratch.weight); },
+      options.repetitions);
+  const NormalsHistory history{last.normals, last.positions, s.pose};
+  json["normals_ms"] = bench::median_ms(
+      [&] { normals_method.run(scratch.filtered, s.intrinsics, s.pose, &history, {}, scratch.positions, scratch.normals); },
+      options.repetitions);
   return json;
 }
 
