@@ -213,7 +213,7 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
     std::size_t vpl_count = 0;
     for (int repetition = 0; repetition < 3; ++repetition) {
       const auto start = Clock::now();
-      const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options, gpu);
+      const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options, {.cone_search = gpu});
       vpl_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
       errors = compare(renderer.render(camera, vpls, vk_options), reference);
       ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());

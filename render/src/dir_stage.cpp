@@ -88,6 +88,8 @@ void MrSceneStage::run(StageContext& context) {
 VplStage::VplStage(VplOptions options, vk::VulkanContext* context) : options_(std::move(options)) {
   if (context && options_.bounces > 1 && options_.bounce_method == BounceMethod::PointCone)
     cone_search_ = std::make_unique<ConeSearchVk>(*context);
+  if (context && options_.source == VplSource::ReflectiveShadowMaps)
+    reflective_shadow_maps_ = std::make_unique<ReflectiveShadowMapsVk>(*context);
 }
 
 VplStage::~VplStage() = default;
@@ -104,8 +106,10 @@ void VplStage::run(StageContext& context) {
     const VplSet* previous = context.get(previous_);
     options_.previous_flux = previous ? vpl_flux_per_light(previous->vpls, scene.lights.size()) : std::vector<double>{};
   }
-  context.get(vpls_).vpls =
-      generate_vpls(scene, RayTracer(scene, RayTracer::Build::Fast), options_, cone_search_.get());
+  if (reflective_shadow_maps_) reflective_shadow_maps_->set_scene(scene);
+  context.get(vpls_).vpls = generate_vpls(scene, RayTracer(scene, RayTracer::Build::Fast), options_,
+                                          {.cone_search = cone_search_.get(),
+                                           .reflective_shadow_maps = reflective_shadow_maps_.get()});
 }
 
 // ---- dir ---------------------------------------------------------------------------------------

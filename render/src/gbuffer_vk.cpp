@@ -92,7 +92,12 @@ GBufferVk::~GBufferVk() = default;
 
 double GBufferVk::last_gpu_ms() const { return impl_->gpu_ms; }
 
-void GBufferVk::set_scene(const MrScene& scene) { impl_->vertices = detail::upload_scene_vertices(impl_->context, scene); }
+void GBufferVk::set_scene(const MrScene& scene, std::optional<Layer> only) {
+  const detail::MeshLayers layers = !only                 ? detail::MeshLayers::All
+                                    : *only == Layer::Real ? detail::MeshLayers::Real
+                                                           : detail::MeshLayers::Virtual;
+  impl_->vertices = detail::upload_scene_vertices(impl_->context, scene, layers);
+}
 
 std::size_t GBufferVk::packed_bytes(int width, int height) {
   return 8 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);

@@ -19,15 +19,6 @@ using Vec3 = Eigen::Vector3f;
 
 float luminance(const Vec3& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
 
-/// The texel's share of the light's emission and the texel's importance for `hit`.
-void fill(RsmTexel& texel, const MrScene& scene, const std::optional<SurfaceHit>& hit, const Vec3& emitted) {
-  texel.hit = hit;
-  if (!hit) return;
-  texel.flux = emitted;
-  const float albedo = std::max(luminance(scene.materials[hit->material].kd), kMinAlbedo);
-  texel.importance = std::max(0.f, luminance(emitted)) * albedo;
-}
-
 }  // namespace
 
 std::vector<float> ReflectiveShadowMap::importance() const {
@@ -47,43 +38,71 @@ bool has_reflective_shadow_maps(const MrLight& light) {
   return light.kind == LightKind::Spot && light.cos_outer >= std::cos(kMaxHalfAngle);
 }
 
+RsmView rsm_view(const MrScene& scene, std::size_t light_index, int size, const char* who) {
+  if (light_index >= scene.lights.size()) throw LogicError(std::string(who) + ": no such light");
+  const MrLight& light = scene.lights[light_index];
+  if (!has_reflective_shadow_maps(light)) throw LogicError(std::string(who) + ": not a spot light of <= 75 degrees");
+  if (size < 1 || !std::has_single_bit(static_cast<unsigned>(size)))
+    throw LogicError(std::string(who) + ": size " + std::to_string(size) + " is not a power of two");
+  RsmView view;
+  view.axis = light.direction.normalized();
+  orthonormal_basis(view.axis, view.tangent, view.bitangent);
+  const float cos_outer = std::clamp(light.cos_outer, 1e-3f, 1.f);
+  view.half_extent = std::sqrt(1.f - cos_outer * cos_outer) / cos_outer;
+  view.texel_side = 2.f * view.half_extent / static_cast<float>(size);
+  view.size = size;
+  return view;
+}
+
+namespace detail {
+
+Vec3 rsm_texel_direction(const RsmView& view, int x, int y) {
+  const float px = -view.half_extent + (static_cast<float>(x) + 0.5f) * view.texel_side;
+  const float py = -view.half_extent + (static_cast<float>(y) + 0.5f) * view.texel_side;
+  return (px * view.tangent + py * view.bitangent + view.axis).normalized();
+}
+
+Vec3 rsm_texel_emitted(const MrLight& light, const RsmView& view, int x, int y, const Vec3& direction) {
+  const float px = -view.half_extent + (static_cast<float>(x) + 0.5f) * view.texel_side;
+  const float py = -view.half_extent + (static_cast<float>(y) + 0.5f) * view.texel_side;
+  const float r2 = 1.f + px * px + py * py;
+  // dOmega = dA cos(theta) / r^2 with cos(theta) = 1 / r on the plane at distance 1.
+  const float solid_angle = view.texel_side * view.texel_side / (r2 * std::sqrt(r2));
+  return light.intensity * (spot_falloff(light, direction) * solid_angle);
+}
+
+void fill_rsm_texel(RsmTexel& texel, const MrScene& scene, const std::optional<SurfaceHit>& hit, const Vec3& emitted) {
+  texel.hit = hit;
+  if (!hit) return;
+  texel.flux = emitted;
+  const float albedo = std::max(luminance(scene.materials[hit->material].kd), kMinAlbedo);
+  texel.importance = std::max(0.f, luminance(emitted)) * albedo;
+}
+
+}  // namespace detail
+
 std::vector<ReflectiveShadowMap> reflective_shadow_maps_cpu(const MrScene& scene, const RayTracer& tracer,
                                                             std::size_t light_index, int size) {
-  if (light_index >= scene.lights.size()) throw LogicError("reflective_shadow_maps_cpu: no such light");
+  const RsmView view = rsm_view(scene, light_index, size, "reflective_shadow_maps_cpu");
   const MrLight& light = scene.lights[light_index];
-  if (!has_reflective_shadow_maps(light)) throw LogicError("reflective_shadow_maps_cpu: not a spot light of <= 75 degrees");
-  if (size < 1 || !std::has_single_bit(static_cast<unsigned>(size)))
-    throw LogicError("reflective_shadow_maps_cpu: size " + std::to_string(size) + " is not a power of two");
-  // Image plane at distance 1 along the axis, just holding the outer cone.
-  const Vec3 axis = light.direction.normalized();
-  Vec3 t, b;
-  orthonormal_basis(axis, t, b);
-  const float cos_outer = std::clamp(light.cos_outer, 1e-3f, 1.f);
-  const float half_extent = std::sqrt(1.f - cos_outer * cos_outer) / cos_outer;
-  const float texel_side = 2.f * half_extent / static_cast<float>(size);
   const auto texel_count = static_cast<std::size_t>(size) * static_cast<std::size_t>(size);
   std::vector<ReflectiveShadowMap> maps(light.real ? 2 : 1, ReflectiveShadowMap{size, std::vector<RsmTexel>(texel_count)});
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x) {
-      const float px = -half_extent + (static_cast<float>(x) + 0.5f) * texel_side;
-      const float py = -half_extent + (static_cast<float>(y) + 0.5f) * texel_side;
-      const float r2 = 1.f + px * px + py * py;
-      const Vec3 direction = (px * t + py * b + axis).normalized();
-      // dOmega = dA cos(theta) / r^2 with cos(theta) = 1 / r on the plane at distance 1.
-      const float solid_angle = texel_side * texel_side / (r2 * std::sqrt(r2));
-      const Vec3 emitted = light.intensity * (detail::spot_falloff(light, direction) * solid_angle);
+      const Vec3 direction = detail::rsm_texel_direction(view, x, y);
+      const Vec3 emitted = detail::rsm_texel_emitted(light, view, x, y, direction);
       const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(size) + static_cast<std::size_t>(x);
       const std::optional<SurfaceHit> real = tracer.intersect(Layer::Real, light.position, direction);
       const std::optional<SurfaceHit> virtual_hit = tracer.intersect(
           Layer::Virtual, light.position, direction, real ? real->t : std::numeric_limits<float>::infinity());
       for (ReflectiveShadowMap& map : maps) map.texels[i].direction = direction;
       if (!light.real) {
-        fill(maps[0].texels[i], scene, virtual_hit ? virtual_hit : real, emitted);
+        detail::fill_rsm_texel(maps[0].texels[i], scene, virtual_hit ? virtual_hit : real, emitted);
         continue;
       }
-      fill(maps[0].texels[i], scene, real, emitted);
+      detail::fill_rsm_texel(maps[0].texels[i], scene, real, emitted);
       maps[0].texels[i].occluded_by_virtual = virtual_hit.has_value();
-      fill(maps[1].texels[i], scene, virtual_hit, emitted);
+      detail::fill_rsm_texel(maps[1].texels[i], scene, virtual_hit, emitted);
     }
   return maps;
 }

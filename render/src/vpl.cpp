@@ -12,6 +12,7 @@
 #include "relight/render/hierarchical_warp.h"
 #include "relight/render/phong_brdf.h"
 #include "relight/render/reflective_shadow_map.h"
+#include "relight/render/reflective_shadow_map_vk.h"
 #include "relight/render/sampler.h"
 #include "surface_shading.h"
 
@@ -381,10 +382,11 @@ std::vector<int> rsm_slots(const std::vector<ReflectiveShadowMap>& maps, int n) 
 
 /// A spot light's n first-bounce VPLs from its RSMs (VplSource::ReflectiveShadowMaps).
 void emit_from_rsms(const MrScene& scene, const RayTracer& tracer, std::size_t index, int n, const VplOptions& options,
-                    VplTracer& vpl_tracer) {
+                    ReflectiveShadowMapsVk* gpu, VplTracer& vpl_tracer) {
   if (n <= 0) return;
   const MrLight& light = scene.lights[index];
-  const std::vector<ReflectiveShadowMap> maps = reflective_shadow_maps_cpu(scene, tracer, index, options.rsm_size);
+  const std::vector<ReflectiveShadowMap> maps = gpu ? gpu->render(scene, index, options.rsm_size)
+                                                    : reflective_shadow_maps_cpu(scene, tracer, index, options.rsm_size);
   const std::vector<int> slots = rsm_slots(maps, n);
   for (std::size_t m = 0; m < maps.size(); ++m) {
     if (slots[m] <= 0) continue;
@@ -417,7 +419,7 @@ std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t
 }
 
 std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options,
-                               ConeSearchVk* gpu) {
+                               const VplGpu& gpu) {
   if (options.count < 0) throw Error("the VPL count must not be negative");
   if (options.bounces < 1) throw Error("VPLs need at least one bounce");
   if (options.bounce_method == BounceMethod::PointCone &&
@@ -428,7 +430,7 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
       (options.rsm_size < 1 || options.rsm_size > 4096 || !std::has_single_bit(static_cast<unsigned>(options.rsm_size))))
     throw Error("the RSM size must be a power of two in [1, 4096]");
   std::vector<Vpl> vpls;
-  VplTracer vpl_tracer(scene, tracer, options, vpls, gpu);
+  VplTracer vpl_tracer(scene, tracer, options, vpls, gpu.cone_search);
   if (options.virtual_share < 0.f || options.virtual_share >= 1.f) throw Error("the virtual VPL share must be in [0, 1)");
   const BoundingSphere bounds = bounding_sphere(scene);
   const std::vector<int> budget = light_budget(scene, bounds, options);
@@ -441,7 +443,7 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
       continue;
     }
     if (options.source == VplSource::ReflectiveShadowMaps && has_reflective_shadow_maps(light)) {
-      emit_from_rsms(scene, tracer, l, budget[l], options, vpl_tracer);
+      emit_from_rsms(scene, tracer, l, budget[l], options, gpu.reflective_shadow_maps, vpl_tracer);
       continue;
     }
     const std::optional<Cone> cone = options.virtual_share > 0.f ? cone_towards(virtual_sphere, light.position) : std::nullopt;

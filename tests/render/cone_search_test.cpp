@@ -105,7 +105,7 @@ TEST_F(ConeSearchVkTest, VplsFromTheGpuSearchEqualTheCpuOnes) {
   options.bounce_method = BounceMethod::PointCone;
   const std::vector<Vpl> cpu = generate_vpls(scene, tracer, options);
   ConeSearchVk gpu_search(context);
-  const std::vector<Vpl> gpu = generate_vpls(scene, tracer, options, &gpu_search);
+  const std::vector<Vpl> gpu = generate_vpls(scene, tracer, options, {.cone_search = &gpu_search});
   ASSERT_EQ(gpu.size(), cpu.size());
   int second = 0, same = 0;
   for (std::size_t i = 0; i < cpu.size(); ++i) {

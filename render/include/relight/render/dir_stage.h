@@ -46,6 +46,7 @@
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
 #include "relight/render/cone_search_vk.h"
+#include "relight/render/reflective_shadow_map_vk.h"
 #include "relight/render/depth_mesh.h"
 #include "relight/render/dir_vk.h"
 #include "relight/render/temporal_smoothing.h"
@@ -95,8 +96,9 @@ class MrSceneStage final : public Stage {
   Write<MrScene> scene_;
 };
 
-/// Step 2 (primary lights and VPLs). With a Vulkan context (may be null) and
-/// BounceMethod::PointCone, the cone searches of bounces >= 2 run on the GPU.
+/// Step 2 (primary lights and VPLs). With a Vulkan context (may be null), the cone searches of
+/// BounceMethod::PointCone (bounces >= 2) and the RSMs of VplSource::ReflectiveShadowMaps
+/// (rasterised, reflective_shadow_map_vk.h) run on the GPU.
 class VplStage final : public Stage {
  public:
   explicit VplStage(VplOptions options, vk::VulkanContext* context = nullptr);
@@ -108,6 +110,7 @@ class VplStage final : public Stage {
  private:
   VplOptions options_;
   std::unique_ptr<ConeSearchVk> cone_search_;
+  std::unique_ptr<ReflectiveShadowMapsVk> reflective_shadow_maps_;
   Read<MrScene> scene_;
   ReadPrevious<VplSet> previous_;
   Write<VplSet> vpls_;

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include "relight/render/gbuffer.h"
@@ -30,8 +31,9 @@ class GBufferVk {
   GBufferVk(const GBufferVk&) = delete;
   GBufferVk& operator=(const GBufferVk&) = delete;
 
-  /// Uploads the scene's triangles (meshes without vertex normals are drawn flat).
-  void set_scene(const MrScene& scene);
+  /// Uploads the scene's triangles (meshes without vertex normals are drawn flat); with `only`,
+  /// those of one layer (the rasterised RSMs of a real light see each layer on its own).
+  void set_scene(const MrScene& scene, std::optional<Layer> only = std::nullopt);
   /// Renders the camera's view and reads the G-buffer back. The camera's intrinsics must have
   /// this renderer's size.
   [[nodiscard]] GBuffer render(const MrCamera& camera);

@@ -6,8 +6,10 @@
 // the texels each covers.
 //
 // The view: a square perspective frustum along the spot's axis that just holds its outer cone,
-// `size` x `size` texels (this is the ray-cast reference; the rasterised shadow views of
-// shadow_maps.h do not output these attributes yet). A texel where the cone sees a surface stores
+// `size` x `size` texels. reflective_shadow_maps_cpu is the ray-cast reference; the rasterised
+// RSMs of reflective_shadow_map_vk.h use the same view (RsmView) and the same per-texel rules
+// (detail::fill_rsm_texel) on the nearest surfaces a G-buffer pass finds. A texel where the cone
+// sees a surface stores
 //   hit       the surface (point, normals, material, real/virtual);
 //   flux      the flux I(omega) falloff(omega) dOmega that reaches it through the texel's solid
 //             angle dOmega: what a first-bounce VPL there carries (vpl.h);
@@ -52,5 +54,28 @@ inline constexpr float kMinAlbedo = 0.05f;
 
 /// Whether `light` can be sampled through RSMs (a spot light of at most kMaxRsmHalfAngleDeg).
 [[nodiscard]] bool has_reflective_shadow_maps(const MrLight& light);
+
+/// The RSM view of a spot light: the image plane at distance 1 along `axis`, spanned by
+/// `tangent` (texel x) and `bitangent` (texel y), [-half_extent, half_extent]² in `size`² texels.
+struct RsmView {
+  Eigen::Vector3f axis, tangent, bitangent;
+  float half_extent = 0.f;
+  float texel_side = 0.f;
+  int size = 0;
+};
+/// Throws LogicError (naming `who`) unless `light_index` is a spot light with RSMs and `size` a
+/// power of two.
+[[nodiscard]] RsmView rsm_view(const MrScene& scene, std::size_t light_index, int size, const char* who);
+
+namespace detail {
+/// Unit direction from the light through the centre of texel (x, y).
+[[nodiscard]] Eigen::Vector3f rsm_texel_direction(const RsmView& view, int x, int y);
+/// The light's emission through texel (x, y) in `direction`: I(ω) falloff(ω) dΩ.
+[[nodiscard]] Eigen::Vector3f rsm_texel_emitted(const MrLight& light, const RsmView& view, int x, int y,
+                                                const Eigen::Vector3f& direction);
+/// Sets the texel's hit, flux and importance (header comment) for a surface `hit` (or none).
+void fill_rsm_texel(RsmTexel& texel, const MrScene& scene, const std::optional<SurfaceHit>& hit,
+                    const Eigen::Vector3f& emitted);
+}  // namespace detail
 
 }  // namespace relight::render

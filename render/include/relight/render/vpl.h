@@ -81,7 +81,8 @@ enum class VplBudget { Equal, ByPower, ByWeight, ByPreviousFlux };
 /// Where a spot light's first-bounce VPLs come from.
 ///   RayTraced             light samples traced against both layers (above), for every light;
 ///   ReflectiveShadowMaps  importance-sampled texels of the spot light's RSMs
-///                         (reflective_shadow_map.h) by hierarchical warping of a Hammersley set
+///                         (reflective_shadow_map.h: ray cast on the CPU, or rasterised by
+///                         VplGpu::reflective_shadow_maps) by hierarchical warping of a Hammersley set
 ///                         (hierarchical_warp.h), flux = texel flux / (probability x slots); a
 ///                         real light's slots are shared between its real and virtual RSM by the
 ///                         texels each covers. virtual_share does not apply (the virtual RSM is the
@@ -114,6 +115,15 @@ struct VplSet {
 };
 
 class ConeSearchVk;
+class ReflectiveShadowMapsVk;
+
+/// The GPU engines VPL generation may use, each optional: the point-cone search of the
+/// bounces, and the rasterised RSMs of VplSource::ReflectiveShadowMaps (which must have been
+/// given the scene, ReflectiveShadowMapsVk::set_scene). Without them the CPU references run.
+struct VplGpu {
+  ConeSearchVk* cone_search = nullptr;
+  ReflectiveShadowMapsVk* reflective_shadow_maps = nullptr;
+};
 
 /// Per light of the scene, the luminance of the flux its first-bounce VPLs carry (the input of
 /// VplBudget::ByPreviousFlux for the next frame).
@@ -123,10 +133,10 @@ class ConeSearchVk;
 /// extraction stage) shoots parallel rays from a disk facing it that covers the scene's bounding
 /// sphere, each carrying irradiance x disk area / samples. Ray-traced bounces follow each path to
 /// its end before the next (a VPL's continuations come right after it); BounceMethod::PointCone
-/// resolves all paths of one bounce together, one search per layer, on `gpu` when given (its
-/// points are replaced), so the list holds all first bounces, then all second bounces, and so
-/// on. Vpl::parent links them either way.
+/// resolves all paths of one bounce together, one search per layer, on gpu.cone_search when
+/// given (its points are replaced), so the list holds all first bounces, then all second
+/// bounces, and so on. Vpl::parent links them either way.
 [[nodiscard]] std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options,
-                                             ConeSearchVk* gpu = nullptr);
+                                             const VplGpu& gpu = {});
 
 }  // namespace relight::render
