@@ -46,6 +46,9 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                          kDefaultSynthPlacement + ")");
   command.add_option("--lights", options.lights, "Lights JSON of `relight lights` (needed to render into a recorded sequence)");
   command.add_option("--virtual-light", options.virtual_lights, "A virtual point light x,y,z,intensity[,r,g,b] (repeatable)");
+  command.add_option("--virtual-spot", options.virtual_spots,
+                     "A virtual spot light x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b] aimed at "
+                     "the target, with that cone half-angle (repeatable)");
   command.add_option("--vpls", options.vpls, "Light samples for virtual point lights per frame")
       ->check(CLI::Range(0, 4096))
       ->capture_default_str();
@@ -56,7 +59,7 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
       ->capture_default_str();
   command.add_option("--vpl-weights", options.vpl_weights,
                      "With --vpl-budget weights: one weight per light, comma-separated (the lights file's order, "
-                     "then the --virtual-light ones; missing weights are 1)")
+                     "then the --virtual-light ones, then the --virtual-spot ones; missing weights are 1)")
       ->delimiter(',')
       ->check(CLI::NonNegativeNumber);
   command.add_option("--vpl-bounces", options.vpl_bounces,
@@ -67,6 +70,11 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                      "How bounces after the first find their surface: rays (ray traced) or cone (the nearest of "
                      "the surface points within 5 degrees of the sampled direction, no ray tracing)")
       ->check(CLI::IsMember({"rays", "cone"}))
+      ->capture_default_str();
+  command.add_option("--vpl-source", options.vpl_source,
+                     "Where a spot light's first VPLs come from: rays (traced from the light) or rsm (importance-"
+                     "sampled texels of its reflective shadow maps, rasterised on the Vulkan device)")
+      ->check(CLI::IsMember({"rays", "rsm"}))
       ->capture_default_str();
   command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
       ->check(CLI::PositiveNumber)

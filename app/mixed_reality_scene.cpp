@@ -23,7 +23,10 @@ bool is_synthetic(const fs::path& sequence) {
   return json.value("generator", std::string()) == "relight synth";
 }
 
-render::MrLight parse_virtual_light(const std::string& text) {
+namespace {
+
+/// The comma-separated numbers of `option`'s value `text`.
+std::vector<float> parse_numbers(const char* option, const std::string& text) {
   std::vector<float> v;
   std::stringstream stream(text);
   std::string field;
@@ -31,15 +34,49 @@ render::MrLight parse_virtual_light(const std::string& text) {
     char* end = nullptr;
     v.push_back(std::strtof(field.c_str(), &end));
     if (field.empty() || *end != '\0' || !std::isfinite(v.back()))
-      throw Error("--virtual-light '" + text + "': '" + field + "' is not a number");
+      throw Error(std::string(option) + " '" + text + "': '" + field + "' is not a number");
   }
+  return v;
+}
+
+/// intensity x (r, g, b) from v[first] and, when present, v[first + 1 .. first + 3].
+Eigen::Vector3f parse_intensity(const char* option, const std::string& text, const std::vector<float>& v,
+                                std::size_t first) {
+  const Eigen::Vector3f colour =
+      v.size() == first + 4 ? Eigen::Vector3f(v[first + 1], v[first + 2], v[first + 3]) : Eigen::Vector3f::Ones();
+  if (v[first] < 0.f || colour.minCoeff() < 0.f)
+    throw Error(std::string(option) + " '" + text + "': intensity and colour must not be negative");
+  return v[first] * colour;
+}
+
+}  // namespace
+
+render::MrLight parse_virtual_light(const std::string& text) {
+  const std::vector<float> v = parse_numbers("--virtual-light", text);
   if (v.size() != 4 && v.size() != 7) throw Error("--virtual-light '" + text + "' needs x,y,z,intensity[,r,g,b]");
   render::MrLight light;
   light.kind = render::LightKind::Point;
   light.position = {v[0], v[1], v[2]};
-  const Eigen::Vector3f colour = v.size() == 7 ? Eigen::Vector3f(v[4], v[5], v[6]) : Eigen::Vector3f::Ones();
-  if (v[3] < 0.f || colour.minCoeff() < 0.f) throw Error("--virtual-light '" + text + "': intensity and colour must not be negative");
-  light.intensity = v[3] * colour;
+  light.intensity = parse_intensity("--virtual-light", text, v, 3);
+  light.real = false;
+  return light;
+}
+
+render::MrLight parse_virtual_spot(const std::string& text) {
+  const std::vector<float> v = parse_numbers("--virtual-spot", text);
+  if (v.size() != 8 && v.size() != 11)
+    throw Error("--virtual-spot '" + text + "' needs x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b]");
+  render::MrLight light;
+  light.kind = render::LightKind::Spot;
+  light.position = {v[0], v[1], v[2]};
+  const Eigen::Vector3f axis = Eigen::Vector3f(v[3], v[4], v[5]) - light.position;
+  if (!(axis.norm() > 1e-6f)) throw Error("--virtual-spot '" + text + "': the target is the light's position");
+  light.direction = axis.normalized();
+  if (!(v[6] > 0.f && v[6] < 90.f)) throw Error("--virtual-spot '" + text + "': the angle must be in (0, 90) degrees");
+  constexpr float kRadians = 3.14159265358979f / 180.f;
+  light.cos_outer = std::cos(v[6] * kRadians);
+  light.cos_inner = std::cos(kSpotInnerFraction * v[6] * kRadians);
+  light.intensity = parse_intensity("--virtual-spot", text, v, 7);
   light.real = false;
   return light;
 }

@@ -23,6 +23,13 @@ inline constexpr const char* kDefaultSynthPlacement = "0.35,-0.2,0.75,30";
 /// "x,y,z,intensity[,r,g,b]": a virtual point light of radiant intensity intensity * (r,g,b) W/sr.
 [[nodiscard]] render::MrLight parse_virtual_light(const std::string& text);
 
+/// A spot's light fades out between this fraction of its angle and the whole angle.
+inline constexpr float kSpotInnerFraction = 0.8f;
+/// "x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b]": a virtual spot light at
+/// (x, y, z) aimed at the target, its cone's half-angle in (0, 90) degrees (full intensity within
+/// kSpotInnerFraction of it), intensity * (r,g,b) W/sr on its axis.
+[[nodiscard]] render::MrLight parse_virtual_spot(const std::string& text);
+
 /// The measured lights of a sequence: the lights JSON of `relight lights` when given, else for a
 /// synthetic sequence 8 lights extracted from its probe.hdr. Throws relight::Error when there
 /// is neither.

@@ -208,7 +208,7 @@ std::string add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& opt
 /// The lights, the BRDF stages (real materials) and the DIR stage with its outputs, when the
 /// options ask for any virtual content.
 void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel) {
-  if (options.objects.empty() && options.virtual_lights.empty()) return;
+  if (options.objects.empty() && options.virtual_lights.empty() && options.virtual_spots.empty()) return;
   if (options.vpls < 0 || options.vpls > 4096) throw Error("--vpls must be 0 to 4096");
   if (!(options.exposure > 0.f)) throw Error("--exposure must be positive");
   const auto sequence = options.sequence.empty() ? default_sequence() : options.sequence;
@@ -219,6 +219,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   render::add_lights(lights, measured);
   content.lights = lights.lights;
   for (const std::string& light : options.virtual_lights) content.lights.push_back(parse_virtual_light(light));
+  for (const std::string& spot : options.virtual_spots) content.lights.push_back(parse_virtual_spot(spot));
   content.objects = virtual_objects(options.objects, options.places, synthetic);
 
   FrameGraph& graph = *pipeline.graph;
@@ -231,6 +232,8 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.light_weights = options.vpl_weights;
   dir.vpls.bounces = options.vpl_bounces;
   dir.vpls.bounce_method = options.bounce_method == "cone" ? render::BounceMethod::PointCone : render::BounceMethod::RayTraced;
+  dir.vpls.source =
+      options.vpl_source == "rsm" ? render::VplSource::ReflectiveShadowMaps : render::VplSource::RayTraced;
   dir.tone_map.exposure = options.exposure;
   dir.materials_buffer = "materials";
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view

@@ -40,11 +40,13 @@ struct ReplayOptions {
   std::vector<std::string> places;             ///< one x,y,z[,yaw[,scale]] per object
   std::filesystem::path lights;                ///< lights JSON of `relight lights` (recorded sequences)
   std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]
+  std::vector<std::string> virtual_spots;      ///< x,y,z,tx,ty,tz,angle,intensity[,r,g,b]
   int vpls = 64;                               ///< first-bounce light samples per frame
   std::string vpl_budget = "power";            ///< equal | power | weights | flux (render/vpl.h)
   std::vector<float> vpl_weights;              ///< per light (lights file order, then virtual lights)
   int vpl_bounces = 1;                         ///< indirect bounces carried by VPLs (render/vpl.h)
   std::string bounce_method = "rays";          ///< rays | cone: how bounces >= 2 find surfaces
+  std::string vpl_source = "rays";             ///< rays | rsm: where spot lights' first VPLs come from
   float exposure = 1.f;                        ///< tone mapping of the rendered light
   bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
   /// Colour mapping of the rendered light to the camera (colormap/): none | sample | stats.

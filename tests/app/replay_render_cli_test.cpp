@@ -85,6 +85,41 @@ TEST(ReplayRenderCli, ColormapNoneWritesOnlyTheUnmappedComposite) {
   EXPECT_EQ(read_text_file(out / "report.json").find("colormap"), std::string::npos);
 }
 
+// A virtual spot light lights its footprint on the table; its first VPLs from the rasterised
+// RSMs (--vpl-source rsm) give the picture the traced ones give. Measured (64 light samples shared
+// equally by the 9 lights): a footprint of 26383 pixels; 8441 pixels differ between the two
+// sources, those in the footprint by 0.77 levels on average.
+TEST(ReplayRenderCli, VirtualSpotLightWithRsmVplsLightsItsFootprint) {
+  TempDir dir;
+  ColorImage composites[2];
+  const char* sources[2] = {"rays", "rsm"};
+  for (int s = 0; s < 2; ++s) {
+    const auto out = dir.path() / sources[s];
+    const auto result = relight("replay --quiet --frames 1 --no-video --colormap none " + two_frame_sequence().string() +
+                                " --virtual-spot 0.35,-0.2,1.8,0.35,-0.2,0.75,20,3 --vpls 64 --vpl-budget equal --vpl-source " +
+                                sources[s] + " --out " + out.string());
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    composites[s] = read_color(out / "frames" / "000000_composite.png");
+  }
+  const ColorImage camera = read_color(dir.path() / "rsm" / "frames" / "000000_color.png");
+  const auto sum = [](Rgb8 c) { return c.r + c.g + c.b; };
+  int lit = 0, differ = 0;
+  double difference = 0.0;
+  for (std::size_t i = 0; i < camera.size(); ++i) {
+    differ += composites[0].pixels()[i] != composites[1].pixels()[i] ? 1 : 0;
+    if (sum(composites[1].pixels()[i]) - sum(camera.pixels()[i]) <= 30) continue;
+    ++lit;
+    const Rgb8 a = composites[0].pixels()[i], b = composites[1].pixels()[i];
+    difference += (std::abs(a.r - b.r) + std::abs(a.g - b.g) + std::abs(a.b - b.b)) / 3.0;
+  }
+  std::printf("spot footprint: %d pixels; %d pixels differ between the sources, in the footprint by %.2f levels on "
+              "average\n", lit, differ, difference / std::max(lit, 1));
+  EXPECT_GT(differ, 1000) << "the spot's VPLs come from elsewhere with --vpl-source rsm";
+  EXPECT_GT(lit, 10000);
+  EXPECT_LT(lit, static_cast<int>(camera.size()) / 2);
+  EXPECT_LT(difference / lit, 2.0);
+}
+
 TEST(ReplayRenderCli, WithoutVirtualContentNothingIsRendered) {
   TempDir dir;
   const auto out = dir.path() / "out";
@@ -101,6 +136,10 @@ TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
   expect_one_line_error(relight("replay" + seq + " --object /no/such/model.glb" + out), 1);
   expect_one_line_error(relight("replay" + seq + pebble + pebble + " --place 0,0,1" + out), 1);  // 2 objects, 1 place
   expect_one_line_error(relight("replay" + seq + " --virtual-light 1,2,x,4" + out), 1);
+  expect_one_line_error(relight("replay" + seq + " --virtual-spot 0,0,1,0,0,1,30,2" + out), 1);  // aimed at itself
+  expect_one_line_error(relight("replay" + seq + " --virtual-spot 0,0,1,0,0,0,95,2" + out), 1);  // wider than 90
+  expect_one_line_error(relight("replay" + seq + " --virtual-spot 0,0,1,0,0,0,30" + out), 1);    // no intensity
+  expect_one_line_error(relight("replay" + seq + pebble + " --vpl-source photons" + out), 2);
   expect_one_line_error(relight("replay" + seq + pebble + " --colormap vivid" + out), 2);  // a usage error
   expect_one_line_error(relight("replay" + seq + pebble + " --colormap sample --colormap-model cubic" + out), 2);
   expect_one_line_error(relight("replay" + seq + pebble + " --vpl-budget most" + out), 2);
