@@ -76,7 +76,9 @@ vec3 phong(Material m, vec3 n, vec3 wi, vec3 wo) {
 float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
   const uint first = floatBitsToUint(light.outer_views.y), count = floatBitsToUint(light.outer_views.z);
   if (count == 0u) return 1.0;
-  const vec4 any_eye = views[first].eye;
+  const int rows = max(params.shadow_rows, 1);
+  const uint layer_base = uint(layer * rows * params.shadow_columns);  // pack_views (dir_vk.cpp)
+  const vec4 any_eye = views[layer_base + first].eye;
   const bool positional = any_eye.w > 0.5;
   const vec3 towards_light = positional ? any_eye.xyz - point : any_eye.xyz;
   uint index = first;
@@ -85,7 +87,7 @@ float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
     const int axis = a.x >= a.y && a.x >= a.z ? 0 : (a.y >= a.z ? 1 : 2);
     index += uint(2 * axis + (d[axis] < 0.0 ? 1 : 0));
   }
-  const ShadowView view = views[index];
+  const ShadowView view = views[layer_base + index];
   const float texel = positional ? view.texel_size.x * length(towards_light) : view.texel_size.x;
   const vec3 facing = dot(normal, towards_light) < 0.0 ? -normal : normal;
   const vec3 receiver = point + 0.5 * texel * facing;
@@ -95,7 +97,6 @@ float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
   if (abs(ndc.x) > 1.0 || abs(ndc.y) > 1.0) return 1.0;
   const int tile = params.shadow_tile;
   const ivec2 texel_xy = clamp(ivec2(floor((ndc * 0.5 + 0.5) * float(tile))), ivec2(0), ivec2(tile - 1));
-  const int rows = max(params.shadow_rows, 1);
   const ivec2 origin = ivec2((int(index) % params.shadow_columns) * tile, (layer * rows + int(index) / params.shadow_columns) * tile);
   const float stored = shadow_atlas[(origin.y + texel_xy.y) * params.shadow_columns * tile + origin.x + texel_xy.x];
   const float depth = positional ? length(receiver - view.eye.xyz) : -dot(receiver, view.eye.xyz);

@@ -1,5 +1,6 @@
 #include "relight/render/dir_vk.h"
 
+#include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cstring>
@@ -65,11 +66,17 @@ std::vector<float> pack_lights(const MrScene& scene, const ShadowLayout& layout)
   return out;
 }
 
+/// The real layer's views, padded to rows x columns, then the virtual layer's: the shader finds
+/// view i of layer l at i + l x rows x columns (dir_shade.comp, shadow_visibility).
 std::vector<float> pack_views(const ShadowLayout& layout) {
   std::vector<float> out;
-  for (const ShadowView& v : layout.views) {
-    out.insert(out.end(), v.world_to_clip.data(), v.world_to_clip.data() + 16);
-    out.insert(out.end(), {v.eye.x(), v.eye.y(), v.eye.z(), v.eye.w(), v.texel_size, 0.f, 0.f, 0.f});
+  const std::size_t slots = static_cast<std::size_t>(std::max(layout.rows(), 1) * layout.columns);
+  for (int layer = 0; layer < 2; ++layer) {
+    for (std::size_t i = 0; i < slots; ++i) {
+      const ShadowView v = i < layout.views.size() ? layout.view(i, layer) : ShadowView{Eigen::Matrix4f::Zero(), {}, 0.f};
+      out.insert(out.end(), v.world_to_clip.data(), v.world_to_clip.data() + 16);
+      out.insert(out.end(), {v.eye.x(), v.eye.y(), v.eye.z(), v.eye.w(), v.texel_size, 0.f, 0.f, 0.f});
+    }
   }
   return out;
 }

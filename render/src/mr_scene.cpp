@@ -47,10 +47,12 @@ void MrScene::validate() const {
       throw Error("material '" + material.name + "' has invalid Phong parameters");
 }
 
-BoundingSphere bounding_sphere(const MrScene& scene) {
+BoundingSphere bounding_sphere(const MrScene& scene, SceneMeshes meshes) {
   Eigen::AlignedBox3f box;
-  for (const TriangleMesh& mesh : scene.meshes)
+  for (const TriangleMesh& mesh : scene.meshes) {
+    if (meshes == SceneMeshes::Virtual && mesh.real) continue;
     for (const Eigen::Vector3f& p : mesh.positions) box.extend(p);
+  }
   BoundingSphere sphere;
   if (box.isEmpty()) return sphere;
   sphere.centre = box.center();

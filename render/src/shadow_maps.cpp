@@ -72,11 +72,15 @@ ShadowLayout plan_shadow_views(const MrScene& scene, int tile) {
   const BoundingSphere bounds = bounding_sphere(scene);
   const Vec3 centre = bounds.radius > 0.f ? bounds.centre : Vec3::Zero();
   const float radius = bounds.radius > 0.f ? bounds.radius : 1.f;
+  const BoundingSphere virtual_bounds = bounding_sphere(scene, SceneMeshes::Virtual);
   for (const MrLight& light : scene.lights) {
     const auto first = static_cast<std::uint32_t>(layout.views.size());
     const float spot_half_angle = std::acos(std::clamp(light.cos_outer, -1.f, 1.f)) * 1.02f;
     if (light.kind == LightKind::Directional) {
       layout.views.push_back(orthographic_view(light.direction, centre, radius, tile));
+      if (virtual_bounds.radius > 0.f) {
+        layout.virtual_views.push_back(orthographic_view(light.direction, virtual_bounds.centre, virtual_bounds.radius, tile));
+      }
     } else if (light.kind == LightKind::Spot && spot_half_angle <= kMaxSpotHalfAngle) {
       layout.views.push_back(perspective_view(light.position, light.direction, spot_half_angle, tile));
     } else {
@@ -86,6 +90,10 @@ ShadowLayout plan_shadow_views(const MrScene& scene, int tile) {
         layout.views.push_back(perspective_view(light.position, forward, static_cast<float>(M_PI / 4), tile));
       }
     }
+    // Views of positional lights (and of any light in a scene without virtual objects) are
+    // the same for both layers.
+    layout.virtual_views.insert(layout.virtual_views.end(), layout.views.begin() + static_cast<std::ptrdiff_t>(layout.virtual_views.size()),
+                                layout.views.end());
     layout.light_views.push_back({first, static_cast<std::uint32_t>(layout.views.size()) - first});
   }
   layout.columns = std::clamp(static_cast<int>(layout.views.size()), 1, 8);
@@ -105,7 +113,7 @@ std::vector<float> shadow_atlas_cpu(const RayTracer& tracer, const ShadowLayout&
   parallel_rows(tile_rows, threads, [&](int begin, int end) {
     for (int row = begin; row < end; ++row) {
       const int view_index = row / (2 * tile), layer = (row / tile) % 2, y = row % tile;
-      const ShadowView& view = layout.views[static_cast<std::size_t>(view_index)];
+      const ShadowView& view = layout.view(static_cast<std::size_t>(view_index), layer);
       const Eigen::Matrix4f clip_to_world = view.world_to_clip.inverse();
       const auto [ox, oy] = layout.tile_origin(view_index, layer);
       for (int x = 0; x < tile; ++x) {
@@ -129,12 +137,12 @@ float shadow_visibility(const ShadowLayout& layout, std::span<const float> atlas
   if (light >= layout.light_views.size()) return 1.f;
   const auto [first, count] = layout.light_views[light];
   if (count == 0) return 1.f;
-  const ShadowView& any = layout.views[first];
+  const ShadowView& any = layout.view(first, layer);
   const Vec3 eye = any.eye.head<3>();
   const bool positional = any.eye.w() > 0.5f;
   const Vec3 towards_light = positional ? Vec3(eye - point) : eye;
   const std::uint32_t index = count == 6 ? first + static_cast<std::uint32_t>(cube_face(point - eye)) : first;
-  const ShadowView& view = layout.views[index];
+  const ShadowView& view = layout.view(index, layer);
   // Against shadow acne: the receiver moves half a texel (measured at the receiver) off its
   // surface, and the depth test allows one texel. Larger offsets lift receivers next to a
   // contact (a virtual object standing on a real table) out of its shadow (bench

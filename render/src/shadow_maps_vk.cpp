@@ -65,10 +65,10 @@ void ShadowMapsVk::record(VkCommandBuffer cmd, const ShadowLayout& layout) {
   vkCmdBeginRenderPass(cmd, &begin, VK_SUBPASS_CONTENTS_INLINE);
   const auto tile = static_cast<std::uint32_t>(layout.tile);
   for (std::size_t v = 0; v < layout.views.size(); ++v) {
-    ViewConstants constants{};
-    std::memcpy(constants.world_to_clip, layout.views[v].world_to_clip.data(), sizeof constants.world_to_clip);
-    std::memcpy(constants.eye, layout.views[v].eye.data(), sizeof constants.eye);
     for (int layer = 0; layer < 2; ++layer) {
+      ViewConstants constants{};
+      std::memcpy(constants.world_to_clip, layout.view(v, layer).world_to_clip.data(), sizeof constants.world_to_clip);
+      std::memcpy(constants.eye, layout.view(v, layer).eye.data(), sizeof constants.eye);
       const auto [x, y] = layout.tile_origin(static_cast<int>(v), layer);
       const VkRect2D area{{x, y}, {tile, tile}};
       draw_scene(cmd, pipeline_, layer == 0 ? real_vertices_ : virtual_vertices_,

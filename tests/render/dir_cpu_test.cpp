@@ -11,6 +11,7 @@
 #include <tuple>
 
 #include "relight/core/error.h"
+#include "relight/render/shadow_maps.h"
 #include "test_scenes.h"
 
 namespace relight::render {
@@ -42,6 +43,37 @@ MrScene cube_scene() {
   MrScene scene = floor_scene(Eigen::Vector3f::Constant(0.8f), {1.0f, 0.f, 1.5f}, 4.f);
   test::add_virtual_box(scene, synth::Box{{-0.2, -0.2, 0.0}, {0.2, 0.2, 0.4}}, diffuse({0.9f, 0.1f, 0.1f}, "red cube"));
   return scene;
+}
+
+// The virtual layer's shadow map of a directional light against exact visibility on the real
+// floor around a 10 cm virtual box on a 4 m floor (256-texel tiles), within 30 cm of the box.
+// Measured: 4 of 382 shadowed points misjudged (texel 0.69 mm); 64 when the view covered the whole
+// scene (texel 22 mm).
+TEST(ShadowMaps, VirtualContactShadowOfADirectionalLightIsSharp) {
+  MrScene scene = test::floor_scene(Eigen::Vector3f::Constant(0.5f), {0.f, 0.f, 2.f}, 1.f);
+  test::add_virtual_box(scene, synth::Box{{-0.05, -0.05, 0.0}, {0.05, 0.05, 0.1}}, diffuse({0.8f, 0.8f, 0.8f}, "box"));
+  MrLight sun;
+  sun.kind = LightKind::Directional;
+  sun.direction = Eigen::Vector3f(0.5f, 0.3f, 0.8f).normalized();  // towards the light
+  scene.lights.push_back(sun);
+  const RayTracer tracer(scene);
+  const ShadowLayout layout = plan_shadow_views(scene, 256);
+  const std::vector<float> atlas = shadow_atlas_cpu(tracer, layout);
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  int shadowed = 0, wrong = 0;
+  for (int i = -60; i <= 60; ++i)
+    for (int j = -60; j <= 60; ++j) {
+      const Eigen::Vector3f point(0.005f * static_cast<float>(i), 0.005f * static_cast<float>(j), 0.f);
+      if (std::abs(point.x()) < 0.052f && std::abs(point.y()) < 0.052f) continue;  // under the box
+      const bool exact = !tracer.occluded(Layer::Virtual, point + 1e-4f * up, sun.direction, 1e3f);
+      const bool mapped = shadow_visibility(layout, atlas, 1, 1, point, up) > 0.5f;
+      shadowed += exact ? 0 : 1;
+      wrong += exact != mapped ? 1 : 0;
+    }
+  std::printf("virtual contact shadow: %d floor points in shadow, %d misjudged (texel %.2f mm)\n", shadowed, wrong,
+              1e3f * layout.view(layout.light_views[1][0], 1).texel_size);
+  EXPECT_GT(shadowed, 300);
+  EXPECT_LT(wrong, shadowed / 20);
 }
 
 TEST(DirCpu, VirtualCubeBleedsRedOntoTheRealFloorOnlyInLrv) {

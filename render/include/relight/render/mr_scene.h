@@ -73,8 +73,10 @@ struct BoundingSphere {
 
 struct MrScene;
 
-/// A sphere around every vertex of `scene` (the box's half diagonal, 1 % + 1 mm larger).
-[[nodiscard]] BoundingSphere bounding_sphere(const MrScene& scene);
+enum class SceneMeshes { All, Virtual };
+/// A sphere around every vertex of `scene`'s meshes (or of its virtual ones): the bounding box's
+/// half diagonal, 1 % + 1 mm larger.
+[[nodiscard]] BoundingSphere bounding_sphere(const MrScene& scene, SceneMeshes meshes = SceneMeshes::All);
 
 struct MrScene {
   std::vector<PhongMaterial> materials;

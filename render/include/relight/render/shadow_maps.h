@@ -5,7 +5,11 @@
 //   point light or wider spot          six cube faces (+x, -x, +y, -y, +z, -z);
 //   directional light                  one orthographic view over the scene's bounding sphere.
 // Each view is rendered twice, through the real and through the virtual layer, so that the
-// shading pass gets V_r and V_v separately (eqs. 5.1-5.5 need min(V_r, V_v) and V_r).
+// shading pass gets V_r and V_v separately (eqs. 5.1-5.5 need min(V_r, V_v) and V_r). A
+// directional light's virtual-layer view covers only the virtual objects' bounding sphere: the
+// virtual layer casts no shadow outside it, and an orthographic view over the whole room gives
+// a small object a few texels (256-texel tiles over a 5 m room: 2 cm each), which smeared its
+// contact shadow over the real surface around it.
 //
 // A texel stores the nearest surface's "light depth": the distance to the light for point and
 // spot lights, and the distance along the light's direction for a directional light
@@ -40,7 +44,8 @@ struct ShadowView {
 struct ShadowLayout {
   int tile = 512;
   int columns = 8;
-  std::vector<ShadowView> views;
+  std::vector<ShadowView> views;          ///< through the real layer
+  std::vector<ShadowView> virtual_views;  ///< through the virtual layer, one per entry of `views`
   /// Per MrScene light: first view and view count (1 or 6).
   std::vector<std::array<std::uint32_t, 2>> light_views;
 
@@ -48,6 +53,10 @@ struct ShadowLayout {
   [[nodiscard]] int atlas_width() const { return columns * tile; }
   /// Both layers; at least one row so that an empty atlas is still a valid image.
   [[nodiscard]] int atlas_height() const { return 2 * std::max(rows(), 1) * tile; }
+  /// View `index` of layer 0 (real) or 1 (virtual).
+  [[nodiscard]] const ShadowView& view(std::size_t index, int layer) const {
+    return layer == 0 ? views[index] : virtual_views[index];
+  }
   /// Top-left texel of view `view` in layer 0 (real) or 1 (virtual).
   [[nodiscard]] std::array<int, 2> tile_origin(int view, int layer) const {
     return {(view % columns) * tile, (layer * std::max(rows(), 1) + view / columns) * tile};
