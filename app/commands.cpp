@@ -76,6 +76,11 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                      "sampled texels of its reflective shadow maps, rasterised on the Vulkan device)")
       ->check(CLI::IsMember({"rays", "rsm"}))
       ->capture_default_str();
+  command.add_option("--real-albedo", options.real_albedo,
+                     "The k_d that real surfaces are rendered with: pixel (each camera pixel's own estimate, so "
+                     "that the real-only render matches the camera's colours) or cluster (its material cluster's)")
+      ->check(CLI::IsMember({"pixel", "cluster"}))
+      ->capture_default_str();
   command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

@@ -236,6 +236,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
       options.vpl_source == "rsm" ? render::VplSource::ReflectiveShadowMaps : render::VplSource::RayTraced;
   dir.tone_map.exposure = options.exposure;
   dir.materials_buffer = "materials";
+  if (options.real_albedo == "pixel") dir.albedo_buffer = "kd";
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view
   // keep their shadows, at a quarter of the rasterisation and memory of 512.
   dir.renderer.shadow_tile = 256;

@@ -47,6 +47,8 @@ struct ReplayOptions {
   int vpl_bounces = 1;                         ///< indirect bounces carried by VPLs (render/vpl.h)
   std::string bounce_method = "rays";          ///< rays | cone: how bounces >= 2 find surfaces
   std::string vpl_source = "rays";             ///< rays | rsm: where spot lights' first VPLs come from
+  /// pixel | cluster: the k_d real surfaces are shaded with (render/camera_albedo.h)
+  std::string real_albedo = "pixel";
   float exposure = 1.f;                        ///< tone mapping of the rendered light
   bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
   /// Colour mapping of the rendered light to the camera (colormap/): none | sample | stats.

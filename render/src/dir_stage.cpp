@@ -1,6 +1,7 @@
 #include "relight/render/dir_stage.h"
 
 #include "relight/core/error.h"
+#include "relight/render/camera_albedo.h"
 #include "relight/render/composite.h"
 #include "relight/render/ray_tracer.h"
 
@@ -43,7 +44,7 @@ void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneConte
                     const DirStageOptions& options) {
   graph.emplace<MrSceneStage>(std::move(content), options);
   graph.emplace<VplStage>(options.vpls, context);
-  graph.emplace<DirRenderStage>(context, options.renderer);
+  graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffer);
   graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
   graph.emplace<DifferentialCompositeStage>(options.tone_map);
 }
@@ -114,8 +115,8 @@ void VplStage::run(StageContext& context) {
 
 // ---- dir ---------------------------------------------------------------------------------------
 
-DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirVkOptions options)
-    : context_(context), options_(std::move(options)) {}
+DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirVkOptions options, std::string albedo_buffer)
+    : context_(context), options_(std::move(options)), albedo_buffer_(std::move(albedo_buffer)) {}
 
 DirRenderStage::~DirRenderStage() = default;
 
@@ -125,6 +126,10 @@ void DirRenderStage::declare(StageBuilder& builder) {
   positions_ = builder.read<PositionMap>("positions");
   scene_ = builder.read<MrScene>("mr_scene");
   vpls_ = builder.read<VplSet>("vpls");
+  if (!albedo_buffer_.empty()) {
+    albedo_ = builder.read<RadianceImage>(albedo_buffer_);
+    albedo_valid_ = builder.read<Mask>(albedo_buffer_ + "_valid");
+  }
   images_ = builder.write<DifferentialImages>("dir_images");
   gbuffer_ = builder.write<GBuffer>("dir_gbuffer");
 }
@@ -144,15 +149,18 @@ void DirRenderStage::run(StageContext& context) {
   GBuffer& gbuffer = context.get(gbuffer_);
   if (!context_) {
     images = render_dir_cpu(scene, camera, vpls, options_, &gbuffer);
-    return;
+  } else {
+    if (!renderer_ || renderer_size_ != std::pair{width, height}) {
+      renderer_ = std::make_unique<DirRendererVk>(*context_, width, height);
+      renderer_size_ = {width, height};
+    }
+    renderer_->set_scene(scene, options_);
+    images = renderer_->render(camera, vpls, options_);
+    gbuffer = renderer_->last_gbuffer();
   }
-  if (!renderer_ || renderer_size_ != std::pair{width, height}) {
-    renderer_ = std::make_unique<DirRendererVk>(*context_, width, height);
-    renderer_size_ = {width, height};
+  if (!albedo_buffer_.empty()) {
+    modulate_camera_albedo(images, gbuffer, scene, context.get(albedo_), context.get(albedo_valid_));
   }
-  renderer_->set_scene(scene, options_);
-  images = renderer_->render(camera, vpls, options_);
-  gbuffer = renderer_->last_gbuffer();
 }
 
 // ---- indirect_smoothing ------------------------------------------------------------------------

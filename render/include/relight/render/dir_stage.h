@@ -13,7 +13,9 @@
 //                            writes VplSet "vpls" (vpl.h)
 //   dir                      reads  FrameInfo "frame", ColorImage "color" and PositionMap
 //                                   "positions" (the image size, which they must share),
-//                                   MrScene "mr_scene", VplSet "vpls"
+//                                   MrScene "mr_scene", VplSet "vpls"; when `albedo_buffer` is
+//                                   set, that RadianceImage (per-pixel k_d) and Mask
+//                                   "<albedo_buffer>_valid" (camera_albedo.h)
 //                            writes DifferentialImages "dir_images" (L_rv, L_r, coverage and
 //                                   their indirect parts, one shading pass) and GBuffer
 //                                   "dir_gbuffer"
@@ -62,6 +64,9 @@ struct DirStageOptions {
   PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
   colormap::ToneMap tone_map{};
   std::string materials_buffer;  ///< empty: no Materials input
+  /// Per-pixel k_d of the camera's real surfaces (brdf/'s "kd"), modulating the cluster k_d of
+  /// diffuse real surfaces (camera_albedo.h); empty: the clusters' k_d alone.
+  std::string albedo_buffer;
   bool temporal_smoothing = true;
   TemporalOptions temporal{};
 };
@@ -119,7 +124,8 @@ class VplStage final : public Stage {
 /// Steps 3-4 (G-buffer, shadow maps, ISMs, one-pass shading of L_rv and L_r).
 class DirRenderStage final : public Stage {
  public:
-  DirRenderStage(vk::VulkanContext* context, DirVkOptions options);
+  /// `albedo_buffer`: DirStageOptions::albedo_buffer.
+  DirRenderStage(vk::VulkanContext* context, DirVkOptions options, std::string albedo_buffer = {});
   ~DirRenderStage() override;
   [[nodiscard]] std::string name() const override { return "dir"; }
   void declare(StageBuilder& builder) override;
@@ -128,6 +134,7 @@ class DirRenderStage final : public Stage {
  private:
   vk::VulkanContext* context_;
   DirVkOptions options_;
+  std::string albedo_buffer_;
   std::unique_ptr<DirRendererVk> renderer_;
   std::pair<int, int> renderer_size_{0, 0};
   Read<FrameInfo> frame_;
@@ -135,6 +142,8 @@ class DirRenderStage final : public Stage {
   Read<PositionMap> positions_;
   Read<MrScene> scene_;
   Read<VplSet> vpls_;
+  Read<RadianceImage> albedo_;
+  Read<Mask> albedo_valid_;
   Write<DifferentialImages> images_;
   Write<GBuffer> gbuffer_;
 };

@@ -1,0 +1,83 @@
+// modulate_camera_albedo (camera_albedo.h) on a hand-built G-buffer: which pixels it changes,
+// and by how much.
+#include "relight/render/camera_albedo.h"
+
+#include <gtest/gtest.h>
+
+#include "relight/core/error.h"
+#include "test_scenes.h"
+
+namespace relight::render {
+namespace {
+
+constexpr int kPixels = 6;
+
+struct Fixture {
+  MrScene scene;
+  GBuffer gbuffer{PositionMap(kPixels, 1), NormalMap(kPixels, 1), LabelImage(kPixels, 1), Mask(kPixels, 1),
+                  DepthMap(kPixels, 1)};
+  DifferentialImages images{RadianceImage(kPixels, 1), RadianceImage(kPixels, 1), CoverageImage(kPixels, 1), 1,
+                            RadianceImage(kPixels, 1), RadianceImage(kPixels, 1)};
+  RadianceImage albedo{kPixels, 1};
+  Mask valid{kPixels, 1};
+};
+
+// Pixels: 0 real diffuse; 1 virtual; 2 real glossy; 3 real diffuse, estimate invalid;
+// 4 nothing seen; 5 real diffuse whose cluster has no blue.
+Fixture fixture() {
+  Fixture f;
+  const std::uint32_t grey = f.scene.add_material(test::diffuse({0.5f, 0.5f, 0.5f}, "grey"));
+  PhongMaterial glossy = test::diffuse({0.5f, 0.5f, 0.5f}, "glossy");
+  glossy.ks = 0.3f;
+  glossy.n = 20.f;
+  const std::uint32_t shiny = f.scene.add_material(glossy);
+  const std::uint32_t yellow = f.scene.add_material(test::diffuse({0.6f, 0.6f, 0.f}, "yellow"));
+  const std::uint16_t labels[kPixels] = {static_cast<std::uint16_t>(grey + 1), static_cast<std::uint16_t>(grey + 1),
+                                         static_cast<std::uint16_t>(shiny + 1), static_cast<std::uint16_t>(grey + 1), 0,
+                                         static_cast<std::uint16_t>(yellow + 1)};
+  for (int x = 0; x < kPixels; ++x) {
+    f.gbuffer.material(0, x) = labels[x];
+    f.gbuffer.distance(0, x) = labels[x] ? 1.f : 0.f;
+    f.gbuffer.virtual_surface(0, x) = x == 1 ? 1 : 0;
+    f.valid(0, x) = x == 3 ? 0 : 1;
+    f.albedo(0, x) = {0.25f, 0.5f, 0.75f};
+    f.images.real(0, x) = {1.f, 2.f, 3.f};
+    f.images.real_virtual(0, x) = {0.5f, 1.f, 1.5f};
+    f.images.indirect_real(0, x) = {0.1f, 0.2f, 0.3f};
+    f.images.indirect_real_virtual(0, x) = {0.05f, 0.1f, 0.15f};
+  }
+  return f;
+}
+
+void expect_rgb(const Float3& got, float r, float g, float b, int pixel) {
+  EXPECT_NEAR(got.x, r, 1e-6f) << "pixel " << pixel;
+  EXPECT_NEAR(got.y, g, 1e-6f) << "pixel " << pixel;
+  EXPECT_NEAR(got.z, b, 1e-6f) << "pixel " << pixel;
+}
+
+TEST(CameraAlbedo, ScalesEveryPartOfRealDiffusePixelsByTheirAlbedoOverTheClusters) {
+  Fixture f = fixture();
+  modulate_camera_albedo(f.images, f.gbuffer, f.scene, f.albedo, f.valid);
+  // Pixel 0: factors (0.25, 0.5, 0.75) / 0.5 = (0.5, 1, 1.5) on all four parts.
+  expect_rgb(f.images.real(0, 0), 0.5f, 2.f, 4.5f, 0);
+  expect_rgb(f.images.real_virtual(0, 0), 0.25f, 1.f, 2.25f, 0);
+  expect_rgb(f.images.indirect_real(0, 0), 0.05f, 0.2f, 0.45f, 0);
+  expect_rgb(f.images.indirect_real_virtual(0, 0), 0.025f, 0.1f, 0.225f, 0);
+  // Virtual, glossy, invalid and empty pixels keep their shading.
+  for (int x : {1, 2, 3, 4}) {
+    expect_rgb(f.images.real(0, x), 1.f, 2.f, 3.f, x);
+    expect_rgb(f.images.real_virtual(0, x), 0.5f, 1.f, 1.5f, x);
+    expect_rgb(f.images.indirect_real(0, x), 0.1f, 0.2f, 0.3f, x);
+  }
+  // Pixel 5: the cluster has no blue to scale, so blue keeps the cluster's shading.
+  expect_rgb(f.images.real(0, 5), 0.25f / 0.6f, 2.f * 0.5f / 0.6f, 3.f, 5);
+}
+
+TEST(CameraAlbedo, ImagesOfDifferentSizesAreAnError) {
+  Fixture f = fixture();
+  const RadianceImage small(kPixels - 1, 1);
+  EXPECT_THROW(modulate_camera_albedo(f.images, f.gbuffer, f.scene, small, f.valid), Error);
+}
+
+}  // namespace
+}  // namespace relight::render
