@@ -73,6 +73,37 @@ TEST(CameraAlbedo, ScalesEveryPartOfRealDiffusePixelsByTheirAlbedoOverTheCluster
   expect_rgb(f.images.real(0, 5), 0.25f / 0.6f, 2.f * 0.5f / 0.6f, 3.f, 5);
 }
 
+// The estimate is averaged over the 5 x 5 window of its own material: a checkerboard of two
+// estimates becomes their mean inside a material, and the neighbouring material stays apart.
+TEST(CameraAlbedo, EstimatesAreAveragedOverTheirMaterialsWindow) {
+  constexpr int kSize = 9;
+  MrScene scene;
+  const std::uint32_t left = scene.add_material(test::diffuse({0.5f, 0.5f, 0.5f}, "left"));
+  const std::uint32_t right = scene.add_material(test::diffuse({0.5f, 0.5f, 0.5f}, "right"));
+  GBuffer gbuffer{PositionMap(kSize, kSize), NormalMap(kSize, kSize), LabelImage(kSize, kSize), Mask(kSize, kSize),
+                  DepthMap(kSize, kSize)};
+  DifferentialImages images{RadianceImage(kSize, kSize), RadianceImage(kSize, kSize), CoverageImage(kSize, kSize), 1,
+                            RadianceImage(kSize, kSize), RadianceImage(kSize, kSize)};
+  RadianceImage albedo(kSize, kSize);
+  Mask valid(kSize, kSize);
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      const bool is_left = x < 5;
+      gbuffer.material(y, x) = static_cast<std::uint16_t>((is_left ? left : right) + 1);
+      valid(y, x) = 1;
+      const float a = is_left ? ((x + y) % 2 ? 0.2f : 0.4f) : 0.8f;
+      albedo(y, x) = {a, a, a};
+      images.real(y, x) = {1.f, 1.f, 1.f};
+      images.real_virtual(y, x) = {1.f, 1.f, 1.f};
+    }
+  modulate_camera_albedo(images, gbuffer, scene, albedo, valid);
+  // Centre of the left material: 13 of the 25 window pixels hold 0.4, 12 hold 0.2.
+  EXPECT_NEAR(images.real(4, 2).x, (13 * 0.4f + 12 * 0.2f) / 25.f / 0.5f, 1e-5f);
+  // Its border column (x = 4) averages left pixels only; the right material keeps 0.8.
+  EXPECT_NEAR(images.real(4, 4).x, (8 * 0.4f + 7 * 0.2f) / 15.f / 0.5f, 1e-5f);
+  EXPECT_NEAR(images.real(4, 5).x, 0.8f / 0.5f, 1e-5f);
+}
+
 TEST(CameraAlbedo, ImagesOfDifferentSizesAreAnError) {
   Fixture f = fixture();
   const RadianceImage small(kPixels - 1, 1);
