@@ -248,6 +248,22 @@ struct Method2State {
   NormalMap normals;
 };
 
+/// Method 1's history from the previous frame's state (none on the first frame).
+std::optional<NormalsHistory> history_of(const Method2State* previous, const BenchSequence& s) {
+  if (!previous) return std::nullopt;
+  return NormalsHistory{previous->normals, previous->positions, s.pose};
+}
+
+/// Runs `frame(depth, previous state or null, next state)` over the sequence's frames; returns
+/// the last frame's state (one of `states`).
+template <class Frame>
+const Method2State& run_frames(const BenchSequence& s, Method2State (&states)[2], Frame&& frame) {
+  for (int i = 0; i < kFrames; ++i) {
+    frame(s.noisy[static_cast<std::size_t>(i)], i > 0 ? &states[1 - i % 2] : nullptr, states[i % 2]);
+  }
+  return states[(kFrames - 1) % 2];
+}
+
 double plain_normals_error(const Method2State& state, const BenchSequence& s) {
   PositionMap positions;
   NormalMap normals;
@@ -269,16 +285,12 @@ Json method2_cpu(const bench::Options& options) {
       warped = DepthMap();  // no history: merge_depth takes the depth alone
     }
     merge_depth(depth, warped, warped_weight, {}, next.filtered, next.weight);
-    std::optional<NormalsHistory> history;
-    if (previous) history.emplace(NormalsHistory{previous->normals, previous->positions, s.pose});
+    const std::optional<NormalsHistory> history = history_of(previous, s);
     normals_method.run(next.filtered, s.intrinsics, s.pose, history ? &*history : nullptr, {}, next.positions,
                        next.normals);
   };
   Method2State states[2];
-  for (int i = 0; i < kFrames; ++i) {
-    frame(s.noisy[static_cast<std::size_t>(i)], i > 0 ? &states[1 - i % 2] : nullptr, states[i % 2]);
-  }
-  const Method2State& last = states[(kFrames - 1) % 2];
+  const Method2State& last = run_frames(s, states, frame);
   const AngularError error = angular_error(last.normals, s.truth);
   Method2State scratch;
   Json json = compare_with_pcl([&] { frame(s.noisy.back(), &last, scratch); }, last.normals, options);
@@ -310,8 +322,7 @@ Json method2_vulkan(const bench::Options& options) {
   const auto frame = [&](const DepthMap& depth, const Method2State* previous, Method2State& next) {
     warp_merge.run(depth, previous ? &previous->filtered : nullptr, previous ? &previous->weight : nullptr, s.intrinsics,
                    Pose::Identity(), {}, next.filtered, next.weight);
-    std::optional<NormalsHistory> history;
-    if (previous) history.emplace(NormalsHistory{previous->normals, previous->positions, s.pose});
+    const std::optional<NormalsHistory> history = history_of(previous, s);
     normals_method.run(next.filtered, s.intrinsics, s.pose, history ? &*history : nullptr, {}, next.positions,
                        next.normals);
     if (warp_merge.last_gpu_ms() && normals_method.last_gpu_ms()) {
@@ -319,10 +330,7 @@ Json method2_vulkan(const bench::Options& options) {
     }
   };
   Method2State states[2];
-  for (int i = 0; i < kFrames; ++i) {
-    frame(s.noisy[static_cast<std::size_t>(i)], i > 0 ? &states[1 - i % 2] : nullptr, states[i % 2]);
-  }
-  const Method2State& last = states[(kFrames - 1) % 2];
+  const Method2State& last = run_frames(s, states, frame);
   const AngularError error = angular_error(last.normals, s.truth);
   Method2State scratch;
   gpu_ms.clear();
