@@ -3,8 +3,10 @@
 // turns interleaved indirect light back into a full image (Segovia et al. 2006; Knecht 2010 §4).
 // Each pixel averages the indirect light of the n x n window [x - n/2, x + n/2 - 1] (one pixel of
 // every VPL subset) over the neighbours on the same kind of surface (real or virtual) within 5 %
-// of its distance and with normals within ~25 degrees; direct light passes through unblurred.
-// The CPU mirror is merge_interleaved() in dir_maps_cpu.cpp.
+// of its distance and with normals within ~25 degrees; a subset whose pixel there fails is
+// looked for one period further out (its 8 pixels at ±n), averaged first, so that each subset
+// found counts once. Direct light passes through unblurred.
+// The CPU mirror is merged_pixel() in dir_maps_cpu.cpp.
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(std430, set = 0, binding = 0) readonly buffer GBuffer { vec4 gbuffer[]; };
@@ -17,6 +19,15 @@ layout(push_constant) uniform Params {
   uint height;
   uint interleave;
 } params;
+
+bool similar(ivec2 q, ivec2 size, uint pixels, float distance, vec3 normal) {
+  if (q.x < 0 || q.y < 0 || q.x >= size.x || q.y >= size.y) return false;
+  const uint j = uint(q.y) * params.width + uint(q.x);
+  const float dq = gbuffer[j].w;
+  if (dq == 0.0 || (dq < 0.0) != (distance < 0.0)) return false;
+  if (abs(abs(dq) - abs(distance)) > 0.05 * abs(distance)) return false;
+  return dot(gbuffer[pixels + j].xyz, normal) >= 0.9;
+}
 
 void main() {
   const ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -32,15 +43,29 @@ void main() {
   if (n > 1 && position.w != 0.0) {
     for (int dy = -n / 2; dy < n - n / 2; ++dy)
       for (int dx = -n / 2; dx < n - n / 2; ++dx) {
+        if (dx == 0 && dy == 0) continue;
         const ivec2 q = p + ivec2(dx, dy);
-        if ((dx == 0 && dy == 0) || q.x < 0 || q.y < 0 || q.x >= size.x || q.y >= size.y) continue;
-        const uint j = uint(q.y) * params.width + uint(q.x);
-        const float dq = gbuffer[j].w;
-        if (dq == 0.0 || (dq < 0.0) != (position.w < 0.0)) continue;
-        if (abs(abs(dq) - abs(position.w)) > 0.05 * abs(position.w)) continue;
-        if (dot(gbuffer[pixels + j].xyz, normal) < 0.9) continue;
-        sum_rv += shaded[4u * j + 2u].xyz;
-        sum_r += shaded[4u * j + 3u].xyz;
+        if (similar(q, size, pixels, position.w, normal)) {
+          const uint j = uint(q.y) * params.width + uint(q.x);
+          sum_rv += shaded[4u * j + 2u].xyz;
+          sum_r += shaded[4u * j + 3u].xyz;
+          weight += 1.0;
+          continue;
+        }
+        vec3 subset_rv = vec3(0.0), subset_r = vec3(0.0);
+        float found = 0.0;
+        for (int b = -1; b <= 1; ++b)
+          for (int a = -1; a <= 1; ++a) {
+            const ivec2 s = q + ivec2(a, b) * n;
+            if ((a == 0 && b == 0) || !similar(s, size, pixels, position.w, normal)) continue;
+            const uint j = uint(s.y) * params.width + uint(s.x);
+            subset_rv += shaded[4u * j + 2u].xyz;
+            subset_r += shaded[4u * j + 3u].xyz;
+            found += 1.0;
+          }
+        if (found == 0.0) continue;
+        sum_rv += subset_rv / found;
+        sum_r += subset_r / found;
         weight += 1.0;
       }
   }

@@ -94,26 +94,50 @@ class MapShader {
   const DirVkOptions& options_;
 };
 
-/// merge_interleaved: dir_merge.comp's geometry-aware average of the indirect light over the
-/// n x n window, direct light added unblurred.
+/// Whether neighbour (qx, qy) may lend pixel (x, y) its indirect light: inside the image, on the
+/// same kind of surface, within 5 % of its distance and with a normal within ~25 degrees.
+bool similar(const GBuffer& g, int x, int y, int qx, int qy) {
+  if (qx < 0 || qy < 0 || qx >= g.distance.width() || qy >= g.distance.height()) return false;
+  const float distance = g.distance(y, x), dq = g.distance(qy, qx);
+  if (dq == 0.f || (g.virtual_surface(qy, qx) != 0) != (g.virtual_surface(y, x) != 0)) return false;
+  if (std::abs(dq - distance) > 0.05f * distance) return false;
+  return dot(g.normal(qy, qx), g.normal(y, x)) >= 0.9f;
+}
+
+/// merge_interleaved: dir_merge.comp's geometry-aware average of the indirect light, direct
+/// light added unblurred. The n x n window holds one pixel of every VPL subset; a subset whose
+/// pixel there is not similar is looked for one period further out (its 8 pixels at ±n), and
+/// the found pixels of a subset are averaged first, so that every subset found counts once.
+/// Without that search, a pixel next to an edge loses the same subsets as its neighbours, and
+/// their indirect light shows as light or dark blocks.
 Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, int y, int n) {
   const Radiance& own = shaded(y, x);
   Vec3 sum_rv = own.indirect_real_virtual, sum_r = own.indirect_real;
   float weight = 1.f;
-  const float distance = g.distance(y, x);
-  if (n > 1 && distance != 0.f) {
-    const Float3 normal = g.normal(y, x);
-    const bool is_virtual = g.virtual_surface(y, x) != 0;
+  if (n > 1 && g.distance(y, x) != 0.f) {
     for (int dy = -n / 2; dy < n - n / 2; ++dy)
       for (int dx = -n / 2; dx < n - n / 2; ++dx) {
+        if (dx == 0 && dy == 0) continue;
         const int qx = x + dx, qy = y + dy;
-        if ((dx == 0 && dy == 0) || qx < 0 || qy < 0 || qx >= g.distance.width() || qy >= g.distance.height()) continue;
-        const float dq = g.distance(qy, qx);
-        if (dq == 0.f || (g.virtual_surface(qy, qx) != 0) != is_virtual) continue;
-        if (std::abs(dq - distance) > 0.05f * distance) continue;
-        if (dot(g.normal(qy, qx), normal) < 0.9f) continue;
-        sum_rv += shaded(qy, qx).indirect_real_virtual;
-        sum_r += shaded(qy, qx).indirect_real;
+        if (similar(g, x, y, qx, qy)) {
+          sum_rv += shaded(qy, qx).indirect_real_virtual;
+          sum_r += shaded(qy, qx).indirect_real;
+          weight += 1.f;
+          continue;
+        }
+        Vec3 subset_rv = Vec3::Zero(), subset_r = Vec3::Zero();
+        float found = 0.f;
+        for (int b = -1; b <= 1; ++b)
+          for (int a = -1; a <= 1; ++a) {
+            const int sx = qx + a * n, sy = qy + b * n;
+            if ((a == 0 && b == 0) || !similar(g, x, y, sx, sy)) continue;
+            subset_rv += shaded(sy, sx).indirect_real_virtual;
+            subset_r += shaded(sy, sx).indirect_real;
+            found += 1.f;
+          }
+        if (found == 0.f) continue;
+        sum_rv += subset_rv / found;
+        sum_r += subset_r / found;
         weight += 1.f;
       }
   }

@@ -58,6 +58,48 @@ std::vector<Vpl> make_vpls(const MrScene& scene, int count) {
 
 float luminance(const Float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
+// Interleaved sampling (n = 4) and the merge against every pixel seeing every VPL (n = 1), on
+// the CPU mirror: the merged indirect light's mean relative error where the 4 x 4 window crosses
+// an edge (a neighbour on another surface), and elsewhere. Measured (160x120, 64 light
+// samples): interior 0.030, edges 0.190; 0.352 at edges when a subset missing from the window
+// was simply left out.
+TEST(DirMerge, InterleavedIndirectLightStaysCloseToTheFullSumAtEdges) {
+  const MrScene scene = indoor_with_pebble();
+  const MrCamera camera = camera_at({1.3, -1.1, 1.4}, {0.2, -0.1, 0.75}, 160, 120);
+  const std::vector<Vpl> vpls = make_vpls(scene, 64);
+  DirVkOptions options = test_options();
+  options.backend = DirBackend::Cpu;
+  GBuffer gbuffer;
+  options.interleave = 1;
+  const DifferentialImages full = render_dir_cpu(scene, camera, vpls, options, &gbuffer);
+  options.interleave = 4;
+  const DifferentialImages merged = render_dir_cpu(scene, camera, vpls, options);
+  const auto luminance = [](const Float3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; };
+  double error[2] = {0, 0};
+  int count[2] = {0, 0};
+  for (int y = 2; y < 118; ++y)
+    for (int x = 2; x < 158; ++x) {
+      const double reference = luminance(full.indirect_real_virtual(y, x));
+      if (gbuffer.distance(y, x) == 0.f || reference < 1e-3) continue;
+      bool edge = false;
+      for (int dy = -2; dy < 2; ++dy)
+        for (int dx = -2; dx < 2; ++dx) {
+          const float dq = gbuffer.distance(y + dy, x + dx);
+          edge = edge || dq == 0.f || std::abs(dq - gbuffer.distance(y, x)) > 0.05f * gbuffer.distance(y, x) ||
+                 dot(gbuffer.normal(y + dy, x + dx), gbuffer.normal(y, x)) < 0.9f ||
+                 gbuffer.virtual_surface(y + dy, x + dx) != gbuffer.virtual_surface(y, x);
+        }
+      error[edge ? 1 : 0] += std::abs(luminance(merged.indirect_real_virtual(y, x)) - reference) / reference;
+      ++count[edge ? 1 : 0];
+    }
+  ASSERT_GT(count[1], 500);
+  const double interior = error[0] / count[0], at_edges = error[1] / count[1];
+  std::printf("merged indirect light against the full sum: interior %.3f (%d px), edges %.3f (%d px)\n", interior,
+              count[0], at_edges, count[1]);
+  EXPECT_LT(at_edges, 0.25);
+  EXPECT_LT(interior, 0.05);
+}
+
 TEST_F(DirVkTest, ShadowAtlasMatchesTheRayCastReference) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   MrScene scene = indoor_with_pebble();
