@@ -85,7 +85,7 @@ class TemporalSmoothingStageTest : public relight::test::VulkanTest {};
 enum class Geometry {
   NoisyPositionsExactNormals,  ///< raw noisy depth back-projected, exact normals
   Method1,                     ///< raw depth, filtered normals (NormalsRawDepthCpuStage, §4.3.2)
-  Method2,                     ///< warped and merged depth, normals from it (§4.3.3)
+  Method2,                     ///< warped and merged depth, filtered normals from it (§4.3.3)
 };
 
 const char* to_string(Geometry g) {
@@ -97,26 +97,27 @@ const char* to_string(Geometry g) {
   return "?";
 }
 
-/// Mean frame-to-frame change of the indirect light (real pixels, frames 4-8) of the DIR stage.
-double flicker(vk::VulkanContext& context, bool smoothing, Geometry geometry) {
+/// Mean frame-to-frame change of the indirect light of the DIR stage at the same surface point
+/// (real pixels, frames 4-8): each pixel's world point (the G-buffer's) is projected into the
+/// previous frame and compared where that frame's pixel holds the same point (within 1 cm).
+/// A static camera with fresh Kinect-like depth noise every frame shows every point at its own
+/// pixel; on the orbit the points move across the image.
+double flicker(vk::VulkanContext& context, bool smoothing, Geometry geometry, const std::vector<Pose>& poses) {
   const PinholeIntrinsics intrinsics{131.25, 131.25, 79.5, 59.5, 160, 120};
   FrameGraph graph(&context.transfer());
-  // A static camera with fresh Kinect-like depth noise every frame: a pixel shows the same
-  // surface point in every frame, so its change is flicker alone.
-  const Pose pose = synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75});
   using Output = test::SyntheticFrameStage::Output;
   switch (geometry) {
     case Geometry::NoisyPositionsExactNormals:
-      graph.emplace<test::SyntheticFrameStage>(intrinsics, pose, 0.0015f);
+      graph.emplace<test::SyntheticFrameStage>(intrinsics, poses, 0.0015f);
       break;
     case Geometry::Method1:
-      graph.emplace<test::SyntheticFrameStage>(intrinsics, pose, 0.0015f, Output::Depth);
+      graph.emplace<test::SyntheticFrameStage>(intrinsics, poses, 0.0015f, Output::Depth);
       graph.emplace<NormalsRawDepthCpuStage>();
       break;
     case Geometry::Method2:
-      graph.emplace<test::SyntheticFrameStage>(intrinsics, pose, 0.0015f, Output::Depth);
+      graph.emplace<test::SyntheticFrameStage>(intrinsics, poses, 0.0015f, Output::Depth);
       graph.emplace<DepthWarpMergeCpuStage>();
-      graph.emplace<NormalsFromPositionsCpuStage>();
+      graph.emplace<NormalsRawDepthCpuStage>(NormalsRawDepthOptions{}, NormalsDepthInput::Filtered);
       break;
   }
   DirSceneContent content;
@@ -128,41 +129,62 @@ double flicker(vk::VulkanContext& context, bool smoothing, Geometry geometry) {
   options.temporal_smoothing = smoothing;
   add_dir_stages(graph, &context, std::move(content), options);
   graph.keep("L_rv_indirect");
+  graph.keep("dir_gbuffer");
   graph.compile();
   RadianceImage previous;
+  GBuffer previous_gbuffer;
+  Pose previous_pose;
   double change = 0.0;
   int samples = 0;
   for (int frame = 0; frame < 9; ++frame) {
     EXPECT_TRUE(graph.run_frame());
     const RadianceImage& now = *graph.find<RadianceImage>("L_rv_indirect");
     const CoverageImage& coverage = *graph.find<CoverageImage>("virtual_coverage");
-    if (frame >= 4)  // past the first blends
-      for (std::size_t i = 0; i < now.size(); ++i)
-        if (coverage.pixels()[i] == 0.f) {
-          change += length(now.pixels()[i] - previous.pixels()[i]);
-          ++samples;
-        }
+    const GBuffer& gbuffer = *graph.find<GBuffer>("dir_gbuffer");
+    const Pose pose = graph.find<FrameInfo>("frame")->camera_to_world.value_or(Pose::Identity());
+    if (frame >= 4) {  // past the first blends
+      const Pose previous_from_world = previous_pose.inverse();
+      for (std::size_t i = 0; i < now.size(); ++i) {
+        if (coverage.pixels()[i] != 0.f || gbuffer.distance.pixels()[i] == 0.f) continue;
+        const Float3& p = gbuffer.position.pixels()[i];
+        const Eigen::Vector3d world(p.x, p.y, p.z);
+        const Eigen::Vector3d in_previous = previous_from_world * world;
+        if (in_previous.z() <= 0.0) continue;
+        const Eigen::Vector2d uv = intrinsics.project(in_previous);
+        const int u = static_cast<int>(std::floor(uv.x() + 0.5)), v = static_cast<int>(std::floor(uv.y() + 0.5));
+        if (u < 0 || v < 0 || u >= intrinsics.width || v >= intrinsics.height) continue;
+        const std::size_t j = static_cast<std::size_t>(v) * static_cast<std::size_t>(intrinsics.width) + static_cast<std::size_t>(u);
+        if (previous_gbuffer.distance.pixels()[j] == 0.f || previous_gbuffer.virtual_surface.pixels()[j]) continue;
+        const Float3& q = previous_gbuffer.position.pixels()[j];
+        if ((Eigen::Vector3d(q.x, q.y, q.z) - world).norm() > 0.03) continue;
+        change += length(now.pixels()[i] - previous.pixels()[j]);
+        ++samples;
+      }
+    }
     previous = now;
+    previous_gbuffer = gbuffer;
+    previous_pose = pose;
   }
   return change / std::max(samples, 1);
 }
 
+// The goal, at least 50 % less flicker, on a static camera and on the orbit, for every
+// kind of geometry. Measured (static / orbit): noisy positions with exact normals 71 / 62 %,
+// method 1 73 / 67 %, method 2 88 / 82 %. (Comparing pixels rather than surface points, the
+// static camera gave 44 / 40 / 75 %: a pixel on a depth edge swaps surfaces with the noise, and
+// no temporal filter may blend those.)
 TEST_F(TemporalSmoothingStageTest, CutsTheFlickerOfIndirectLightOnNoisyDepth) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
-  for (const Geometry geometry : {Geometry::NoisyPositionsExactNormals, Geometry::Method1, Geometry::Method2}) {
-    const double without = flicker(context, false, geometry);
-    const double with = flicker(context, true, geometry);
-    std::printf("flicker, %s: %.5f without smoothing, %.5f with (%.0f %% less)\n", to_string(geometry), without,
-                with, 100.0 * (1.0 - with / without));
-    EXPECT_GT(without, 0.0) << "the noise moves the VPLs";
-    if (geometry == Geometry::Method2) {
-      // The geometry the dissertation renders with (§4.3.3, filtered depth). Measured: 75 % less.
-      EXPECT_LT(with, 0.5 * without) << to_string(geometry);
-    } else {
-      // Measured 44 % (exact normals) and 40 % (method 1) less: on raw depth the Kinect-like noise
-      // (sigma ~ 0.0015 z^2) alone gives eps_pos ~ 0.3-0.4 with the paper's w_p, so the
-      // confidence stays near 0.55 instead of c_B = 0.9.
-      EXPECT_LT(with, 0.7 * without) << to_string(geometry);
+  const std::vector<Pose> still{synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75})};
+  const std::vector<Pose> orbit = synth::make_trajectory(synth::Trajectory::Orbit, 9, 0, synth::default_indoor_scene());
+  for (const bool moving : {false, true}) {
+    for (const Geometry geometry : {Geometry::NoisyPositionsExactNormals, Geometry::Method1, Geometry::Method2}) {
+      const double without = flicker(context, false, geometry, moving ? orbit : still);
+      const double with = flicker(context, true, geometry, moving ? orbit : still);
+      std::printf("flicker, %s, %s: %.5f without smoothing, %.5f with (%.0f %% less)\n", moving ? "orbit" : "static",
+                  to_string(geometry), without, with, 100.0 * (1.0 - with / without));
+      EXPECT_GT(without, 0.0) << "the noise moves the VPLs";
+      EXPECT_LT(with, 0.5 * without) << (moving ? "orbit, " : "static, ") << to_string(geometry);
     }
   }
 }
