@@ -74,7 +74,11 @@ TEST(DeviceRobustness, DeviceUnpluggedDuringRecord) {
   const auto to_folder = run_relight({"record", "--quiet", "--device", kDevice + "&disconnect_after=3", "--frames", "10",
                                       "--out", folder.string()});
   expect_clean_error(to_folder, 1, "disconnected", folder);
-  EXPECT_EQ(TumSequence::open(folder).size(), 3u);
+  // The device serves 3 frames on its own clock; a recorder slowed down by a loaded machine may
+  // miss one (OpenNI keeps only the newest frame), but it keeps what it received.
+  const std::size_t recorded = TumSequence::open(folder).size();
+  EXPECT_GE(recorded, 2u);
+  EXPECT_LE(recorded, 3u);
 }
 
 // Ctrl-C once frame 1 is written: outputs finalised, no error, exit 0 (live runs until stopped).
