@@ -5,7 +5,8 @@
 // normal now and the previous frame's normal there (both in the world frame) is averaged. The
 // scene is static, so every degree of change is noise. Raw stride-1 cross products, method 1
 // (stride-4 cross products blended with the history, eq. 4.4-4.8) and method 2 (warped and merged
-// depth, normals from it) run over the same frames; "ms" is method 1's median time per frame.
+// depth, then method 1's estimator on it, as replay runs it; "method2_plain": the stride-1 cross
+// products of the merged depth) run over the same frames; "ms" is method 1's median time per frame.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -77,9 +78,9 @@ Json tum_stability(const bench::Options& options) {
   }
   if (frames.size() < 2) throw Error(folder.string() + ": needs at least two frames");
 
-  Stability raw, method1, method2;
-  NormalMap raw_prev, m1_prev, m2_prev;
-  PositionMap m1_positions_prev;
+  Stability raw, method1, method2, method2_plain;
+  NormalMap raw_prev, m1_prev, m2_prev, m2_plain_prev;
+  PositionMap m1_positions_prev, m2_positions_prev;
   DepthMap filtered;
   DepthWeightMap weight;
   for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -105,18 +106,25 @@ Json tum_stability(const bench::Options& options) {
       merge_depth(f.depth, DepthMap(k.width, k.height), DepthWeightMap(k.width, k.height), {}, merged, merged_weight);
     }
     PositionMap m2_positions;
+    NormalMap m2_plain_now;
     positions_from_depth(merged, k, m2_positions);
-    normals_from_positions(m2_positions, m2_now);
+    normals_from_positions(m2_positions, m2_plain_now);
+    const NormalsHistory m2_history{m2_prev, m2_positions_prev,
+                                    i > 0 ? frames[i - 1].camera_to_world : Pose::Identity()};
+    normals_raw_depth(merged, k, f.camera_to_world, i > 0 ? &m2_history : nullptr, {}, m2_positions, m2_now);
 
     if (i > 0) {
       add_change(frames[i - 1], raw_prev, f, raw_now, k, raw);
       add_change(frames[i - 1], m1_prev, f, m1_now, k, method1);
       add_change(frames[i - 1], m2_prev, f, m2_now, k, method2);
+      add_change(frames[i - 1], m2_plain_prev, f, m2_plain_now, k, method2_plain);
     }
     raw_prev = std::move(raw_now);
     m1_prev = std::move(m1_now);
     m1_positions_prev = std::move(m1_positions);
     m2_prev = std::move(m2_now);
+    m2_positions_prev = std::move(m2_positions);
+    m2_plain_prev = std::move(m2_plain_now);
     filtered = std::move(merged);
     weight = std::move(merged_weight);
   }
@@ -135,6 +143,7 @@ Json tum_stability(const bench::Options& options) {
           {"raw_change_deg", raw.mean()},
           {"method1_change_deg", method1.mean()},
           {"method2_change_deg", method2.mean()},
+          {"method2_plain_change_deg", method2_plain.mean()},
           {"raw_compared", static_cast<double>(raw.pixels) / pixels},
           {"method1_compared", static_cast<double>(method1.pixels) / pixels},
           {"method2_compared", static_cast<double>(method2.pixels) / pixels}};
