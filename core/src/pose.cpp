@@ -7,6 +7,10 @@ namespace relight {
 
 Pose pose_from_tum(const std::array<double, 7>& f) {
   Eigen::Quaterniond q(f[6], f[3], f[4], f[5]);  // Eigen's constructor order is (w, x, y, z)
+  // Scale by the largest component first: the squared norm of components around 1e155 or more
+  // overflows to infinity, and normalising by it left a zero quaternion (the identity rotation).
+  const double largest = q.coeffs().cwiseAbs().maxCoeff();
+  if (largest > 0.0 && std::isfinite(largest)) q.coeffs() /= largest;
   q.normalize();
   Pose pose = Pose::Identity();
   pose.linear() = q.toRotationMatrix();

@@ -18,6 +18,20 @@ TEST(Pose, TumFieldsRoundTrip) {
   EXPECT_NEAR(rotation_distance(pose, pose_from_tum(back)), 0.0, 1e-7);
 }
 
+// A quaternion is a direction: any positive scale gives the same rotation, including scales whose
+// squared norm a double cannot hold (a ground-truth file with components around 1e300 became the
+// identity before).
+TEST(Pose, TumQuaternionOfAnyScaleGivesTheSameRotation) {
+  const std::array<double, 7> unit{0.1, 0.2, 0.3, 0.6853, 0.5405, -0.0074, -0.4881};
+  const Pose reference = pose_from_tum(unit);
+  for (const double scale : {1e-150, 1e-3, 7.0, 1e160, 1e300}) {
+    std::array<double, 7> scaled = unit;
+    for (int i = 3; i < 7; ++i) scaled[static_cast<std::size_t>(i)] *= scale;
+    EXPECT_NEAR(rotation_distance(pose_from_tum(scaled), reference), 0.0, 1e-9) << "scale " << scale;
+  }
+  EXPECT_GT(rotation_distance(reference, Pose::Identity()), 1.0);
+}
+
 TEST(Pose, InterpolationIsLinearInTranslationAndSlerpInRotation) {
   Pose a = Pose::Identity();
   Pose b = Pose::Identity();

@@ -11,7 +11,8 @@ using Pose = Eigen::Isometry3d;
 /// Timestamps are seconds (double), as in TUM files.
 using Timestamp = double;
 
-/// Build a pose from TUM fields tx ty tz qx qy qz qw (quaternion normalised here).
+/// Build a pose from TUM fields tx ty tz qx qy qz qw (quaternion normalised here, at any scale
+/// a double holds).
 Pose pose_from_tum(const std::array<double, 7>& fields);
 /// TUM fields tx ty tz qx qy qz qw of a pose (qw >= 0).
 std::array<double, 7> pose_to_tum(const Pose& pose);
