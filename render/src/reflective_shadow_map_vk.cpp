@@ -104,26 +104,18 @@ std::vector<ReflectiveShadowMap> ReflectiveShadowMapsVk::render(const MrScene& s
   r.gpu_ms = 0.0;
   const MrLight& light = scene.lights[light_index];
   const MrCamera camera = light_camera(light, view);
-  const auto texel_count = static_cast<std::size_t>(size) * static_cast<std::size_t>(size);
-  std::vector<ReflectiveShadowMap> maps(light.real ? 2 : 1, ReflectiveShadowMap{size, std::vector<RsmTexel>(texel_count)});
   const GBuffer first = r.draw(light.real ? kRealLayer : kBothLayers, scene, camera);
   const std::optional<GBuffer> virtual_layer =
       light.real ? std::optional<GBuffer>(r.draw(kVirtualLayer, scene, camera)) : std::nullopt;
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(size) + static_cast<std::size_t>(x);
-      const Eigen::Vector3f direction = detail::rsm_texel_direction(view, x, y);
-      const Eigen::Vector3f emitted = detail::rsm_texel_emitted(light, view, x, y, direction);
-      for (ReflectiveShadowMap& map : maps) map.texels[i].direction = direction;
-      const std::optional<SurfaceHit> nearest = hit_at(first, i);
-      detail::fill_rsm_texel(maps[0].texels[i], scene, nearest, emitted);
-      if (!light.real) continue;
-      std::optional<SurfaceHit> virtual_hit = hit_at(*virtual_layer, i);
-      if (virtual_hit && nearest && !(virtual_hit->t < nearest->t)) virtual_hit.reset();  // behind the real surface
-      maps[0].texels[i].occluded_by_virtual = virtual_hit.has_value();
-      detail::fill_rsm_texel(maps[1].texels[i], scene, virtual_hit, emitted);
-    }
-  return maps;
+  return assemble_reflective_shadow_maps(scene, light_index, view, [&](int x, int y, const Eigen::Vector3f&) {
+    const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(size) + static_cast<std::size_t>(x);
+    RsmTexelHits seen{hit_at(first, i), std::nullopt};
+    if (!virtual_layer) return seen;
+    seen.virtual_in_front = hit_at(*virtual_layer, i);
+    const bool behind = seen.virtual_in_front && seen.first && !(seen.virtual_in_front->t < seen.first->t);
+    if (behind) seen.virtual_in_front.reset();
+    return seen;
+  });
 }
 
 }  // namespace relight::render

@@ -8,8 +8,8 @@
 // The view: a square perspective frustum along the spot's axis that just holds its outer cone,
 // `size` x `size` texels. reflective_shadow_maps_cpu is the ray-cast reference; the rasterised
 // RSMs of reflective_shadow_map_vk.h use the same view (RsmView) and the same per-texel rules
-// (detail::fill_rsm_texel) on the nearest surfaces a G-buffer pass finds. A texel where the cone
-// sees a surface stores
+// (assemble_reflective_shadow_maps) on the nearest surfaces a G-buffer pass finds. A texel where
+// the cone sees a surface stores
 //   hit       the surface (point, normals, material, real/virtual);
 //   flux      the flux I(omega) falloff(omega) dOmega that reaches it through the texel's solid
 //             angle dOmega: what a first-bounce VPL there carries (vpl.h);
@@ -20,6 +20,7 @@
 // virtual one (the real-only VPLs of Fig. 5.7); in its virtual RSM, texels behind a real surface
 // are empty (no world sees them).
 #include <Eigen/Core>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -67,15 +68,23 @@ struct RsmView {
 /// power of two.
 [[nodiscard]] RsmView rsm_view(const MrScene& scene, std::size_t light_index, int size, const char* who);
 
-namespace detail {
-/// Unit direction from the light through the centre of texel (x, y).
-[[nodiscard]] Eigen::Vector3f rsm_texel_direction(const RsmView& view, int x, int y);
-/// The light's emission through texel (x, y) in `direction`: I(ω) falloff(ω) dΩ.
-[[nodiscard]] Eigen::Vector3f rsm_texel_emitted(const MrLight& light, const RsmView& view, int x, int y,
-                                                const Eigen::Vector3f& direction);
-/// Sets the texel's hit, flux and importance (header comment) for a surface `hit` (or none).
-void fill_rsm_texel(RsmTexel& texel, const MrScene& scene, const std::optional<SurfaceHit>& hit,
-                    const Eigen::Vector3f& emitted);
-}  // namespace detail
+/// What the ray through one texel meets, as the RSMs need it: `first`, the nearest surface of the
+/// layers the light's first RSM sees (both layers for a virtual light, the real layer for a real
+/// one), and for a real light `virtual_in_front`, the virtual surface nearer than `first` (or
+/// any virtual surface where `first` is empty).
+struct RsmTexelHits {
+  std::optional<SurfaceHit> first;
+  std::optional<SurfaceHit> virtual_in_front;
+};
+/// The surfaces of texel (x, y), whose ray from the light has unit `direction`.
+using RsmTexelHitsFn = std::function<RsmTexelHits(int x, int y, const Eigen::Vector3f& direction)>;
+
+/// The RSMs of spot light `light_index` (one or two, as reflective_shadow_maps_cpu) over `view`,
+/// with every texel's direction, flux, importance and occlusion set by the rules of the header
+/// comment from the surfaces `hits` reports: the part the ray-cast and rasterised RSMs share.
+[[nodiscard]] std::vector<ReflectiveShadowMap> assemble_reflective_shadow_maps(const MrScene& scene,
+                                                                               std::size_t light_index,
+                                                                               const RsmView& view,
+                                                                               const RsmTexelHitsFn& hits);
 
 }  // namespace relight::render

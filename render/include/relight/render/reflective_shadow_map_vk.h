@@ -5,10 +5,10 @@
 // layer and its virtual RSM through the virtual layer, both drawn, so that the virtual RSM keeps
 // only the virtual surfaces in front of the real ones and the real RSM knows which of its texels a
 // virtual surface hides (occluded_by_virtual). The per-texel direction, flux and importance come
-// from the same functions as the ray-cast reference, reflective_shadow_maps_cpu, which these maps
-// equal texel for texel away from triangle edges; the surface normal is the G-buffer's, which
-// faces the light (the ray-cast hit's shading normal is not flipped; VPL generation orients
-// normals itself).
+// from assemble_reflective_shadow_maps, as in the ray-cast reference, reflective_shadow_maps_cpu,
+// which these maps equal texel for texel away from triangle edges; the surface normal is the
+// G-buffer's, which faces the light (the ray-cast hit's shading normal is not flipped; VPL
+// generation orients normals itself).
 //
 // Reads: the MrScene (set_scene, uploaded per layer), a spot light of it per render.
 // Writes: std::vector<ReflectiveShadowMap>, as reflective_shadow_maps_cpu.
