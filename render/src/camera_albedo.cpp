@@ -19,31 +19,36 @@ Float3 scaled(const Float3& value, const Float3& factor) {
   return {value.x * factor.x, value.y * factor.y, value.z * factor.z};
 }
 
-/// Whether pixel i takes part: a real surface of a diffuse material with a valid estimate.
-bool modulated(const GBuffer& gbuffer, const MrScene& scene, const Mask& valid, std::size_t i) {
-  const std::uint16_t label = gbuffer.material.pixels()[i];
-  return label != 0 && !gbuffer.virtual_surface.pixels()[i] && valid.pixels()[i] &&
-         scene.materials.at(label - 1u).ks == 0.f;
+/// Per pixel, whether it takes part: a real surface of a diffuse material with a valid estimate.
+Mask modulated_pixels(const GBuffer& gbuffer, const MrScene& scene, const Mask& valid) {
+  Mask out(valid.width(), valid.height());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::uint16_t label = gbuffer.material.pixels()[i];
+    out.pixels()[i] = label != 0 && !gbuffer.virtual_surface.pixels()[i] && valid.pixels()[i] &&
+                              scene.materials.at(label - 1u).ks == 0.f
+                          ? 1
+                          : 0;
+  }
+  return out;
 }
 
 /// k_d averaged over the (2 kAlbedoSmoothingRadius + 1)² window's modulated pixels of the same
 /// material; zero where the pixel itself is not modulated.
-RadianceImage smoothed_albedo(const GBuffer& gbuffer, const MrScene& scene, const RadianceImage& albedo,
-                              const Mask& valid) {
+RadianceImage smoothed_albedo(const GBuffer& gbuffer, const RadianceImage& albedo, const Mask& modulated) {
   const int width = albedo.width(), height = albedo.height();
   RadianceImage out(width, height);
   parallel_rows(height, 0, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
       for (int x = 0; x < width; ++x) {
         const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
-        if (!modulated(gbuffer, scene, valid, i)) continue;
+        if (!modulated.pixels()[i]) continue;
         const std::uint16_t label = gbuffer.material.pixels()[i];
         Float3 sum{};
         int count = 0;
         for (int v = std::max(0, y - kAlbedoSmoothingRadius); v <= std::min(height - 1, y + kAlbedoSmoothingRadius); ++v)
           for (int u = std::max(0, x - kAlbedoSmoothingRadius); u <= std::min(width - 1, x + kAlbedoSmoothingRadius); ++u) {
             const std::size_t j = static_cast<std::size_t>(v) * static_cast<std::size_t>(width) + static_cast<std::size_t>(u);
-            if (gbuffer.material.pixels()[j] != label || !modulated(gbuffer, scene, valid, j)) continue;
+            if (gbuffer.material.pixels()[j] != label || !modulated.pixels()[j]) continue;
             sum = sum + albedo.pixels()[j];
             ++count;
           }
@@ -61,9 +66,10 @@ void modulate_camera_albedo(DifferentialImages& images, const GBuffer& gbuffer, 
       !valid.same_shape(gbuffer.material) || !images.real_virtual.same_shape(images.real))
     throw Error("camera albedo: the G-buffer, the rendered images and the albedo image differ in size");
   const bool has_indirect = images.indirect_real.same_shape(images.real) && images.indirect_real_virtual.same_shape(images.real);
-  const RadianceImage smoothed = smoothed_albedo(gbuffer, scene, albedo, valid);
+  const Mask modulated = modulated_pixels(gbuffer, scene, valid);
+  const RadianceImage smoothed = smoothed_albedo(gbuffer, albedo, modulated);
   for (std::size_t i = 0; i < images.real.size(); ++i) {
-    if (!modulated(gbuffer, scene, valid, i)) continue;
+    if (!modulated.pixels()[i]) continue;
     const PhongMaterial& material = scene.materials.at(gbuffer.material.pixels()[i] - 1u);
     const Float3 factor = albedo_ratio(smoothed.pixels()[i], material.kd);
     images.real.pixels()[i] = scaled(images.real.pixels()[i], factor);
