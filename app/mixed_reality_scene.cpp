@@ -1,6 +1,7 @@
 #include "mixed_reality_scene.h"
 
 #include <cmath>
+#include <numbers>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -73,7 +74,7 @@ render::MrLight parse_virtual_spot(const std::string& text) {
   if (!(axis.norm() > 1e-6f)) throw Error("--virtual-spot '" + text + "': the target is the light's position");
   light.direction = axis.normalized();
   if (!(v[6] > 0.f && v[6] < 90.f)) throw Error("--virtual-spot '" + text + "': the angle must be in (0, 90) degrees");
-  constexpr float kRadians = 3.14159265358979f / 180.f;
+  constexpr float kRadians = std::numbers::pi_v<float> / 180.f;
   light.cos_outer = std::cos(v[6] * kRadians);
   light.cos_inner = std::cos(kSpotInnerFraction * v[6] * kRadians);
   light.intensity = parse_intensity("--virtual-spot", text, v, 7);

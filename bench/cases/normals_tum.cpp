@@ -107,11 +107,10 @@ Json tum_stability(const bench::Options& options) {
     }
     PositionMap m2_positions;
     NormalMap m2_plain_now;
-    positions_from_depth(merged, k, m2_positions);
-    normals_from_positions(m2_positions, m2_plain_now);
     const NormalsHistory m2_history{m2_prev, m2_positions_prev,
                                     i > 0 ? frames[i - 1].camera_to_world : Pose::Identity()};
     normals_raw_depth(merged, k, f.camera_to_world, i > 0 ? &m2_history : nullptr, {}, m2_positions, m2_now);
+    normals_from_positions(m2_positions, m2_plain_now);  // φ⁻¹(merged), as normals_raw_depth wrote them
 
     if (i > 0) {
       add_change(frames[i - 1], raw_prev, f, raw_now, k, raw);

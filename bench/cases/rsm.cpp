@@ -11,6 +11,7 @@
 // material or world).
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "bench.h"
@@ -113,8 +114,8 @@ MrScene room_with_spot() {
   spot.kind = LightKind::Spot;
   spot.position = {0.3f, -0.25f, 1.6f};
   spot.direction = {0.05f, 0.05f, -1.f};
-  spot.cos_outer = std::cos(30.f * 3.14159265f / 180.f);
-  spot.cos_inner = std::cos(24.f * 3.14159265f / 180.f);
+  spot.cos_outer = std::cos(30.f * std::numbers::pi_v<float> / 180.f);
+  spot.cos_inner = std::cos(24.f * std::numbers::pi_v<float> / 180.f);
   spot.intensity = {4.f, 4.f, 4.f};
   scene.lights = {spot};
   return scene;
