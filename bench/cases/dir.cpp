@@ -1,6 +1,7 @@
 // Differential instant radiosity against the path tracer (render/dir_cpu.h, render/path_tracer.h)
 // on the synthetic scene with the shipped pebble on the table, 640x480 (the camera's size; the
-// same comparison at 320x240 under "at_320x240"), one indirect bounce in both, the sky switched off (DIR lights the environment with directional lights, direct only).
+// same comparison at 320x240 under "at_320x240"), one indirect bounce in both, the sky switched
+// off (DIR lights the environment with directional lights, direct only).
 //
 // dir/vs_reference: for 64, 256 and 1024 light samples, the mean relative error of the
 // differential image DeltaL = TM(L_rv) - TM(L_r) where it matters (|DeltaL_reference| > 0.01:

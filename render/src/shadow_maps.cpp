@@ -79,7 +79,8 @@ ShadowLayout plan_shadow_views(const MrScene& scene, int tile) {
     if (light.kind == LightKind::Directional) {
       layout.views.push_back(orthographic_view(light.direction, centre, radius, tile));
       if (virtual_bounds.radius > 0.f) {
-        layout.virtual_views.push_back(orthographic_view(light.direction, virtual_bounds.centre, virtual_bounds.radius, tile));
+        layout.virtual_views.push_back(
+            orthographic_view(light.direction, virtual_bounds.centre, virtual_bounds.radius, tile));
       }
     } else if (light.kind == LightKind::Spot && spot_half_angle <= kMaxSpotHalfAngle) {
       layout.views.push_back(perspective_view(light.position, light.direction, spot_half_angle, tile));
@@ -92,8 +93,8 @@ ShadowLayout plan_shadow_views(const MrScene& scene, int tile) {
     }
     // Views of positional lights (and of any light in a scene without virtual objects) are
     // the same for both layers.
-    layout.virtual_views.insert(layout.virtual_views.end(), layout.views.begin() + static_cast<std::ptrdiff_t>(layout.virtual_views.size()),
-                                layout.views.end());
+    const auto shared = layout.views.begin() + static_cast<std::ptrdiff_t>(layout.virtual_views.size());
+    layout.virtual_views.insert(layout.virtual_views.end(), shared, layout.views.end());
     layout.light_views.push_back({first, static_cast<std::uint32_t>(layout.views.size()) - first});
   }
   layout.columns = std::clamp(static_cast<int>(layout.views.size()), 1, 8);

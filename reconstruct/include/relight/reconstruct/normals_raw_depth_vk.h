@@ -48,8 +48,9 @@ class NormalsRawDepthVk {
 };
 
 /// Frame-graph stage of method 1 on Vulkan, a drop-in for NormalsRawDepthCpuStage (same name and
-/// buffers, also for NormalsDepthInput::Filtered: reads DepthMap "depth", FrameInfo "frame" and the previous frame's "normals",
-/// "positions" and "frame"; writes NormalMap "normals" and PositionMap "positions").
+/// buffers for either NormalsDepthInput: reads DepthMap "depth" or "depth_filtered", FrameInfo
+/// "frame" and the previous frame's "normals", "positions" and "frame"; writes NormalMap
+/// "normals" and PositionMap "positions").
 /// It works on the graph's host buffers and does its own uploads and downloads, because the
 /// graph hands previous-frame buffers to stages on the host only and pass 1 runs on the CPU
 /// anyway; so backend() is Cpu in the graph's sense, while the GPU time of the dispatches is

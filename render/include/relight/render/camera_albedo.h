@@ -9,8 +9,8 @@
 //
 // modulate_camera_albedo() replaces, on real G-buffer pixels of a purely diffuse material (k_s
 // = 0, where L = k_d/π · irradiance exactly), the cluster's k_d by the pixel's own estimate
-// k_d(x, y) (brdf/ diffuse estimation, eq. 4.13; smoothed, see kAlbedoSmoothingRadius), scaling all four radiance parts per channel
-// by k_d(x, y) / k_d(cluster). It runs after the interleaved merge, so the merged indirect light
+// k_d(x, y) (brdf/ diffuse estimation, eq. 4.13; smoothed, see kAlbedoSmoothingRadius), scaling
+// all four radiance parts per channel by k_d(x, y) / k_d(cluster). It runs after the interleaved merge, so the merged indirect light
 // (an irradiance times the cluster's constant k_d) is modulated, not blurred, by the texture.
 // Pixels where the estimate is invalid, glossy materials, virtual surfaces and channels where
 // the cluster's k_d is below kMinClusterAlbedo keep the cluster's shading.
