@@ -12,20 +12,26 @@ namespace {
 
 constexpr int kPixels = 6;
 
+/// Everything modulate_camera_albedo reads and writes, `width` x `height`, all zero.
 struct Fixture {
+  Fixture(int width, int height)
+      : gbuffer{PositionMap(width, height), NormalMap(width, height), LabelImage(width, height), Mask(width, height),
+                DepthMap(width, height)},
+        images{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,
+               RadianceImage(width, height), RadianceImage(width, height)},
+        albedo(width, height),
+        valid(width, height) {}
   MrScene scene;
-  GBuffer gbuffer{PositionMap(kPixels, 1), NormalMap(kPixels, 1), LabelImage(kPixels, 1), Mask(kPixels, 1),
-                  DepthMap(kPixels, 1)};
-  DifferentialImages images{RadianceImage(kPixels, 1), RadianceImage(kPixels, 1), CoverageImage(kPixels, 1), 1,
-                            RadianceImage(kPixels, 1), RadianceImage(kPixels, 1)};
-  RadianceImage albedo{kPixels, 1};
-  Mask valid{kPixels, 1};
+  GBuffer gbuffer;
+  DifferentialImages images;
+  RadianceImage albedo;
+  Mask valid;
 };
 
 // Pixels: 0 real diffuse; 1 virtual; 2 real glossy; 3 real diffuse, estimate invalid;
 // 4 nothing seen; 5 real diffuse whose cluster has no blue.
 Fixture fixture() {
-  Fixture f;
+  Fixture f(kPixels, 1);
   const std::uint32_t grey = f.scene.add_material(test::diffuse({0.5f, 0.5f, 0.5f}, "grey"));
   PhongMaterial glossy = test::diffuse({0.5f, 0.5f, 0.5f}, "glossy");
   glossy.ks = 0.3f;
@@ -77,31 +83,25 @@ TEST(CameraAlbedo, ScalesEveryPartOfRealDiffusePixelsByTheirAlbedoOverTheCluster
 // estimates becomes their mean inside a material, and the neighbouring material stays apart.
 TEST(CameraAlbedo, EstimatesAreAveragedOverTheirMaterialsWindow) {
   constexpr int kSize = 9;
-  MrScene scene;
-  const std::uint32_t left = scene.add_material(test::diffuse({0.5f, 0.5f, 0.5f}, "left"));
-  const std::uint32_t right = scene.add_material(test::diffuse({0.5f, 0.5f, 0.5f}, "right"));
-  GBuffer gbuffer{PositionMap(kSize, kSize), NormalMap(kSize, kSize), LabelImage(kSize, kSize), Mask(kSize, kSize),
-                  DepthMap(kSize, kSize)};
-  DifferentialImages images{RadianceImage(kSize, kSize), RadianceImage(kSize, kSize), CoverageImage(kSize, kSize), 1,
-                            RadianceImage(kSize, kSize), RadianceImage(kSize, kSize)};
-  RadianceImage albedo(kSize, kSize);
-  Mask valid(kSize, kSize);
+  Fixture f(kSize, kSize);
+  const std::uint32_t left = f.scene.add_material(test::diffuse({0.5f, 0.5f, 0.5f}, "left"));
+  const std::uint32_t right = f.scene.add_material(test::diffuse({0.5f, 0.5f, 0.5f}, "right"));
   for (int y = 0; y < kSize; ++y)
     for (int x = 0; x < kSize; ++x) {
       const bool is_left = x < 5;
-      gbuffer.material(y, x) = static_cast<std::uint16_t>((is_left ? left : right) + 1);
-      valid(y, x) = 1;
+      f.gbuffer.material(y, x) = static_cast<std::uint16_t>((is_left ? left : right) + 1);
+      f.valid(y, x) = 1;
       const float a = is_left ? ((x + y) % 2 ? 0.2f : 0.4f) : 0.8f;
-      albedo(y, x) = {a, a, a};
-      images.real(y, x) = {1.f, 1.f, 1.f};
-      images.real_virtual(y, x) = {1.f, 1.f, 1.f};
+      f.albedo(y, x) = {a, a, a};
+      f.images.real(y, x) = {1.f, 1.f, 1.f};
+      f.images.real_virtual(y, x) = {1.f, 1.f, 1.f};
     }
-  modulate_camera_albedo(images, gbuffer, scene, albedo, valid);
+  modulate_camera_albedo(f.images, f.gbuffer, f.scene, f.albedo, f.valid);
   // Centre of the left material: 13 of the 25 window pixels hold 0.4, 12 hold 0.2.
-  EXPECT_NEAR(images.real(4, 2).x, (13 * 0.4f + 12 * 0.2f) / 25.f / 0.5f, 1e-5f);
+  EXPECT_NEAR(f.images.real(4, 2).x, (13 * 0.4f + 12 * 0.2f) / 25.f / 0.5f, 1e-5f);
   // Its border column (x = 4) averages left pixels only; the right material keeps 0.8.
-  EXPECT_NEAR(images.real(4, 4).x, (8 * 0.4f + 7 * 0.2f) / 15.f / 0.5f, 1e-5f);
-  EXPECT_NEAR(images.real(4, 5).x, 0.8f / 0.5f, 1e-5f);
+  EXPECT_NEAR(f.images.real(4, 4).x, (8 * 0.4f + 7 * 0.2f) / 15.f / 0.5f, 1e-5f);
+  EXPECT_NEAR(f.images.real(4, 5).x, 0.8f / 0.5f, 1e-5f);
 }
 
 TEST(CameraAlbedo, ImagesOfDifferentSizesAreAnError) {
