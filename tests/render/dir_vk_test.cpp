@@ -9,8 +9,6 @@
 
 #include "../reconstruct/vulkan_test_env.h"
 #include "relight/core/error.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/scene_from_synth.h"
 #include "relight/synth/scene.h"
 #include "relight/vk/context.h"
 #include "test_scenes.h"
@@ -30,12 +28,6 @@ MrScene cube_scene() {
                                  scene.add_material(diffuse({0.3f, 0.6f, 0.3f}, "green wall")));
   scene.meshes.push_back(wall);
   test::add_virtual_box(scene, synth::Box{{-0.2, -0.2, 0.0}, {0.2, 0.2, 0.4}}, diffuse({0.9f, 0.1f, 0.1f}, "red cube"));
-  return scene;
-}
-
-MrScene indoor_with_pebble() {
-  MrScene scene = scene_from_synth(synth::default_indoor_scene(), {48});
-  add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
   return scene;
 }
 
@@ -64,7 +56,7 @@ float luminance(const Float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722
 // samples): interior 0.030, edges 0.190; 0.352 at edges when a subset missing from the window
 // was simply left out.
 TEST(DirMerge, InterleavedIndirectLightStaysCloseToTheFullSumAtEdges) {
-  const MrScene scene = indoor_with_pebble();
+  const MrScene scene = test::indoor_with_pebble();
   const MrCamera camera = camera_at({1.3, -1.1, 1.4}, {0.2, -0.1, 0.75}, 160, 120);
   const std::vector<Vpl> vpls = make_vpls(scene, 64);
   DirVkOptions options = test_options();
@@ -102,7 +94,7 @@ TEST(DirMerge, InterleavedIndirectLightStaysCloseToTheFullSumAtEdges) {
 
 TEST_F(DirVkTest, ShadowAtlasMatchesTheRayCastReference) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
-  MrScene scene = indoor_with_pebble();
+  MrScene scene = test::indoor_with_pebble();
   MrLight spot;
   spot.kind = LightKind::Spot;
   spot.position = {0.8f, -0.9f, 2.0f};

@@ -6,8 +6,6 @@
 
 #include "../reconstruct/vulkan_test_env.h"
 #include "relight/core/error.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
 #include "test_scenes.h"
@@ -17,15 +15,9 @@ namespace {
 
 class GBufferVkTest : public relight::test::VulkanTest {};
 
-MrScene scene_with_pebble() {
-  MrScene scene = scene_from_synth(synth::default_indoor_scene(), {48});
-  add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
-  return scene;
-}
-
 TEST_F(GBufferVkTest, MatchesTheRayCastGBuffer) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
-  const MrScene scene = scene_with_pebble();
+  const MrScene scene = test::indoor_with_pebble();
   const MrCamera camera = test::camera_at({1.3, -1.1, 1.4}, {0.2, -0.1, 0.75}, 160, 120);
   GBufferVk renderer(context, 160, 120);
   renderer.set_scene(scene);

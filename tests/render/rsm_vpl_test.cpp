@@ -9,9 +9,7 @@
 #include "../reconstruct/vulkan_test_env.h"
 #include "relight/core/error.h"
 #include "relight/render/reflective_shadow_map.h"
-#include "relight/render/procedural_models.h"
 #include "relight/render/reflective_shadow_map_vk.h"
-#include "relight/render/scene_from_synth.h"
 #include "relight/render/vpl.h"
 #include "test_scenes.h"
 
@@ -166,8 +164,7 @@ RsmComparison compare(const ReflectiveShadowMap& gpu, const ReflectiveShadowMap&
 /// The synthetic room (tessellated, smooth-shaded objects) with the glossy pebble on its table,
 /// lit by a real spot light above the table.
 MrScene room_scene() {
-  MrScene scene = scene_from_synth(synth::default_indoor_scene(), {48});
-  add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
+  MrScene scene = test::indoor_with_pebble();
   MrLight spot;
   spot.kind = LightKind::Spot;
   spot.position = {0.3f, -0.25f, 1.6f};

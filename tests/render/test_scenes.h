@@ -9,8 +9,10 @@
 #include "relight/core/image.h"
 #include "relight/render/mr_scene.h"
 #include "relight/render/path_tracer.h"
+#include "relight/render/procedural_models.h"
 #include "relight/render/ray_tracer.h"
 #include "relight/render/scene_from_synth.h"
+#include "relight/render/virtual_model.h"
 #include "relight/synth/trajectory.h"
 
 namespace relight::render::test {
@@ -34,6 +36,14 @@ inline MrScene floor_scene(const Eigen::Vector3f& albedo, const Eigen::Vector3f&
   point.position = light;
   point.intensity = Eigen::Vector3f::Constant(intensity);
   scene.lights.push_back(point);
+  return scene;
+}
+
+/// The synthetic room (objects tessellated with 48 segments, smooth-shaded) with the glossy
+/// pebble standing on its table, and the room's own lights.
+inline MrScene indoor_with_pebble() {
+  MrScene scene = scene_from_synth(synth::default_indoor_scene(), {48});
+  add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
   return scene;
 }
 
