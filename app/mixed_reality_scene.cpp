@@ -1,7 +1,6 @@
 #include "mixed_reality_scene.h"
 
 #include <cmath>
-#include <numbers>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -67,19 +66,12 @@ render::MrLight parse_virtual_spot(const std::string& text) {
   const std::vector<float> v = parse_numbers("--virtual-spot", text);
   if (v.size() != 8 && v.size() != 11)
     throw Error("--virtual-spot '" + text + "' needs x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b]");
-  render::MrLight light;
-  light.kind = render::LightKind::Spot;
-  light.position = {v[0], v[1], v[2]};
-  const Eigen::Vector3f axis = Eigen::Vector3f(v[3], v[4], v[5]) - light.position;
+  const Eigen::Vector3f position(v[0], v[1], v[2]);
+  const Eigen::Vector3f axis = Eigen::Vector3f(v[3], v[4], v[5]) - position;
   if (!(axis.norm() > 1e-6f)) throw Error("--virtual-spot '" + text + "': the target is the light's position");
-  light.direction = axis.normalized();
   if (!(v[6] > 0.f && v[6] < 90.f)) throw Error("--virtual-spot '" + text + "': the angle must be in (0, 90) degrees");
-  constexpr float kRadians = std::numbers::pi_v<float> / 180.f;
-  light.cos_outer = std::cos(v[6] * kRadians);
-  light.cos_inner = std::cos(kSpotInnerFraction * v[6] * kRadians);
-  light.intensity = parse_intensity("--virtual-spot", text, v, 7);
-  light.real = false;
-  return light;
+  return render::spot_light(position, axis.normalized(), v[6], kSpotInnerFraction * v[6],
+                            parse_intensity("--virtual-spot", text, v, 7), false);
 }
 
 LightSet real_light_set(bool synthetic, const fs::path& sequence, const fs::path& lights_file) {

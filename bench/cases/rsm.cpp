@@ -11,7 +11,6 @@
 // material or world).
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <vector>
 
 #include "bench.h"
@@ -110,14 +109,7 @@ relight::bench::Json warp_vulkan(const relight::bench::Options& options) {
 MrScene room_with_spot() {
   MrScene scene = scene_from_synth(relight::synth::default_indoor_scene());
   add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
-  MrLight spot;
-  spot.kind = LightKind::Spot;
-  spot.position = {0.3f, -0.25f, 1.6f};
-  spot.direction = {0.05f, 0.05f, -1.f};
-  spot.cos_outer = std::cos(30.f * std::numbers::pi_v<float> / 180.f);
-  spot.cos_inner = std::cos(24.f * std::numbers::pi_v<float> / 180.f);
-  spot.intensity = {4.f, 4.f, 4.f};
-  scene.lights = {spot};
+  scene.lights = {spot_light({0.3f, -0.25f, 1.6f}, {0.05f, 0.05f, -1.f}, 30.f, 24.f, {4.f, 4.f, 4.f}, true)};
   return scene;
 }
 

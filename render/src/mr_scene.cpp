@@ -3,10 +3,24 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <numbers>
 
 #include "relight/core/error.h"
 
 namespace relight::render {
+
+MrLight spot_light(const Eigen::Vector3f& position, const Eigen::Vector3f& direction, float outer_deg, float inner_deg,
+                   const Eigen::Vector3f& intensity, bool real) {
+  MrLight light;
+  light.kind = LightKind::Spot;
+  light.position = position;
+  light.direction = direction;
+  light.cos_outer = std::cos(outer_deg * std::numbers::pi_v<float> / 180.f);
+  light.cos_inner = std::cos(inner_deg * std::numbers::pi_v<float> / 180.f);
+  light.intensity = intensity;
+  light.real = real;
+  return light;
+}
 
 std::uint32_t MrScene::add_material(PhongMaterial material) {
   materials.push_back(std::move(material));

@@ -22,13 +22,7 @@ using test::diffuse;
 /// and a red virtual box under it.
 MrScene spot_scene(bool real_light) {
   MrScene scene = test::floor_scene(Eigen::Vector3f::Constant(0.6f), {0.f, 0.f, 2.f}, 5.f);
-  MrLight& spot = scene.lights[0];
-  spot.kind = LightKind::Spot;
-  spot.direction = {0.1f, 0.f, -1.f};
-  spot.cos_outer = std::cos(40.f * std::numbers::pi_v<float> / 180.f);
-  spot.cos_inner = std::cos(30.f * std::numbers::pi_v<float> / 180.f);
-  spot.intensity = {5.f, 4.f, 3.f};
-  spot.real = real_light;
+  scene.lights[0] = spot_light({0.f, 0.f, 2.f}, {0.1f, 0.f, -1.f}, 40.f, 30.f, {5.f, 4.f, 3.f}, real_light);
   test::add_virtual_box(scene, synth::Box{{-0.1, -0.3, 0.0}, {0.4, 0.2, 0.5}}, diffuse({0.9f, 0.1f, 0.1f}, "red box"));
   return scene;
 }
@@ -165,20 +159,14 @@ RsmComparison compare(const ReflectiveShadowMap& gpu, const ReflectiveShadowMap&
 /// lit by a real spot light above the table.
 MrScene room_scene() {
   MrScene scene = test::indoor_with_pebble();
-  MrLight spot;
-  spot.kind = LightKind::Spot;
-  spot.position = {0.3f, -0.25f, 1.6f};
-  spot.direction = {0.05f, 0.05f, -1.f};
-  spot.cos_outer = std::cos(15.f * std::numbers::pi_v<float> / 180.f);
-  spot.cos_inner = std::cos(10.f * std::numbers::pi_v<float> / 180.f);
-  spot.intensity = {4.f, 4.f, 4.f};
-  scene.lights = {spot};
+  scene.lights = {spot_light({0.3f, -0.25f, 1.6f}, {0.05f, 0.05f, -1.f}, 15.f, 10.f, {4.f, 4.f, 4.f}, true)};
   return scene;
 }
 
 // Measured (128² texels): the floor-and-box scene agrees in every texel (real light: 16128 and
-// 625 covered texels; virtual light: 16128); in the room with the pebble (real light, 15 degrees) as well: 16384 and 1445 texels. A
-// principal point shifted by 0.2 texel makes 15-128 texels differ per map.
+// 625 covered texels; virtual light: 16128); in the room with the pebble (real light, 15 degrees)
+// as well: 16384 and 1445 texels. A principal point shifted by 0.2 texel makes 15-128 texels
+// differ per map.
 TEST_F(RsmVkTest, RasterisedMapsEqualTheRayCastOnes) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   ReflectiveShadowMapsVk rasteriser(context);

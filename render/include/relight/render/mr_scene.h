@@ -59,6 +59,11 @@ struct MrLight {
   bool real = true;
 };
 
+/// A spot light at `position` shining along `direction` (stored as given), at full intensity
+/// within `inner_deg` of its axis and fading to zero at `outer_deg`.
+[[nodiscard]] MrLight spot_light(const Eigen::Vector3f& position, const Eigen::Vector3f& direction, float outer_deg,
+                                 float inner_deg, const Eigen::Vector3f& intensity, bool real);
+
 /// Radiance arriving from every direction where a ray leaves the scene (real: it is part of the
 /// camera's world, like the synthetic scene's open sky).
 struct Environment {
