@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "bench.h"
+#include "vulkan_timing.h"
 #include "relight/brdf/brdf_stages.h"
 #include "relight/brdf/kmeans_vk.h"
 #include "relight/brdf/specular_objective_vk.h"
@@ -126,9 +127,7 @@ bench::Json kmeans_cpu(const bench::Options& options) {
 }
 
 bench::Json kmeans_vulkan(const bench::Options& options) {
-  std::string why;
-  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);
-  if (!context) throw Error("no Vulkan device: " + why);
+  const auto context = relight::bench::timing_vulkan();
   KMeansVk engine(*context);
   return kmeans_case(options, engine, context->device_info().name);
 }
@@ -177,9 +176,7 @@ bench::Json specular_objective_vulkan(const bench::Options& options) {
   const SpecularProblem problem = sphere_problem(f);
   SpecularOptions so;
   const std::vector<SpecularCandidate> grid = specular_start_grid(so, 24, 16);
-  std::string why;
-  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);
-  if (!context) throw Error("no Vulkan device: " + why);
+  const auto context = relight::bench::timing_vulkan();
   SpecularObjectiveVk gpu(*context);
   std::vector<double> ours, theirs(grid.size());
   const bench::Comparison cmp = bench::compare_interleaved(

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bench.h"
+#include "vulkan_timing.h"
 #include "relight/colormap/sample_mapping.h"
 #include "relight/colormap/statistics_transfer.h"
 #include "relight/colormap/statistics_transfer_vk.h"
@@ -72,9 +73,7 @@ bench::Json sample_cpu(const bench::Options& options) {
 }
 
 bench::Json stats_vulkan(const bench::Options& options) {
-  std::string why;
-  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);
-  if (!context) throw Error("no Vulkan device: " + why);
+  const auto context = relight::bench::timing_vulkan();
   const SyntheticTriple& triple = frame_640x480();
   StatisticsColorMapVk mapper(*context);
   vk::VulkanTransfer& transfer = context->transfer();

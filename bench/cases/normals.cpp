@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "bench.h"
-#include "relight/core/error.h"
+#include "vulkan_timing.h"
 #include "relight/reconstruct/cross_normals_vk.h"
 #include "relight/reconstruct/depth_warp_merge.h"
 #include "relight/reconstruct/depth_warp_merge_vk.h"
@@ -205,9 +205,7 @@ void add_vulkan_fields(Json& json, const AngularError& error, std::vector<double
 }
 
 Json method1_vulkan(const bench::Options& options) {
-  std::string why;
-  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);  // no validation in timings
-  if (!context) throw Error("no Vulkan device: " + why);
+  const auto context = relight::bench::timing_vulkan();
   const BenchSequence& s = sequence();
   NormalsRawDepthVk gpu(*context);
   std::vector<double> gpu_ms;
@@ -312,9 +310,7 @@ Json method2_cpu(const bench::Options& options) {
 }
 
 Json method2_vulkan(const bench::Options& options) {
-  std::string why;
-  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);  // no validation in timings
-  if (!context) throw Error("no Vulkan device: " + why);
+  const auto context = relight::bench::timing_vulkan();
   const BenchSequence& s = sequence();
   DepthWarpMergeVk warp_merge(*context);
   NormalsRawDepthVk normals_method(*context);

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "bench.h"
-#include "relight/core/error.h"
+#include "vulkan_timing.h"
 #include "relight/render/hierarchical_warp.h"
 #include "relight/render/hierarchical_warp_vk.h"
 #include "relight/render/procedural_models.h"
@@ -72,9 +72,7 @@ relight::bench::Json warp_cpu(const relight::bench::Options& options) {
 
 relight::bench::Json warp_vulkan(const relight::bench::Options& options) {
   namespace vk = relight::vk;
-  std::string why;
-  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);
-  if (!context) throw relight::Error("no Vulkan device: " + why);
+  const auto context = relight::bench::timing_vulkan();
   const std::vector<float> map = spot_like_map();
   const std::vector<WarpPoint> points = hammersley_points(kSamples);
   HierarchicalWarpVk warp(*context);
@@ -114,10 +112,7 @@ MrScene room_with_spot() {
 }
 
 relight::bench::Json rsm_vulkan(const relight::bench::Options& options) {
-  namespace vk = relight::vk;
-  std::string why;
-  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);
-  if (!context) throw relight::Error("no Vulkan device: " + why);
+  const auto context = relight::bench::timing_vulkan();
   constexpr int kRsmSize = 256;
   const MrScene scene = room_with_spot();
   const RayTracer tracer(scene);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bench.h"
+#include "vulkan_timing.h"
 #include "relight/reconstruct/depth_box_filter.h"
 #include "relight/vk/backend.h"
 #include "relight/vk/buffer.h"
@@ -43,9 +44,7 @@ double median(std::vector<double> values) {
 
 relight::bench::Json box3x3_vs_cpu(const relight::bench::Options& options) {
   namespace vk = relight::vk;
-  std::string why;
-  auto context = vk::try_create_vulkan({.validation = vk::Validation::Off}, &why);
-  if (!context) throw relight::Error("no Vulkan device: " + why);
+  const auto context = relight::bench::timing_vulkan();
 
   constexpr int width = 640, height = 480;
   const DepthMap depth = synthetic_depth(width, height);
