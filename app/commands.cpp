@@ -31,6 +31,15 @@ void add_compute_options(CLI::App& command, ReplayOptions& options) {
 
 }  // namespace
 
+void add_pose_option(CLI::App& command, ReplayOptions& options) {
+  command.add_option("--pose", options.pose,
+                     "camera pose: auto (the sequence's own poses when it has them, else marker+odometry with a "
+                     "marker layout, else odometry), sequence, marker, odometry, marker+odometry; writes "
+                     "camera_trajectory.txt")
+      ->check(CLI::IsMember({"auto", "sequence", "marker", "odometry", "marker+odometry"}))
+      ->capture_default_str();
+}
+
 void add_method2_normals_option(CLI::App& command, ReplayOptions& options) {
   command.add_option("--method2-normals", options.method2_normals,
                      "method2's normals: filtered (method1's temporal filter on the merged depth) or plain "
@@ -130,6 +139,7 @@ void register_replay(CLI::App& app) {
                      "AprilTag layout for the camera pose: auto (the sequence's scene.json if it has a tag), "
                      "none, or a layout JSON file; writes marker_trajectory.txt")
       ->capture_default_str();
+  add_pose_option(*replay, *options);
   add_compute_options(*replay, *options);
   add_render_options(*replay, *options);
   registry().runners[replay] = [options] { return run_replay(*options); };

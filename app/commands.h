@@ -21,6 +21,8 @@ void register_live(CLI::App& app, Runners& runners);
 
 /// The options of differential rendering (--object, --place, --lights, ...) shared by replay and live.
 void add_render_options(CLI::App& command, ReplayOptions& options);
+/// --pose auto|sequence|marker|odometry|marker+odometry, shared by replay and live.
+void add_pose_option(CLI::App& command, ReplayOptions& options);
 /// --method2-normals filtered|plain, shared by replay and live.
 void add_method2_normals_option(CLI::App& command, ReplayOptions& options);
 

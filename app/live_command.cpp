@@ -16,6 +16,7 @@
 
 #include "commands.h"
 #include "interrupt.h"
+#include "camera_trajectory_stage.h"
 #include "marker_trajectory_stage.h"
 #include "relight/capture/openni_source.h"
 #include "relight/capture/tum_writer.h"
@@ -133,6 +134,7 @@ int run_live(const LiveOptions& options) {
     report["marker_pose"] = pipeline.markers->summary();
     std::cerr << pipeline.markers->no_tag_warning(options.replay.markers);
   }
+  report["tracking"] = pipeline.trajectory->summary();
   write_reports(options.replay.out, "relight live: " + description, graph, report, pipeline.report);
   if (!quiet) {
     std::cerr << "relight live: " << graph.frames_run() << " frames in " << seconds << " s ("
@@ -285,6 +287,7 @@ void register_live(CLI::App& app, Runners& runners) {
   live->add_flag("!--no-frames", live_options->replay.write_frames, "Do not write per-frame images");
   live->add_option("--markers", live_options->replay.markers, "AprilTag layout JSON for the camera pose, or none")
       ->capture_default_str();
+  add_pose_option(*live, live_options->replay);
   add_live_compute_options(*live, live_options->replay);
   add_render_options(*live, live_options->replay);
   runners[live] = [live_options] { return run_live(*live_options); };

@@ -9,8 +9,8 @@
 namespace relight::app {
 
 void MarkerTrajectoryStage::declare(StageBuilder& builder) {
-  pose_ = builder.read<CameraPose>("camera_pose");
-  frame_ = builder.read<FrameInfo>("frame");
+  pose_ = builder.read<CameraPose>("marker_pose");
+  frame_ = builder.read<FrameInfo>("source_frame");
 }
 
 void MarkerTrajectoryStage::run(StageContext& context) {

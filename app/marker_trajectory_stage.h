@@ -5,7 +5,7 @@
 // groundtruth.txt, or a synthetic sequence's exact poses) it also measures the marker pose
 // against them; that comparison is meaningful when the tag layout and those poses share a world
 // frame, as they do for `relight synth` sequences.
-// Reads: "camera_pose" (CameraPose), "frame" (FrameInfo).
+// Reads: "marker_pose" (CameraPose), "source_frame" (FrameInfo: the sequence's own pose).
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <vector>

@@ -10,8 +10,10 @@
 #include "frame_range.h"
 #include "frame_writer_stage.h"
 #include "interrupt.h"
+#include "camera_trajectory_stage.h"
 #include "marker_trajectory_stage.h"
 #include "mixed_reality_scene.h"
+#include "relight/capture/camera_tracking_stage.h"
 #include "relight/capture/marker_pose.h"
 #include "relight/capture/openni_source.h"
 #include "relight/capture/source_stage.h"
@@ -247,11 +249,24 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   pipeline.renders = true;
 }
 
-void add_marker_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
+/// The marker pose (when there is a layout) and the camera tracking stage that turns the
+/// source's frame into the tracked "frame" every pose reader uses.
+void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
+  CameraTrackingOptions tracking;
+  if (options.pose != "auto") {
+    tracking.source = parse_pose_source(options.pose);
+    if (!tracking.source) {
+      throw Error("--pose '" + options.pose + "' is not one of auto, sequence, marker, odometry, marker+odometry");
+    }
+  }
   auto layout = marker_layout(options);
-  if (!layout) return;
-  pipeline.graph->emplace<MarkerPoseStage>(std::move(*layout));
-  pipeline.markers = &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt");
+  tracking.has_marker_layout = layout.has_value();
+  if (layout) {
+    pipeline.graph->emplace<MarkerPoseStage>(std::move(*layout), TagDetectorOptions{}, "source_frame");
+    pipeline.markers = &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt");
+  }
+  pipeline.graph->emplace<CameraTrackingStage>(tracking);
+  pipeline.trajectory = &pipeline.graph->emplace<CameraTrajectoryStage>(options.out / "camera_trajectory.txt");
 }
 
 void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, bool method2) {
@@ -298,7 +313,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
 
   FrameGraph& graph = *pipeline.graph;
   const std::int64_t total_frames = source->size_hint();
-  graph.emplace<SourceStage>(std::move(source));
+  graph.emplace<SourceStage>(std::move(source), "source_frame");
   graph.add(make_depth_box_filter_stage(per_pixel, pipeline.vulkan.get()));
   // Geometry (positions + normals) follows the per-pixel backend; method 1's
   // pass-1 pyramid stays on the CPU either way (normals_raw_depth_vk.h).
@@ -323,7 +338,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   }
   graph.keep("normals");
   graph.keep("positions");
-  add_marker_pose(pipeline, options);
+  add_camera_pose(pipeline, options);
   add_differential_rendering(pipeline, options, per_pixel);
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
@@ -380,6 +395,7 @@ int run_replay(const ReplayOptions& options) {
     report["marker_pose"] = pipeline.markers->summary();
     std::cerr << pipeline.markers->no_tag_warning(marker_layout_name(options));
   }
+  report["tracking"] = pipeline.trajectory->summary();
   write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
   if (interrupted) {
     // Not a failure of the input, but the run did not cover it: 128 + SIGINT, as shells report it.
@@ -389,7 +405,7 @@ int run_replay(const ReplayOptions& options) {
   }
   if (!options.quiet) {
     std::cerr << "relight replay: " << graph.frames_run() << " frames in " << seconds << " s; results in "
-              << options.out.string() << " (report.html, report.json, graph.dot, frames/"
+              << options.out.string() << " (report.html, report.json, graph.dot, camera_trajectory.txt, frames/"
               << (pipeline.renders && options.video ? ", composite.mp4" : "") << ")\n";
   }
   return 0;

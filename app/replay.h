@@ -14,6 +14,7 @@ class VulkanContext;
 
 namespace relight::app {
 
+class CameraTrajectoryStage;
 class MarkerTrajectoryStage;
 class ReportCollectorStage;
 
@@ -30,6 +31,9 @@ struct ReplayOptions {
   /// AprilTag layout for the marker pose: "auto" (the sequence's scene.json when it has a tag),
   /// "none", or a layout/scene JSON file.
   std::string markers = "auto";
+  /// Camera pose source (capture/camera_tracking_stage.h): auto | sequence | marker | odometry |
+  /// marker+odometry.
+  std::string pose = "auto";
   bool skip_bad_frames = false;  ///< TUM frames that cannot be read: warn and skip instead of failing
   std::string geometry = "method1";  ///< normals: method1 (NormalsRawDepth) | method2 (DepthWarpMerge + normals below)
   /// Method 2's normals: "filtered" (method 1's estimator on the merged depth, §4.3.3's filtered
@@ -65,6 +69,7 @@ struct ReplayPipeline {
   std::unique_ptr<FrameGraph> graph;
   std::string compute;  ///< one line: which backend runs the per-pixel stages, on which device
   app::MarkerTrajectoryStage* markers = nullptr;  ///< set when the marker pose runs
+  app::CameraTrajectoryStage* trajectory = nullptr;  ///< the tracked pose of every frame
   bool renders = false;                           ///< the DIR stage is in the graph
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".
   std::string final_composite = "composite";

@@ -133,8 +133,8 @@ MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetect
 void MarkerPoseStage::declare(StageBuilder& builder) {
   color_ = builder.read<ColorImage>("color");
   depth_ = builder.read<DepthMap>("depth");
-  frame_ = builder.read<FrameInfo>("frame");
-  pose_ = builder.write<CameraPose>("camera_pose");
+  frame_ = builder.read<FrameInfo>(frame_buffer_);
+  pose_ = builder.write<CameraPose>("marker_pose");
 }
 
 void MarkerPoseStage::run(StageContext& context) {
@@ -149,6 +149,8 @@ void MarkerPoseStage::run(StageContext& context) {
   out.camera_to_world = last_ ? last_->camera_to_world : Pose::Identity();
   out.tags_used = estimate ? estimate->tags_used : 0;
   out.reprojection_rms_px = estimate ? estimate->reprojection_rms_px : 0.0;
+  out.source = PoseSource::Marker;
+  out.failure = estimate ? "" : "no known tag in view";
 }
 
 }  // namespace relight

@@ -5,7 +5,7 @@ namespace relight {
 void SourceStage::declare(StageBuilder& builder) {
   color_ = builder.write<ColorImage>("color");
   depth_ = builder.write<DepthMap>("depth");
-  frame_ = builder.write<FrameInfo>("frame");
+  frame_ = builder.write<FrameInfo>(frame_buffer_);
 }
 
 void SourceStage::run(StageContext& context) {

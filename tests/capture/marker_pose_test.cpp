@@ -149,9 +149,9 @@ TEST(MarkerPoseStage, HoldsTheLastPoseWhenTheTagIsLost) {
   FrameGraph graph;
   graph.emplace<PoseFrameSource>(std::vector<ColorImage>{blank, tagged, blank});
   graph.emplace<MarkerPoseStage>(synth::tag_layout(scene));
-  graph.keep("camera_pose");
+  graph.keep("marker_pose");
   std::vector<CameraPose> poses;
-  while (graph.run_frame()) poses.push_back(*graph.find<CameraPose>("camera_pose"));
+  while (graph.run_frame()) poses.push_back(*graph.find<CameraPose>("marker_pose"));
   ASSERT_EQ(poses.size(), 3u);
   EXPECT_FALSE(poses[0].valid);
   EXPECT_TRUE(poses[1].valid);

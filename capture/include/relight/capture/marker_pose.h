@@ -10,11 +10,14 @@
 //
 // Stage MarkerPoseStage
 //   reads:  "color" (ColorImage), "depth" (DepthMap, for the refinement), "frame" (FrameInfo: intrinsics)
-//   writes: "camera_pose" (CameraPose): camera-to-world; when no known tag is visible the last
+//   writes: "marker_pose" (CameraPose): camera-to-world; when no known tag is visible the last
 //           pose is held and flagged (held = true), before the first detection valid = false.
+//   The frame buffer it reads is "frame" by default; in replay/live, where the camera tracking
+//   stage (camera_tracking_stage.h) writes "frame", it reads the source's "source_frame".
 #include <optional>
 #include <vector>
 
+#include "relight/capture/camera_pose.h"
 #include "relight/capture/tag_detector.h"
 #include "relight/capture/tag_layout.h"
 #include "relight/core/camera.h"
@@ -41,20 +44,10 @@ struct MarkerPose {
                                            const TagLayout& layout, const PinholeIntrinsics& intrinsics,
                                            const DepthMap& depth);
 
-/// The camera pose slot read by reconstruction and rendering.
-struct CameraPose {
-  Pose camera_to_world = Pose::Identity();
-  bool valid = false;  ///< false until a first pose is known
-  bool held = false;   ///< true when this frame saw no known tag and the last pose is repeated
-  int tags_used = 0;
-  double reprojection_rms_px = 0;
-  static constexpr const char* type_name = "CameraPose";
-};
-
 class MarkerPoseStage final : public Stage {
  public:
-  MarkerPoseStage(TagLayout layout, const TagDetectorOptions& options = {})
-      : layout_(std::move(layout)), detector_(options) {}
+  MarkerPoseStage(TagLayout layout, const TagDetectorOptions& options = {}, std::string frame_buffer = "frame")
+      : layout_(std::move(layout)), detector_(options), frame_buffer_(std::move(frame_buffer)) {}
   [[nodiscard]] std::string name() const override { return "marker_pose"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
@@ -62,6 +55,7 @@ class MarkerPoseStage final : public Stage {
  private:
   TagLayout layout_;
   TagDetector detector_;
+  std::string frame_buffer_;
   std::optional<MarkerPose> last_;
   Read<ColorImage> color_;
   Read<DepthMap> depth_;

@@ -1,8 +1,10 @@
 #pragma once
 // Frame-graph stage that pulls frames from a FrameSource.
-// Writes: "color" (ColorImage), "depth" (DepthMap, metres), "frame" (FrameInfo).
+// Writes: "color" (ColorImage), "depth" (DepthMap, metres), "frame" (FrameInfo; another name
+// when a camera tracking stage writes "frame" from it: replay and live call it "source_frame").
 // Signals end of stream when the source is exhausted.
 #include <memory>
+#include <string>
 
 #include "relight/capture/frame_source.h"
 #include "relight/core/frame_graph.h"
@@ -11,7 +13,8 @@ namespace relight {
 
 class SourceStage final : public Stage {
  public:
-  explicit SourceStage(std::unique_ptr<FrameSource> source) : source_(std::move(source)) {}
+  explicit SourceStage(std::unique_ptr<FrameSource> source, std::string frame_buffer = "frame")
+      : source_(std::move(source)), frame_buffer_(std::move(frame_buffer)) {}
   [[nodiscard]] std::string name() const override { return "source"; }
   [[nodiscard]] bool has_side_effects() const override { return true; }
   void declare(StageBuilder& builder) override;
@@ -20,6 +23,7 @@ class SourceStage final : public Stage {
 
  private:
   std::unique_ptr<FrameSource> source_;
+  std::string frame_buffer_;
   Write<ColorImage> color_;
   Write<DepthMap> depth_;
   Write<FrameInfo> frame_;
