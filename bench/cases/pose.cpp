@@ -162,22 +162,20 @@ Json odometry_640x480(const bench::Options&) {
   const Json mine = figures(runs.front(), truth);
   json["ms"] = mine["ms"];
   Json libraries = Json::object();
-  const Json* best = nullptr;
-  std::string best_name;
+  std::string best;  // the library tracker with the lowest ATE
   for (std::size_t r = 1; r < runs.size(); ++r) {
     libraries[runs[r].name] = figures(runs[r], truth);
-    const Json& entry = libraries[runs[r].name];
-    if (!best || entry["ate_cm"].get<double>() < (*best)["ate_cm"].get<double>()) {
-      best = &entry;
-      best_name = runs[r].name;
+    if (best.empty() || libraries[runs[r].name]["ate_cm"].get<double>() < libraries[best]["ate_cm"].get<double>()) {
+      best = runs[r].name;
     }
   }
-  if (best) {
-    json["baseline"] = best_name;
-    json["baseline_ms"] = (*best)["ms"];
-    json["ratio"] = (*best)["ms"].get<double>() / std::max(1e-9, mine["ms"].get<double>());
-    json["baseline_ate_cm"] = (*best)["ate_cm"];
-    json["baseline_rpe_deg"] = (*best)["rpe_deg"];
+  if (!best.empty()) {
+    const Json& baseline = libraries[best];
+    json["baseline"] = best;
+    json["baseline_ms"] = baseline["ms"];
+    json["ratio"] = baseline["ms"].get<double>() / std::max(1e-9, mine["ms"].get<double>());
+    json["baseline_ate_cm"] = baseline["ate_cm"];
+    json["baseline_rpe_deg"] = baseline["rpe_deg"];
   } else {
     json["baseline"] = "none (libopencv-contrib-dev not installed)";
   }

@@ -270,7 +270,7 @@ struct Reference {
 /// Q = T P, dQ/dxi = R [I | -[P]x], and a residual with gradient g (in the keyframe) has the
 /// Jacobian [R^T g, P x R^T g].
 void linearise(const Level& current, const Reference& reference, float max_distance,
-               const RgbdOdometryOptions& options, const Scales& scales, bool photometric, int threads,
+               const RgbdOdometryOptions& options, const Scales& scales, bool photometric, int threads, int stride,
                std::vector<Normal6>& rows) {
   const Level& key = *reference.key;
   const PreparedLevel& prepared = *reference.prepared;
@@ -285,8 +285,9 @@ void linearise(const Level& current, const Reference& reference, float max_dista
       h, threads,
       [&](int row_begin, int row_end) {
         for (int v = row_begin; v < row_end; ++v) {
+          if (v % stride != 0) continue;
           RowAccumulator acc;
-          for (int u = 0; u < w; ++u) {
+          for (int u = (v / stride) % stride; u < w; u += stride) {
             const std::size_t i = static_cast<std::size_t>(v) * w + u;
             const float z = current.depth[i];
             if (!(z > 0.f)) continue;
@@ -450,13 +451,16 @@ Alignment align(const Pyramid& current, const std::vector<KeyframeView>& keys, c
     for (int it = 0; it < iterations; ++it) {
       Normal6 system;
       std::int64_t first_inliers = 0, first_valid = 0;
-      for (std::size_t k = 0; k < keys.size(); ++k) {
+      // Levels finer than model_finest_level align against the nearest keyframe alone.
+      const std::size_t used = l < options.model_finest_level ? 1 : keys.size();
+      for (std::size_t k = 0; k < used; ++k) {
         Reference reference;
         reference.key = &keys[k].key->pyramid[level];
         reference.prepared = &(*keys[k].prepared)[level];
         reference.key_from_current = (keys[k].key->camera_to_world.inverse() * result.camera_to_world).cast<float>();
         rows.assign(current[level].depth.size() / static_cast<std::size_t>(current[level].width), Normal6{});
-        linearise(current[level], reference, max_distance, options, scales, photometric, threads, rows);
+        linearise(current[level], reference, max_distance, options, scales, photometric, threads,
+                  l == finest ? options.finest_stride : 1, rows);
         Normal6 one;
         for (const Normal6& row : rows) one.add(row);  // in row order: the result is schedule-free
         if (k == 0) {

@@ -48,6 +48,7 @@ namespace relight {
 struct RgbdOdometryOptions {
   int levels = 4;         ///< pyramid levels below and including the input (640 -> 80 px wide)
   int finest_level = 1;   ///< 0 aligns at the input size; 1 stops at half size (faster, ~same ATE)
+  int finest_stride = 2;  ///< the finest level uses every n-th row and column (staggered; same ATE, half the time)
   int iterations[4] = {4, 6, 8, 10};  ///< at most, Gauss-Newton steps per level, finest first
   float max_point_distance_m[4] = {0.04f, 0.06f, 0.10f, 0.15f};
   float min_depth_m = 0.3f;
@@ -61,6 +62,7 @@ struct RgbdOdometryOptions {
   float keyframe_min_overlap = 0.55f;  ///< inlier share below which the frame becomes a keyframe
   int model_keyframes = 3;             ///< keyframes aligned against together (the nearest ones)
   float model_radius_deg = 12.f;       ///< farther keyframes (pose distance, 1 cm = 1 deg) are not
+  int model_finest_level = 0;          ///< finer levels align against the nearest keyframe only
   int max_keyframes = 96;              ///< the least recently used is dropped beyond this
   // Failure detection.
   float min_inlier_ratio = 0.25f;       ///< of the valid pixels at the finest level
