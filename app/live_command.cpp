@@ -37,12 +37,17 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 class LiveStatus {
  public:
   LiveStatus(std::string label, bool quiet) : label_(std::move(label)), enabled_(!quiet && isatty(STDERR_FILENO)) {}
-  void update(std::int64_t frames, std::int64_t dropped) {
+  /// `pose`: the last frame's camera pose, shown as the tracking state (tracking, or lost and why).
+  void update(std::int64_t frames, std::int64_t dropped, const CameraPose* pose = nullptr) {
     if (!enabled_ || Clock::now() - last_ < std::chrono::milliseconds(500)) return;
     last_ = Clock::now();
     const double elapsed = seconds_since(start_);
-    std::fprintf(stderr, "\r%s: %lld frames, %.1f fps, %lld dropped   ", label_.c_str(), static_cast<long long>(frames),
-                 elapsed > 0 ? static_cast<double>(frames) / elapsed : 0.0, static_cast<long long>(dropped));
+    const std::string tracking = !pose                  ? ""
+                                 : pose->failure.empty() ? std::string(", tracking (") + to_string(pose->source) + ")"
+                                                         : ", LOST: " + pose->failure;
+    std::fprintf(stderr, "\r%s: %lld frames, %.1f fps, %lld dropped%s   ", label_.c_str(),
+                 static_cast<long long>(frames), elapsed > 0 ? static_cast<double>(frames) / elapsed : 0.0,
+                 static_cast<long long>(dropped), tracking.c_str());
     drawn_ = true;
   }
   void finish() {
@@ -105,7 +110,9 @@ int run_live(const LiveOptions& options) {
   std::filesystem::create_directories(options.replay.out, ec);
   if (ec) throw Error("cannot create output folder " + options.replay.out.string() + ": " + ec.message());
 
-  ReplayPipeline pipeline = build_replay_pipeline(std::move(source), options.replay);
+  ReplayOptions replay = options.replay;
+  replay.live_device = options.device.empty() ? "the first OpenNI2 device" : options.device;
+  ReplayPipeline pipeline = build_replay_pipeline(std::move(source), replay);
   FrameGraph& graph = *pipeline.graph;
   graph.compile();
   write_file_atomically(options.replay.out / "graph.dot", graph.to_dot());
@@ -116,7 +123,9 @@ int run_live(const LiveOptions& options) {
   const auto start = Clock::now();
   std::string failure;
   try {
-    while (graph.run_frame()) status.update(graph.frames_run(), stoppable.device().dropped());
+    while (graph.run_frame()) {
+      status.update(graph.frames_run(), stoppable.device().dropped(), pipeline.trajectory->last());
+    }
   } catch (const Error& e) {
     failure = e.what();  // e.g. the device was unplugged: keep what was processed, then report it
   }

@@ -215,7 +215,11 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   if (!(options.exposure > 0.f)) throw Error("--exposure must be positive");
   const auto sequence = options.sequence.empty() ? default_sequence() : options.sequence;
   const bool synthetic = sequence.extension() != ".oni" && is_synthetic(sequence);
-  const LightSet measured = real_light_set(synthetic, sequence, options.lights);
+  if (!options.live_device.empty() && options.lights.empty()) {
+    throw Error("the device " + options.live_device +
+                " serves no light probe: give its lights with --lights FILE (from `relight lights`)");
+  }
+  const LightSet measured = real_light_set(synthetic && options.live_device.empty(), sequence, options.lights);
   render::DirSceneContent content;
   render::MrScene lights;
   render::add_lights(lights, measured);

@@ -60,6 +60,8 @@ struct ReplayOptions {
   std::string colormap_model = "affine_3x4";  ///< sample mapping: per_channel_affine | linear_3x3 | affine_3x4
   bool channel_swap = false;                  ///< sample mapping: add channel-permuted pairs
   bool video = true;                           ///< composite.mp4
+  /// `relight live`: the device the frames come from (it has no sequence folder; errors name it).
+  std::string live_device;
 };
 
 

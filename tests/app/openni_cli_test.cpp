@@ -79,6 +79,24 @@ TEST(OpenNiCli, LiveRunsTheReplayGraphForNFrames) {
   EXPECT_GE(pngs, 2u * 4u);  // colour, depth, smoothed depth, normals per frame
 }
 
+// live tracks the device's camera (no poses come from a device: auto is odometry) and writes its
+// trajectory; rendering without --lights names the device, not the embedded sample.
+TEST(OpenNiCli, LiveTracksTheCameraAndNamesTheDeviceWhenLightsAreMissing) {
+  TempDir dir;
+  const auto result =
+      relight("live --quiet --no-frames --device \"relight://synthetic?trajectory=orbit&size=320x240\" --frames 3 --out " +
+              dir.path().string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto report = read_report(dir.path());
+  EXPECT_EQ(report["tracking"]["source"], "odometry");
+  EXPECT_EQ(report["tracking"]["frames_tracked"], 3) << report["tracking"].dump();
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "camera_trajectory.txt"));
+  const std::string model = std::string(RELIGHT_TEST_DATA) + "/models/glossy_pebble.gltf";
+  expect_one_line_error(relight("live --quiet --device relight://synthetic --frames 1 --object " + model +
+                                " --place 0,0,0.8 --out " + (dir.path() / "render").string()),
+                        "the device relight://synthetic serves no light probe");
+}
+
 TEST(OpenNiCli, UnknownDeviceIsAClearError) {
   TempDir dir;
   expect_one_line_error(relight("live --device relight://nowhere --out " + dir.path().string()), "relight://nowhere");
