@@ -88,7 +88,7 @@ CameraPose CameraTrackingStage::track_odometry(const FrameInfo& frame, const Dep
     }
     odometry_.reset(first);
   }
-  const OdometryResult result = odometry_.track(depth, color, frame.intrinsics);
+  const OdometryResult result = odometry_.track(depth, color, frame.intrinsics, std::nullopt, frame.timestamp);
   if (!odometry_started_ && !result.quality.tracked) {
     out.failure = result.quality.failure;
     return out;

@@ -388,6 +388,7 @@ struct RgbdOdometry::State {
   Pose velocity = Pose::Identity();  ///< last_good_previous^-1 * last_good
   bool lost = false;
   int frames_since_good = 1;  ///< the motion bound grows with the frames the camera was lost
+  std::optional<Timestamp> good_time;  ///< of the last good frame, when timestamps are given
 
   const std::vector<PreparedLevel>& prepared(Keyframe& key, int finest_level) {
     if (key.prepared.empty()) {
@@ -525,7 +526,7 @@ void RgbdOdometry::correct(const Pose& pose) {
 }
 
 OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& color, const PinholeIntrinsics& intrinsics,
-                                   const std::optional<Pose>& prior) {
+                                   const std::optional<Pose>& prior, const std::optional<Timestamp>& timestamp) {
   State& state = *state_;
   const int threads = worker_count(options_.threads);
   Pyramid pyramid = build_pyramid(depth, color, intrinsics, options_);
@@ -559,6 +560,7 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
     }
     state.started = true;
     state.last_good = state.first_pose;
+    state.good_time = timestamp;
     result.quality.tracked = true;
     result.quality.inlier_ratio = 1;
     result.quality.condition = 1;
@@ -586,6 +588,10 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
   if (nearest) candidates.push_back(nearest);
   if (recent && recent != nearest) candidates.push_back(recent);
 
+  // Frame periods (1/30 s) since the last good frame: from the timestamps when known.
+  const double periods = timestamp && state.good_time
+                             ? std::max(1.0, (*timestamp - *state.good_time) * 30.0)
+                             : static_cast<double>(state.frames_since_good);
   std::string failure = "no keyframe";
   for (Keyframe* key : candidates) {
     // The model: this keyframe and the nearest others that overlap the prediction.
@@ -614,8 +620,7 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
       failure = "the view constrains the pose too little (a plane or a blank wall)";
     } else if (alignment.rms > options.max_rms) {
       failure = "residual too large";
-    } else if (quality.step_m > options.max_step_m * state.frames_since_good ||
-               quality.step_deg > options.max_step_deg * state.frames_since_good) {
+    } else if (quality.step_m > options.max_step_m * periods || quality.step_deg > options.max_step_deg * periods) {
       // Also while lost: a wrong local minimum far from the last good pose must not be taken
       // for a recovery (nothing renders with a pose that jumped); a camera that truly moved
       // away is re-acquired when it comes back, or by a marker.
@@ -628,6 +633,7 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
       state.last_good = pose;
       state.lost = false;
       state.frames_since_good = 1;
+      state.good_time = timestamp;
       // A new keyframe when no stored one is within both thresholds of this pose.
       bool covered = false;
       for (const Keyframe& other : state.keyframes) {

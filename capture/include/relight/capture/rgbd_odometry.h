@@ -68,8 +68,8 @@ struct RgbdOdometryOptions {
   float min_inlier_ratio = 0.25f;       ///< of the valid pixels at the finest level
   float recovery_min_inlier_ratio = 0.5f;  ///< while lost, a stricter bar for taking a pose again
   float max_rms = 8.0f;                 ///< normalised residual RMS of the inliers
-  float max_step_m = 0.15f;             ///< between consecutive frames (~4.5 m/s at 30 fps)
-  float max_step_deg = 20.f;
+  float max_step_m = 0.15f;             ///< per 1/30 s (~4.5 m/s) since the last good frame
+  float max_step_deg = 20.f;            ///< per 1/30 s since the last good frame
   float min_condition = 1e-4f;          ///< smallest/largest eigenvalue of the geometric J^T J
   double convergence = 2e-4;  ///< a level ends when the step is below this (m, rad)
   bool photometric = true;
@@ -105,8 +105,12 @@ class RgbdOdometry {
   /// Tracks one frame. The first frame (or the first after reset) is placed at `first_pose`
   /// (identity by default, see reset) and becomes the first keyframe. `prior`, when given, is
   /// where the alignment starts instead of the constant-velocity prediction (a marker pose).
+  /// `timestamp` (seconds), when given, bounds the motion by the time since the last good frame
+  /// (max_step_* per 1/30 s) instead of by the frames tracked: a live device drops frames when
+  /// the pipeline is slower than the camera.
   OdometryResult track(const DepthMap& depth, const ColorImage& color, const PinholeIntrinsics& intrinsics,
-                       const std::optional<Pose>& prior = std::nullopt);
+                       const std::optional<Pose>& prior = std::nullopt,
+                       const std::optional<Timestamp>& timestamp = std::nullopt);
 
   /// Forgets every keyframe; the next frame is placed at `pose`.
   void reset(const Pose& pose = Pose::Identity());
