@@ -9,39 +9,22 @@
 // Reads: "camera_pose" (CameraPose), "source_frame" (FrameInfo: timestamp, the sequence's pose).
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <optional>
-#include <vector>
 
-#include "relight/capture/camera_pose.h"
-#include "relight/core/frame_graph.h"
-#include "relight/core/rgbd_frame.h"
+#include "pose_trajectory_stage.h"
 
 namespace relight::app {
 
-class CameraTrajectoryStage final : public Stage {
+class CameraTrajectoryStage final : public PoseTrajectoryStage {
  public:
-  explicit CameraTrajectoryStage(std::filesystem::path file) : file_(std::move(file)) {}
+  explicit CameraTrajectoryStage(std::filesystem::path file) : PoseTrajectoryStage(std::move(file), "camera_pose") {}
   [[nodiscard]] std::string name() const override { return "camera_trajectory"; }
-  [[nodiscard]] bool has_side_effects() const override { return true; }
-  void declare(StageBuilder& builder) override;
-  void run(StageContext& context) override;
-  void finish() override;
 
   [[nodiscard]] nlohmann::ordered_json summary() const;
   /// The last frame's pose state, for the progress line and the live view.
-  [[nodiscard]] const CameraPose* last() const { return entries_.empty() ? nullptr : &entries_.back().pose; }
+  [[nodiscard]] const CameraPose* last() const { return entries().empty() ? nullptr : &entries().back().pose; }
 
  private:
-  struct Entry {
-    std::int64_t index;
-    Timestamp timestamp;
-    CameraPose pose;
-    std::optional<Pose> reference;
-  };
-  std::filesystem::path file_;
-  std::vector<Entry> entries_;
-  Read<CameraPose> pose_;
-  Read<FrameInfo> frame_;
+  [[nodiscard]] std::string description() const override;
 };
 
 }  // namespace relight::app

@@ -8,21 +8,15 @@
 // Reads: "marker_pose" (CameraPose), "source_frame" (FrameInfo: the sequence's own pose).
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <vector>
 
-#include "relight/capture/marker_pose.h"
-#include "relight/core/frame_graph.h"
+#include "pose_trajectory_stage.h"
 
 namespace relight::app {
 
-class MarkerTrajectoryStage final : public Stage {
+class MarkerTrajectoryStage final : public PoseTrajectoryStage {
  public:
-  explicit MarkerTrajectoryStage(std::filesystem::path file) : file_(std::move(file)) {}
+  explicit MarkerTrajectoryStage(std::filesystem::path file) : PoseTrajectoryStage(std::move(file), "marker_pose") {}
   [[nodiscard]] std::string name() const override { return "marker_trajectory"; }
-  [[nodiscard]] bool has_side_effects() const override { return true; }
-  void declare(StageBuilder& builder) override;
-  void run(StageContext& context) override;
-  void finish() override;
 
   /// Frames, frames with a fresh / held pose, and the error against the sequence's poses.
   [[nodiscard]] nlohmann::ordered_json summary() const;
@@ -32,15 +26,7 @@ class MarkerTrajectoryStage final : public Stage {
   [[nodiscard]] std::string no_tag_warning(const std::string& layout) const;
 
  private:
-  struct Entry {
-    Timestamp timestamp;
-    CameraPose pose;
-    std::optional<Pose> reference;
-  };
-  std::filesystem::path file_;
-  std::vector<Entry> entries_;
-  Read<CameraPose> pose_;
-  Read<FrameInfo> frame_;
+  [[nodiscard]] std::string description() const override { return "camera poses from AprilTag markers (camera to world)"; }
 };
 
 }  // namespace relight::app
