@@ -1,7 +1,6 @@
 #include "marker_trajectory_stage.h"
 
 #include <algorithm>
-#include <numbers>
 
 namespace relight::app {
 
@@ -13,7 +12,7 @@ nlohmann::ordered_json MarkerTrajectoryStage::summary() const {
     entry.pose.held ? ++held : ++fresh;
     if (entry.pose.held || !entry.reference) continue;
     const double cm = 100.0 * (entry.pose.camera_to_world.translation() - entry.reference->translation()).norm();
-    const double deg = rotation_distance(entry.pose.camera_to_world, *entry.reference) * 180.0 / std::numbers::pi;
+    const double deg = rotation_distance_degrees(entry.pose.camera_to_world, *entry.reference);
     ++compared;
     sum_cm += cm;
     sum_deg += deg;

@@ -1,7 +1,6 @@
 #include "relight/capture/camera_tracking_stage.h"
 
 #include <algorithm>
-#include <numbers>
 
 #include "relight/capture/support_plane.h"
 #include "relight/core/error.h"
@@ -33,7 +32,7 @@ bool uses_marker(PoseSource source) { return source == PoseSource::Marker || sou
 /// `from` moved towards `to` by at most max_m and max_deg.
 Pose bounded_step(const Pose& from, const Pose& to, double max_m, double max_deg) {
   const double distance = (to.translation() - from.translation()).norm();
-  const double angle = rotation_distance(from, to) * 180.0 / std::numbers::pi;
+  const double angle = rotation_distance_degrees(from, to);
   double t = 1.0;
   if (distance > max_m) t = std::min(t, max_m / distance);
   if (angle > max_deg) t = std::min(t, max_deg / angle);

@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <limits>
 #include <list>
-#include <numbers>
 #include <vector>
 
 #include "relight/core/error.h"
@@ -426,7 +425,7 @@ Pose rigid(const Pose& pose) {
 
 /// Pose distance in "degrees": rotation angle plus 1 degree per centimetre.
 double pose_distance(const Pose& a, const Pose& b) {
-  return rotation_distance(a, b) * 180.0 / std::numbers::pi + 100.0 * (a.translation() - b.translation()).norm();
+  return rotation_distance_degrees(a, b) + 100.0 * (a.translation() - b.translation()).norm();
 }
 
 /// A keyframe the current frame is aligned against, with its derived levels.
@@ -452,14 +451,12 @@ Alignment align(const Pyramid& current, const std::vector<KeyframeView>& keys, c
     for (int it = 0; it < iterations; ++it) {
       Normal6 system;
       std::int64_t first_inliers = 0, first_valid = 0;
-      // Levels finer than model_finest_level align against the nearest keyframe alone.
-      const std::size_t used = l < options.model_finest_level ? 1 : keys.size();
-      for (std::size_t k = 0; k < used; ++k) {
+      for (std::size_t k = 0; k < keys.size(); ++k) {
         Reference reference;
         reference.key = &keys[k].key->pyramid[level];
         reference.prepared = &(*keys[k].prepared)[level];
         reference.key_from_current = (keys[k].key->camera_to_world.inverse() * result.camera_to_world).cast<float>();
-        rows.assign(current[level].depth.size() / static_cast<std::size_t>(current[level].width), Normal6{});
+        rows.assign(static_cast<std::size_t>(current[level].height), Normal6{});
         linearise(current[level], reference, max_distance, options, scales, photometric, threads,
                   l == finest ? options.finest_stride : 1, rows);
         Normal6 one;
@@ -572,21 +569,18 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
   const Pose predicted = prior                                       ? *prior
                          : (options.constant_velocity && !state.lost) ? Pose(state.last_good * state.velocity)
                                                                       : state.last_good;
-  // Candidates: the keyframe nearest the prediction, then the most recently used one.
-  std::vector<Keyframe*> candidates;
-  Keyframe* nearest = nullptr;
-  double nearest_distance = std::numeric_limits<double>::max();
+  // The keyframes by their distance to the prediction (stable: the first of equals stays first).
+  std::vector<std::pair<double, Keyframe*>> by_distance;
   Keyframe* recent = nullptr;
   for (Keyframe& key : state.keyframes) {
-    const double d = pose_distance(key.camera_to_world, predicted);
-    if (d < nearest_distance) {
-      nearest_distance = d;
-      nearest = &key;
-    }
+    by_distance.emplace_back(pose_distance(key.camera_to_world, predicted), &key);
     if (!recent || key.last_used > recent->last_used) recent = &key;
   }
-  if (nearest) candidates.push_back(nearest);
-  if (recent && recent != nearest) candidates.push_back(recent);
+  std::stable_sort(by_distance.begin(), by_distance.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  // Candidates: the keyframe nearest the prediction, then the most recently used one.
+  std::vector<Keyframe*> candidates;
+  if (!by_distance.empty()) candidates.push_back(by_distance.front().second);
+  if (recent && recent != by_distance.front().second) candidates.push_back(recent);
 
   // Frame periods (1/30 s) since the last good frame: from the timestamps when known.
   const double periods = timestamp && state.good_time
@@ -596,14 +590,9 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
   for (Keyframe* key : candidates) {
     // The model: this keyframe and the nearest others that overlap the prediction.
     std::vector<KeyframeView> views{{key, &state.prepared(*key, options.finest_level)}};
-    std::vector<std::pair<double, Keyframe*>> others;
-    for (Keyframe& other : state.keyframes) {
-      if (&other != key) others.emplace_back(pose_distance(other.camera_to_world, predicted), &other);
-    }
-    std::sort(others.begin(), others.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [distance, other] : others) {
+    for (const auto& [distance, other] : by_distance) {
       if (static_cast<int>(views.size()) >= options.model_keyframes || distance > options.model_radius_deg) break;
-      views.push_back({other, &state.prepared(*other, options.finest_level)});
+      if (other != key) views.push_back({other, &state.prepared(*other, options.finest_level)});
     }
     const Alignment alignment = align(pyramid, views, predicted, options, threads);
     const Pose pose = alignment.camera_to_world;
@@ -613,7 +602,7 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
     quality.condition = alignment.condition;
     quality.keyframe = key->id;
     quality.step_m = (pose.translation() - state.last_good.translation()).norm();
-    quality.step_deg = rotation_distance(state.last_good, pose) * 180.0 / std::numbers::pi;
+    quality.step_deg = rotation_distance_degrees(state.last_good, pose);
     if (alignment.inlier_ratio < options.min_inlier_ratio) {
       failure = "too few depth pixels align (" + std::to_string(static_cast<int>(100 * alignment.inlier_ratio)) + " %)";
     } else if (alignment.condition < options.min_condition) {
@@ -637,10 +626,9 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
       // A new keyframe when no stored one is within both thresholds of this pose.
       bool covered = false;
       for (const Keyframe& other : state.keyframes) {
-        covered = covered || (rotation_distance(other.camera_to_world, pose) * 180.0 / std::numbers::pi <=
-                                  options.keyframe_angle_deg &&
-                              (other.camera_to_world.translation() - pose.translation()).norm() <=
-                                  options.keyframe_distance_m);
+        covered = covered ||
+                  (rotation_distance_degrees(other.camera_to_world, pose) <= options.keyframe_angle_deg &&
+                   (other.camera_to_world.translation() - pose.translation()).norm() <= options.keyframe_distance_m);
       }
       if (!covered || alignment.inlier_ratio < options.keyframe_min_overlap) {
         quality.new_keyframe = true;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace relight {
 
@@ -40,5 +41,7 @@ double rotation_distance(const Pose& a, const Pose& b) {
   const double cosine = std::clamp((relative.trace() - 1.0) / 2.0, -1.0, 1.0);
   return std::acos(cosine);
 }
+
+double rotation_distance_degrees(const Pose& a, const Pose& b) { return rotation_distance(a, b) * 180.0 / std::numbers::pi; }
 
 }  // namespace relight

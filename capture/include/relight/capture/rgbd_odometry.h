@@ -62,7 +62,6 @@ struct RgbdOdometryOptions {
   float keyframe_min_overlap = 0.55f;  ///< inlier share below which the frame becomes a keyframe
   int model_keyframes = 3;             ///< keyframes aligned against together (the nearest ones)
   float model_radius_deg = 12.f;       ///< farther keyframes (pose distance, 1 cm = 1 deg) are not
-  int model_finest_level = 0;          ///< finer levels align against the nearest keyframe only
   int max_keyframes = 96;              ///< the least recently used is dropped beyond this
   // Failure detection.
   float min_inlier_ratio = 0.25f;       ///< of the valid pixels at the finest level

@@ -20,5 +20,7 @@ std::array<double, 7> pose_to_tum(const Pose& pose);
 Pose interpolate(const Pose& a, const Pose& b, double t);
 /// Rotation angle (radians) of a.inverse() * b, for comparisons in tests and tools.
 double rotation_distance(const Pose& a, const Pose& b);
+/// The same angle in degrees.
+double rotation_distance_degrees(const Pose& a, const Pose& b);
 
 }  // namespace relight
