@@ -31,6 +31,19 @@ void add_compute_options(CLI::App& command, ReplayOptions& options) {
 
 }  // namespace
 
+namespace {
+
+/// --markers and --pose: what replay and graph share of the camera pose.
+void add_pose_options(CLI::App& command, ReplayOptions& options) {
+  command.add_option("--markers", options.markers,
+                     "AprilTag layout for the camera pose: auto (the sequence's scene.json if it has a tag), "
+                     "none, or a layout JSON file; writes marker_trajectory.txt")
+      ->capture_default_str();
+  add_pose_option(command, options);
+}
+
+}  // namespace
+
 void add_pose_option(CLI::App& command, ReplayOptions& options) {
   command.add_option("--pose", options.pose,
                      "camera pose: auto (the sequence's own poses when it has them, else marker+odometry with a "
@@ -135,11 +148,7 @@ void register_replay(CLI::App& app) {
   replay->add_flag("!--no-frames", options->write_frames, "Do not write per-frame images");
   replay->add_flag("--skip-bad-frames", options->skip_bad_frames,
                    "A TUM frame that cannot be read is skipped with a warning naming it (default: an error)");
-  replay->add_option("--markers", options->markers,
-                     "AprilTag layout for the camera pose: auto (the sequence's scene.json if it has a tag), "
-                     "none, or a layout JSON file; writes marker_trajectory.txt")
-      ->capture_default_str();
-  add_pose_option(*replay, *options);
+  add_pose_options(*replay, *options);
   add_compute_options(*replay, *options);
   add_render_options(*replay, *options);
   registry().runners[replay] = [options] { return run_replay(*options); };
@@ -150,6 +159,7 @@ void register_graph(CLI::App& app) {
   CLI::App* graph = app.add_subcommand("graph", "Show the replay frame graph (stages, buffers, order)");
   graph->add_flag("--dot", *dot, "Print Graphviz DOT instead of the execution order");
   auto options = std::make_shared<ReplayOptions>();
+  add_pose_options(*graph, *options);
   add_compute_options(*graph, *options);
   registry().runners[graph] = [dot, options] {
     ReplayPipeline pipeline = build_replay_pipeline(open_replay_source(*options), *options);

@@ -74,6 +74,27 @@ TEST(ReplayTracking, OdometryAndMarkerOdometryFollowTheSyntheticOrbit) {
   }
 }
 
+// `relight graph` shows the tracking stage for the pose options: with a tag layout and
+// marker+odometry the marker pose runs before the tracking stage, which reads depth and colour.
+TEST(ReplayTracking, GraphShowsTheTrackingStageOfThePoseOptions) {
+  const auto plain = relight("graph");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_NE(plain.out.find("camera_tracking\n"), std::string::npos) << plain.out;
+  EXPECT_NE(plain.out.find("camera_trajectory\n"), std::string::npos) << plain.out;
+  EXPECT_EQ(plain.out.find("marker_pose\n"), std::string::npos) << plain.out;
+  const std::string layout = (orbit_sequence() / "scene.json").string();
+  const auto marked = relight("graph --markers " + layout + " --pose marker+odometry");
+  ASSERT_EQ(marked.exit_code, 0) << marked.err;
+  const auto marker = marked.out.find("marker_pose\n"), tracking = marked.out.find("camera_tracking\n");
+  ASSERT_NE(marker, std::string::npos) << marked.out;
+  ASSERT_NE(tracking, std::string::npos) << marked.out;
+  EXPECT_LT(marker, tracking) << marked.out;
+  const auto dot = relight("graph --dot --markers " + layout + " --pose marker+odometry");
+  EXPECT_NE(dot.out.find("\"buffer:marker_pose\" -> \"stage:camera_tracking\""), std::string::npos) << dot.out;
+  EXPECT_NE(dot.out.find("\"buffer:depth\" -> \"stage:camera_tracking\""), std::string::npos) << dot.out;
+  EXPECT_EQ(relight("graph --pose gps").exit_code, 2);
+}
+
 TEST(ReplayTracking, PoseSourcesTheSequenceCannotGiveAreOneLineErrors) {
   TempDir dir;
   // A copy of the orbit without its ground truth: --pose sequence has nothing to read.
