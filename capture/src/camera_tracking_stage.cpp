@@ -72,7 +72,7 @@ CameraPose CameraTrackingStage::track_odometry(const FrameInfo& frame, const Dep
                                                const CameraPose* marker) {
   const bool sighting = marker && marker->valid && !marker->held;
   CameraPose out;
-  if (!odometry_started_) {
+  if (!odometry_.started()) {
     // The world frame: the marker layout's once a tag is seen (marker+odometry waits for it),
     // else the first camera levelled on its support plane.
     if (source_ == PoseSource::MarkerOdometry && !sighting) {
@@ -88,11 +88,10 @@ CameraPose CameraTrackingStage::track_odometry(const FrameInfo& frame, const Dep
     odometry_.reset(first);
   }
   const OdometryResult result = odometry_.track(depth, color, frame.intrinsics, std::nullopt, frame.timestamp);
-  if (!odometry_started_ && !result.quality.tracked) {
+  if (!odometry_.started()) {  // the first frame had too little depth to place
     out.failure = result.quality.failure;
     return out;
   }
-  odometry_started_ = true;
   out.valid = true;
   out.inlier_ratio = result.quality.inlier_ratio;
   out.keyframe = result.quality.keyframe;

@@ -506,6 +506,7 @@ RgbdOdometry::RgbdOdometry(RgbdOdometry&&) noexcept = default;
 RgbdOdometry& RgbdOdometry::operator=(RgbdOdometry&&) noexcept = default;
 
 std::size_t RgbdOdometry::keyframe_count() const { return state_->keyframes.size(); }
+bool RgbdOdometry::started() const { return state_->started; }
 
 void RgbdOdometry::reset(const Pose& pose) {
   state_ = std::make_unique<State>();

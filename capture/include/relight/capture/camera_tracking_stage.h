@@ -65,7 +65,6 @@ class CameraTrackingStage final : public Stage {
   CameraTrackingOptions options_;
   std::optional<PoseSource> source_;  ///< options_.source, or what auto chose at the first frame
   RgbdOdometry odometry_;
-  bool odometry_started_ = false;
   std::optional<CameraPose> last_good_;
   Read<FrameInfo> source_frame_;
   Read<DepthMap> depth_;

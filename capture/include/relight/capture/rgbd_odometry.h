@@ -118,6 +118,8 @@ class RgbdOdometry {
   void correct(const Pose& pose);
 
   [[nodiscard]] std::size_t keyframe_count() const;
+  /// A first frame has been placed (since construction or the last reset).
+  [[nodiscard]] bool started() const;
   [[nodiscard]] const RgbdOdometryOptions& options() const { return options_; }
 
  private:
