@@ -66,6 +66,17 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--place", options.places,
                      std::string("Placement x,y,z[,yaw_degrees[,scale]] per --object, world frame (synthetic default ") +
                          kDefaultSynthPlacement + ")");
+  command.add_option("--place-at", options.places_at,
+                     "Placement u,v[,yaw_degrees[,scale]]: stand the object on the surface seen at pixel (u, v) of the "
+                     "first frame, its up axis along that surface's normal (repeatable; objects take the --place "
+                     "placements first, then --place-at, then --place-on-plane)");
+  command.add_option("--place-on-plane", options.places_on_plane,
+                     "Placement [yaw_degrees[,scale]]: stand the object on a support plane of the first frame (of the "
+                     "up-facing planes in view - a table, the floor - the one with a free spot nearest the image "
+                     "centre, at that spot)")
+      ->expected(0, 1)
+      ->default_str("")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command.add_option("--lights", options.lights, "Lights JSON of `relight lights` (needed to render into a recorded sequence)");
   command.add_option("--virtual-light", options.virtual_lights, "A virtual point light x,y,z,intensity[,r,g,b] (repeatable)");
   command.add_option("--virtual-spot", options.virtual_spots,
@@ -134,6 +145,12 @@ Registry& registry() {
   return instance;
 }
 
+void add_no_object_option(CLI::App& command, ReplayOptions& options) {
+  command.add_flag("--no-object", options.no_object,
+                   "On the embedded sample without --object: geometry only (by default the shipped pebble is "
+                   "rendered on the sample's table, lit by the shipped light probe)");
+}
+
 void register_replay(CLI::App& app) {
   auto options = std::make_shared<ReplayOptions>();
   CLI::App* replay = app.add_subcommand("replay", "Run the pipeline on a recorded RGB-D sequence (TUM folder or .oni)");
@@ -151,6 +168,7 @@ void register_replay(CLI::App& app) {
   add_pose_options(*replay, *options);
   add_compute_options(*replay, *options);
   add_render_options(*replay, *options);
+  add_no_object_option(*replay, *options);
   registry().runners[replay] = [options] { return run_replay(*options); };
 }
 
@@ -161,6 +179,7 @@ void register_graph(CLI::App& app) {
   auto options = std::make_shared<ReplayOptions>();
   add_pose_options(*graph, *options);
   add_compute_options(*graph, *options);
+  add_no_object_option(*graph, *options);
   registry().runners[graph] = [dot, options] {
     ReplayPipeline pipeline = build_replay_pipeline(open_replay_source(*options), *options);
     FrameGraph& frame_graph = *pipeline.graph;

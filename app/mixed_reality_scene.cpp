@@ -92,19 +92,16 @@ LightSet real_light_set(bool synthetic, const fs::path& sequence, const fs::path
   }
 }
 
-std::vector<std::pair<render::VirtualModel, render::Placement>> virtual_objects(const std::vector<fs::path>& objects,
-                                                                               const std::vector<std::string>& places,
-                                                                               bool synthetic) {
-  if (!places.empty() && places.size() != objects.size())
-    throw Error("give one --place per --object (" + std::to_string(objects.size()) + " objects, " +
-                std::to_string(places.size()) + " placements)");
-  if (places.empty() && !objects.empty() && !synthetic)
-    throw Error("--place x,y,z[,yaw[,scale]] is needed to put an object into a recorded scene");
-  std::vector<std::pair<render::VirtualModel, render::Placement>> out;
-  for (std::size_t i = 0; i < objects.size(); ++i)
-    out.emplace_back(render::load_model(objects[i]),
-                     render::Placement::parse(places.empty() ? kDefaultSynthPlacement : places[i]));
-  return out;
+LightSet lights_from_latlong_probe(const fs::path& probe, int count) {
+  const RadianceImage image = read_radiance(probe);
+  LightExtractionOptions options;
+  options.lights = count;
+  options.calibration = ProbeCalibration::equirectangular();
+  try {
+    return extract_lights(image, options);
+  } catch (const Error& error) {
+    throw Error(probe.string() + ": " + error.what());
+  }
 }
 
 }  // namespace relight::app

@@ -36,9 +36,8 @@ inline constexpr float kSpotInnerFraction = 0.8f;
 [[nodiscard]] LightSet real_light_set(bool synthetic, const std::filesystem::path& sequence,
                                       const std::filesystem::path& lights_file);
 
-/// Loads each object and pairs it with its placement: one --place per object, or none on a
-/// synthetic sequence (every object then goes to kDefaultSynthPlacement).
-[[nodiscard]] std::vector<std::pair<render::VirtualModel, render::Placement>> virtual_objects(
-    const std::vector<std::filesystem::path>& objects, const std::vector<std::string>& places, bool synthetic);
+/// 8 lights importance-sampled from a lat-long (equirectangular) HDR probe, as `relight lights
+/// PROBE --n 8` gives them.
+[[nodiscard]] LightSet lights_from_latlong_probe(const std::filesystem::path& probe, int count);
 
 }  // namespace relight::app

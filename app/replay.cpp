@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <functional>
 #include <iostream>
@@ -13,6 +14,7 @@
 #include "camera_trajectory_stage.h"
 #include "marker_trajectory_stage.h"
 #include "mixed_reality_scene.h"
+#include "object_placement_stage.h"
 #include "relight/capture/camera_tracking_stage.h"
 #include "relight/capture/marker_pose.h"
 #include "relight/capture/openni_source.h"
@@ -36,6 +38,7 @@
 #include "relight/colormap/colormap_stages.h"
 #include "relight/render/dir_stage.h"
 #include "relight/render/mapped_composite_stage.h"
+#include "relight/render/model_io.h"
 #include "relight/render/scene_lights.h"
 #include "report.h"
 #include "report_collector_stage.h"
@@ -219,16 +222,30 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
     throw Error("the device " + options.live_device +
                 " serves no light probe: give its lights with --lights FILE (from `relight lights`)");
   }
-  const LightSet measured = real_light_set(synthetic && options.live_device.empty(), sequence, options.lights);
+  const LightSet measured = options.lights.empty() && !options.latlong_probe.empty()
+                                ? lights_from_latlong_probe(options.latlong_probe, 8)
+                                : real_light_set(synthetic && options.live_device.empty(), sequence, options.lights);
   render::DirSceneContent content;
   render::MrScene lights;
   render::add_lights(lights, measured);
   content.lights = lights.lights;
   for (const std::string& light : options.virtual_lights) content.lights.push_back(parse_virtual_light(light));
   for (const std::string& spot : options.virtual_spots) content.lights.push_back(parse_virtual_spot(spot));
-  content.objects = virtual_objects(options.objects, options.places, synthetic);
+  auto requests = placement_requests(options.objects.size(), options.places, options.places_at,
+                                     options.places_on_plane, kDefaultSynthPlacement, synthetic);
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < options.objects.size(); ++i) {
+    render::VirtualModel model = render::load_model(options.objects[i]);
+    const Eigen::AlignedBox3f box = render::bounds(model);  // y-up: the footprint is x by z
+    requests[i].footprint_radius_m =
+        requests[i].placement.scale * 0.5 * std::hypot(box.sizes().x(), box.sizes().z());
+    content.objects.emplace_back(std::move(model), requests[i].placement);
+    names.push_back(options.objects[i].filename().string());
+  }
 
   FrameGraph& graph = *pipeline.graph;
+  if (!content.objects.empty())
+    pipeline.placement = &graph.emplace<ObjectPlacementStage>(std::move(requests), std::move(names));
   graph.emplace<ConstantStage<LightSet>>("lights", measured);
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
   graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
@@ -242,6 +259,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
       options.vpl_source == "rsm" ? render::VplSource::ReflectiveShadowMaps : render::VplSource::RayTraced;
   dir.tone_map.exposure = options.exposure;
   dir.materials_buffer = "materials";
+  if (pipeline.placement) dir.placements_buffer = "object_placements";
   if (options.real_albedo == "pixel") dir.albedo_buffer = "kd";
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view
   // keep their shadows, at a quarter of the rasterisation and memory of 512.
@@ -298,7 +316,20 @@ std::string marker_layout_name(const ReplayOptions& options) {
 
 }  // namespace
 
-ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options) {
+ReplayOptions with_main_job_defaults(ReplayOptions options) {
+  const bool embedded_sample = options.sequence.empty() && options.live_device.empty();
+  const bool nothing_to_render =
+      options.objects.empty() && options.virtual_lights.empty() && options.virtual_spots.empty();
+  if (!embedded_sample || !nothing_to_render || options.no_object) return options;
+  options.objects = {data_folder() / "models" / "glossy_pebble.gltf"};
+  options.places_on_plane = {""};
+  // The sample was recorded without a light probe: the shipped Grace Cathedral probe stands in.
+  if (options.lights.empty()) options.latlong_probe = data_folder() / "probes" / "grace_latlong.hdr";
+  return options;
+}
+
+ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& given) {
+  const ReplayOptions options = with_main_job_defaults(given);
   if (options.geometry != "method1" && options.geometry != "method2") {
     throw Error("--geometry '" + options.geometry + "' is not one of method1, method2");
   }
@@ -400,6 +431,10 @@ int run_replay(const ReplayOptions& options) {
     std::cerr << pipeline.markers->no_tag_warning(marker_layout_name(options));
   }
   report["tracking"] = pipeline.trajectory->summary();
+  if (pipeline.placement) {
+    report["placements"] = pipeline.placement->summary();
+    if (!options.quiet) std::cerr << pipeline.placement->describe();
+  }
   write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
   if (interrupted) {
     // Not a failure of the input, but the run did not cover it: 128 + SIGINT, as shells report it.

@@ -16,6 +16,7 @@ namespace relight::app {
 
 class CameraTrajectoryStage;
 class MarkerTrajectoryStage;
+class ObjectPlacementStage;
 class ReportCollectorStage;
 
 struct ReplayOptions {
@@ -41,8 +42,16 @@ struct ReplayOptions {
   std::string method2_normals = "filtered";
   /// Differential rendering (render/dir_stage.h) runs when there is an object or a virtual light.
   std::vector<std::filesystem::path> objects;  ///< .obj / .gltf / .glb
-  std::vector<std::string> places;             ///< one x,y,z[,yaw[,scale]] per object
+  std::vector<std::string> places;             ///< x,y,z[,yaw[,scale]] (world), see object_placement_stage.h
+  std::vector<std::string> places_at;          ///< u,v[,yaw[,scale]]: on the surface at a first-frame pixel
+  std::vector<std::string> places_on_plane;    ///< [yaw[,scale]]: on the dominant support plane
+  /// The main job (`relight replay` on the embedded sample with nothing to render) renders the
+  /// shipped pebble on the sample's support plane, lit by the shipped probe; this turns it off.
+  bool no_object = false;
   std::filesystem::path lights;                ///< lights JSON of `relight lights` (recorded sequences)
+  /// A lat-long HDR probe the real lights are extracted from (8 lights) when there is no
+  /// `lights` file: the main job's stand-in for a sample recorded without a probe.
+  std::filesystem::path latlong_probe;
   std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]
   std::vector<std::string> virtual_spots;      ///< x,y,z,tx,ty,tz,angle,intensity[,r,g,b]
   int vpls = 64;                               ///< first-bounce light samples per frame
@@ -72,6 +81,7 @@ struct ReplayPipeline {
   std::string compute;  ///< one line: which backend runs the per-pixel stages, on which device
   app::MarkerTrajectoryStage* markers = nullptr;  ///< set when the marker pose runs
   app::CameraTrajectoryStage* trajectory = nullptr;  ///< the tracked pose of every frame
+  app::ObjectPlacementStage* placement = nullptr;  ///< set when there are virtual objects
   bool renders = false;                           ///< the DIR stage is in the graph
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".
   std::string final_composite = "composite";
@@ -84,6 +94,11 @@ struct ReplayPipeline {
 /// The folder holding the embedded sample data: $RELIGHT_DATA, else the source tree's data/.
 [[nodiscard]] std::filesystem::path data_folder();
 [[nodiscard]] std::filesystem::path default_sequence();
+
+/// The options with the main job's content filled in: on the embedded sample (no sequence,
+/// no live device) with no object and no virtual light, and without `no_object`, the shipped
+/// glossy pebble on the support plane, lit from the shipped probe unless `lights` is given.
+[[nodiscard]] ReplayOptions with_main_job_defaults(ReplayOptions options);
 
 /// Creates the Vulkan context the options ask for and the replay graph: source, depth filter, writer.
 [[nodiscard]] ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options);

@@ -55,13 +55,15 @@ MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& optio
     : content_(std::move(content)),
       mesh_(options.mesh),
       reconstruction_material_(options.reconstruction_material),
-      materials_buffer_(options.materials_buffer) {}
+      materials_buffer_(options.materials_buffer),
+      placements_buffer_(options.placements_buffer) {}
 
 void MrSceneStage::declare(StageBuilder& builder) {
   frame_ = builder.read<FrameInfo>("frame");
   positions_ = builder.read<PositionMap>("positions");
   normals_ = builder.read<NormalMap>("normals");
   if (!materials_buffer_.empty()) materials_ = builder.read<brdf::Materials>(materials_buffer_);
+  if (!placements_buffer_.empty()) placements_ = builder.read<ObjectPlacements>(placements_buffer_);
   scene_ = builder.write<MrScene>("mr_scene");
 }
 
@@ -81,7 +83,17 @@ void MrSceneStage::run(StageContext& context) {
   mesh.name = "reconstruction";
   scene.meshes.push_back(std::move(mesh));
   scene.lights = content_.lights;
-  for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
+  if (placements_buffer_.empty()) {
+    for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
+    return;
+  }
+  const ObjectPlacements& placements = context.get(placements_);
+  if (!placements.resolved) return;
+  if (placements.placements.size() != content_.objects.size())
+    throw LogicError("mr_scene: " + std::to_string(placements.placements.size()) + " placements for " +
+                     std::to_string(content_.objects.size()) + " objects");
+  for (std::size_t i = 0; i < content_.objects.size(); ++i)
+    add_virtual_model(scene, content_.objects[i].first, placements.placements[i]);
 }
 
 // ---- vpls --------------------------------------------------------------------------------------

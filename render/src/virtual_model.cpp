@@ -39,7 +39,8 @@ Eigen::Affine3d Placement::transform() const {
   const Eigen::AngleAxisd yaw(yaw_degrees * std::numbers::pi / 180.0, Eigen::Vector3d::UnitZ());
   Eigen::Affine3d t = Eigen::Affine3d::Identity();
   t.translate(position);
-  t.rotate(yaw.toRotationMatrix() * y_up_to_z_up);
+  const Eigen::Matrix3d z_to_up = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), up).toRotationMatrix();
+  t.rotate(z_to_up * yaw.toRotationMatrix() * y_up_to_z_up);
   t.scale(scale);
   return t;
 }

@@ -3,9 +3,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <map>
 #include <string>
 
 #include "run_command.h"
+#include "temp_dir.h"
 
 namespace relight::cli_test {
 
@@ -16,6 +19,18 @@ inline void expect_one_line_error(const CommandResult& result, int exit_code) {
   EXPECT_EQ(result.exit_code, exit_code) << result.err;
   EXPECT_EQ(result.err.rfind("relight: error: ", 0), 0u) << result.err;
   EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+}
+
+/// The sequence `relight synth --quiet <arguments>` writes, made once per test binary for each
+/// argument string and kept until it exits (synthesising costs more than most tests).
+inline const std::filesystem::path& synthetic_sequence(const std::string& arguments) {
+  static TempDir dir;
+  static std::map<std::string, std::filesystem::path> made;
+  if (const auto found = made.find(arguments); found != made.end()) return found->second;
+  const auto path = dir.path() / std::to_string(made.size());
+  const auto result = relight("synth --quiet " + arguments + " --out " + path.string());
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  return made.emplace(arguments, path).first->second;
 }
 
 }  // namespace relight::cli_test

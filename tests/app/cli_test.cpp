@@ -39,9 +39,10 @@ TEST(Cli, NoSubcommandOrUnknownFlagIsAUsageError) {
   EXPECT_EQ(relight("replay --no-such-flag").exit_code, 2);
 }
 
+// Geometry only (the main job's pebble: placement_cli_test.cpp).
 TEST(Cli, ReplayOfTheEmbeddedSampleWritesFramesReportAndGraph) {
   TempDir dir;
-  const auto result = relight("replay --quiet --out " + dir.path().string());
+  const auto result = relight("replay --quiet --no-object --out " + dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(result.err.empty()) << result.err;
   const auto report = nlohmann::json::parse(read_text_file(dir.path() / "report.json"));
@@ -75,7 +76,7 @@ TEST(Cli, ReplayOfTheEmbeddedSampleWritesFramesReportAndGraph) {
 
 TEST(Cli, ReportListsTheGraphWhenGraphvizIsMissing) {
   TempDir dir;
-  const auto result = run_command("PATH=/nonexistent " + std::string(RELIGHT_BIN) + " replay --quiet --frames 1 --no-frames --out " +
+  const auto result = run_command("PATH=/nonexistent " + std::string(RELIGHT_BIN) + " replay --quiet --no-object --frames 1 --no-frames --out " +
                                   dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const std::string html = read_text_file(dir.path() / "report.html");
@@ -86,13 +87,13 @@ TEST(Cli, ReportListsTheGraphWhenGraphvizIsMissing) {
 
 TEST(Cli, FrameRangeLimitsTheRun) {
   TempDir dir;
-  ASSERT_EQ(relight("replay --quiet --frames 1:3 --out " + dir.path().string()).exit_code, 0);
+  ASSERT_EQ(relight("replay --quiet --no-object --frames 1:3 --out " + dir.path().string()).exit_code, 0);
   EXPECT_EQ(nlohmann::json::parse(read_text_file(dir.path() / "report.json"))["frames"], 2);
 }
 
 TEST(Cli, LoopPlaysTheRangeAgainAndReportsPeakMemory) {
   TempDir dir;
-  ASSERT_EQ(relight("replay --quiet --no-frames --frames 1:3 --loop 3 --out " + dir.path().string()).exit_code, 0);
+  ASSERT_EQ(relight("replay --quiet --no-object --no-frames --frames 1:3 --loop 3 --out " + dir.path().string()).exit_code, 0);
   const auto report = nlohmann::json::parse(read_text_file(dir.path() / "report.json"));
   EXPECT_EQ(report["frames"], 6);
   EXPECT_NE(report["sequence"].get<std::string>().find("played 3 times"), std::string::npos);
@@ -124,8 +125,8 @@ TEST(Cli, CorruptFrameMidSequenceFailsCleanlyWithoutPartialFiles) {
 TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
   TempDir dir;
   const auto cpu = dir.path() / "cpu", vulkan = dir.path() / "vulkan";
-  ASSERT_EQ(relight("replay --quiet --frames 0:2 --backend cpu --out " + cpu.string()).exit_code, 0);
-  const auto result = relight("replay --quiet --frames 0:2 --backend vulkan --out " + vulkan.string());
+  ASSERT_EQ(relight("replay --quiet --no-object --frames 0:2 --backend cpu --out " + cpu.string()).exit_code, 0);
+  const auto result = relight("replay --quiet --no-object --frames 0:2 --backend vulkan --out " + vulkan.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   for (const char* file : {"000000_depth_smoothed.png", "000001_depth_smoothed.png"}) {
     EXPECT_EQ(read_text_file(cpu / "frames" / file), read_text_file(vulkan / "frames" / file)) << file;
@@ -154,7 +155,7 @@ TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
     const auto& [arguments, stages] = runs[run];
     const auto out = dir.path() / std::to_string(run);
     const auto result =
-        relight("replay --quiet --no-frames --frames 0:2 --backend vulkan " + arguments + " --out " + out.string());
+        relight("replay --quiet --no-object --no-frames --frames 0:2 --backend vulkan " + arguments + " --out " + out.string());
     ASSERT_EQ(result.exit_code, 0) << result.err;
     const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
     for (const std::string& name : stages) {
@@ -172,7 +173,7 @@ TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
 TEST(Cli, WithoutAnyVulkanDeviceReplayFallsBackToTheCpuAndSaysSoOnce) {
   TempDir dir;
   const std::string no_driver = "VK_ICD_FILENAMES=" + (dir.path() / "none.json").string() + " ";
-  const auto result = run_command(no_driver + kRelight + " replay --quiet --frames 0:1 --out " + dir.path().string());
+  const auto result = run_command(no_driver + kRelight + " replay --quiet --no-object --frames 0:1 --out " + dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   std::size_t notes = 0;
   for (std::size_t at = 0; (at = result.err.find("no usable Vulkan device", at)) != std::string::npos; ++at) ++notes;
@@ -187,7 +188,7 @@ TEST(Cli, JsonConfigSuppliesOptionsAndTheCommandLineWins) {
   TempDir dir;
   const auto config = dir.path() / "cfg.json";
   const auto out = dir.path() / "out";
-  write_file_atomically(config, "{\"frames\": \"0:3\", \"quiet\": true, \"out\": \"" + out.string() + "\"}");
+  write_file_atomically(config, "{\"frames\": \"0:3\", \"quiet\": true, \"no-object\": true, \"out\": \"" + out.string() + "\"}");
   ASSERT_EQ(relight("replay --config " + config.string()).exit_code, 0);
   EXPECT_EQ(nlohmann::json::parse(read_text_file(out / "report.json"))["frames"], 3);
   ASSERT_EQ(relight("replay --config " + config.string() + " --frames 0:1").exit_code, 0);

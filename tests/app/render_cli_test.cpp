@@ -18,16 +18,7 @@ using cli_test::relight;
 const std::filesystem::path kData = RELIGHT_TEST_DATA;
 
 /// A one-frame synthetic sequence, made once for the whole suite.
-const std::filesystem::path& synthetic_sequence() {
-  static TempDir dir;
-  static const std::filesystem::path sequence = [] {
-    const auto path = dir.path() / "seq";
-    const auto result = relight("synth --quiet --frames 1 --no-gt --noise none --out " + path.string());
-    EXPECT_EQ(result.exit_code, 0) << result.err;
-    return path;
-  }();
-  return sequence;
-}
+const std::filesystem::path& synthetic_sequence() { return cli_test::synthetic_sequence("--frames 1 --no-gt --noise none"); }
 
 TEST(RenderReferenceCli, WritesLrvLrCompositeAndSummary) {
   TempDir dir;

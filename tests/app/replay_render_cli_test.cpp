@@ -18,16 +18,7 @@ using cli_test::relight;
 
 const std::filesystem::path kData = RELIGHT_TEST_DATA;
 
-const std::filesystem::path& two_frame_sequence() {
-  static TempDir dir;
-  static const std::filesystem::path sequence = [] {
-    const auto path = dir.path() / "seq";
-    const auto result = relight("synth --quiet --frames 2 --no-gt --out " + path.string());
-    EXPECT_EQ(result.exit_code, 0) << result.err;
-    return path;
-  }();
-  return sequence;
-}
+const std::filesystem::path& two_frame_sequence() { return cli_test::synthetic_sequence("--frames 2 --no-gt"); }
 
 TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
   TempDir dir;

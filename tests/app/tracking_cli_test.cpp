@@ -18,16 +18,7 @@ using cli_test::expect_one_line_error;
 using cli_test::relight;
 
 /// A synthetic orbit (20 degrees a second, Kinect v1 noise) with its tag and exact poses.
-const std::filesystem::path& orbit_sequence() {
-  static TempDir dir;
-  static const std::filesystem::path sequence = [] {
-    const auto path = dir.path() / "orbit";
-    const auto result = relight("synth --quiet --frames 12 --trajectory orbit --no-gt --out " + path.string());
-    EXPECT_EQ(result.exit_code, 0) << result.err;
-    return path;
-  }();
-  return sequence;
-}
+const std::filesystem::path& orbit_sequence() { return cli_test::synthetic_sequence("--frames 12 --trajectory orbit --no-gt"); }
 
 int pose_lines(const std::filesystem::path& file) {
   const std::string text = read_text_file(file);
@@ -47,7 +38,7 @@ nlohmann::json tracking_of(const std::filesystem::path& out) {
 TEST(ReplayTracking, EveryRunWritesTheCameraTrajectoryOfItsPoseSource) {
   TempDir dir;
   const auto out = dir.path() / "auto";
-  const auto result = relight("replay --quiet --no-frames --out " + out.string());  // embedded TUM sample
+  const auto result = relight("replay --quiet --no-object --no-frames --out " + out.string());  // embedded TUM sample
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_EQ(tracking_of(out)["source"], "sequence");  // the sample has groundtruth.txt
   EXPECT_EQ(pose_lines(out / "camera_trajectory.txt"), 4);

@@ -169,6 +169,31 @@ TEST(SupportPlane, LevelsTheWorldOnTheTable) {
   EXPECT_FALSE(dominant_support_plane(DepthMap(320, 240, 0.f), intrinsics).has_value());
 }
 
+// `--place-at`'s surface: the local plane around a pixel of the noisy depth is the surface the
+// pixel sees - the table top, and the top of the box standing on it, whose edges the window
+// straddles - not a mix of the two.
+TEST(SupportPlane, LocalPlaneAtAPixelIsTheSurfaceSeenThere) {
+  PinholeIntrinsics intrinsics;
+  const auto frames = render(synth::Trajectory::Static, 1, 1, intrinsics);
+  const Pose world_to_camera = frames[0].truth.inverse();
+  const Eigen::Vector3d up_in_camera = world_to_camera.linear() * Eigen::Vector3d::UnitZ();
+  // Table top beside the box; the middle of the box's top (0.20 x 0.18 m, 0.12 m above the table).
+  for (const Eigen::Vector3d& world : {Eigen::Vector3d(-0.25, -0.15, 0.75), Eigen::Vector3d(0.32, 0.17, 0.87)}) {
+    const Eigen::Vector3d camera = world_to_camera * world;
+    const Eigen::Vector2d pixel = intrinsics.project(camera);
+    ASSERT_TRUE(pixel.x() >= 0 && pixel.y() >= 0 && pixel.x() < 320 && pixel.y() < 240) << pixel.transpose();
+    const auto plane = local_plane_at(frames[0].depth, intrinsics, pixel.x(), pixel.y());
+    ASSERT_TRUE(plane.has_value()) << world.transpose();
+    EXPECT_LT(degrees(std::acos(std::clamp(plane->normal.dot(up_in_camera), -1.0, 1.0))), 3.0) << world.transpose();
+    const auto hit = plane->ray_hit(intrinsics, pixel.x(), pixel.y());
+    ASSERT_TRUE(hit.has_value());
+    EXPECT_LT((frames[0].truth * *hit - world).norm(), 0.01) << world.transpose();
+  }
+  EXPECT_FALSE(local_plane_at(DepthMap(320, 240, 0.f), intrinsics, 160, 120).has_value());
+  EXPECT_FALSE(local_plane_at(frames[0].depth, intrinsics, 320, 10).has_value());
+  EXPECT_FALSE(local_plane_at(frames[0].depth, intrinsics, -1, 10).has_value());
+}
+
 TEST(TrajectoryError, IsZeroForARigidlyMovedCopyAndMeasuresANoisyOne) {
   std::vector<Pose> truth, moved, shifted;
   Pose offset = Pose::Identity();

@@ -144,6 +144,25 @@ TEST(Placement, ParsesAndTurnsYUpIntoZUp) {
   EXPECT_THROW((void)Placement::parse("1,2,3,0,-1"), Error);
 }
 
+// A placement on a real surface: the model's up axis follows the surface normal, yaw turns about
+// it, and for up = z the transform is --place's.
+TEST(Placement, StandsTheModelAlongTheSurfaceNormal) {
+  Placement p = Placement::parse("0.3,-0.2,0.75,90");
+  const Eigen::Affine3d z_up = p.transform();
+  p.up = Eigen::Vector3d::UnitZ();
+  EXPECT_TRUE(p.transform().isApprox(z_up, 1e-12));
+  p.up = Eigen::Vector3d(1, 0, 1).normalized();  // a 45-degree slope facing +x
+  const Eigen::Affine3d t = p.transform();
+  EXPECT_TRUE((t.linear() * Eigen::Vector3d::UnitY()).isApprox(p.up, 1e-12));
+  EXPECT_NEAR(t.linear().determinant(), 1.0, 1e-12);
+  EXPECT_TRUE((t * Eigen::Vector3d::Zero()).isApprox(p.position, 1e-12));
+  // Yaw still turns about the model's up: the model's +x stays perpendicular to up.
+  EXPECT_NEAR((t.linear() * Eigen::Vector3d::UnitX()).dot(p.up), 0.0, 1e-12);
+  p.up = -Eigen::Vector3d::UnitZ();  // under a shelf: upside down, still a rotation
+  EXPECT_TRUE((p.transform().linear() * Eigen::Vector3d::UnitY()).isApprox(p.up, 1e-12));
+  EXPECT_NEAR(p.transform().linear().determinant(), 1.0, 1e-12);
+}
+
 TEST(Placement, AddsTheModelAsVirtualMeshesStandingAtThePoint) {
   MrScene scene;
   scene.add_material({});

@@ -4,10 +4,12 @@
 //
 //   mr_scene                 reads  FrameInfo "frame" (camera_to_world: identity when absent),
 //                                   PositionMap "positions" and NormalMap "normals" (camera frame,
-//                                   reconstruct/), brdf::Materials when `materials_buffer` is set
+//                                   reconstruct/), brdf::Materials when `materials_buffer` is set,
+//                                   ObjectPlacements when `placements_buffer` is set
 //                            writes MrScene "mr_scene": the reconstruction's position map as the
 //                                   real mesh, the configured real and virtual lights, the
-//                                   configured virtual objects
+//                                   configured virtual objects (at the placements of that
+//                                   buffer when set, none while it is unresolved)
 //   vpls                     reads  MrScene "mr_scene"; with VplBudget::ByPreviousFlux also the
 //                                   previous frame's VplSet "vpls" (its flux per light)
 //                            writes VplSet "vpls" (vpl.h)
@@ -64,6 +66,9 @@ struct DirStageOptions {
   PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
   colormap::ToneMap tone_map{};
   std::string materials_buffer;  ///< empty: no Materials input
+  /// ObjectPlacements of the objects (virtual_model.h), e.g. resolved on a real surface at the
+  /// first frame; empty: the placements in DirSceneContent.
+  std::string placements_buffer;
   /// Per-pixel k_d of the camera's real surfaces (brdf/'s "kd"), modulating the cluster k_d of
   /// diffuse real surfaces (camera_albedo.h); empty: the clusters' k_d alone.
   std::string albedo_buffer;
@@ -94,10 +99,12 @@ class MrSceneStage final : public Stage {
   DepthMeshOptions mesh_;
   PhongMaterial reconstruction_material_;
   std::string materials_buffer_;
+  std::string placements_buffer_;
   Read<FrameInfo> frame_;
   Read<PositionMap> positions_;
   Read<NormalMap> normals_;
   Read<brdf::Materials> materials_;
+  Read<ObjectPlacements> placements_;
   Write<MrScene> scene_;
 };
 

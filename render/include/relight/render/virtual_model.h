@@ -23,17 +23,28 @@ struct VirtualModel {
   std::vector<TriangleMesh> meshes;
 };
 
-/// Where a model goes: translation in the world (metres), rotation about world up (degrees),
-/// uniform scale.
+/// Where a model goes: translation in the world (metres), the world direction its up axis
+/// points along (world z for --place; a surface's normal for a placement on a real surface),
+/// rotation about that axis (degrees), uniform scale.
 struct Placement {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   double yaw_degrees = 0.0;
   double scale = 1.0;
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< unit
 
   /// Parses "x,y,z[,yaw[,scale]]"; throws relight::Error naming the text otherwise.
   static Placement parse(const std::string& text);
-  /// model (y-up) -> world (z-up) transform.
+  /// model (y-up) -> world transform: y-up to z-up, yaw about z, then the shortest rotation
+  /// taking z to `up` (identity for up = z), scale, translation.
   [[nodiscard]] Eigen::Affine3d transform() const;
+};
+
+/// The world placement of each virtual object of a run, as a stage resolves them (placements
+/// on a real surface are known only once a frame with a camera pose has been seen).
+struct ObjectPlacements {
+  bool resolved = false;                ///< false: no object is drawn yet
+  std::vector<Placement> placements;    ///< one per object, in the objects' order
+  static constexpr const char* type_name = "ObjectPlacements";
 };
 
 /// Adds the model to the scene as virtual meshes (materials appended, normals transformed).
