@@ -1,6 +1,7 @@
 #pragma once
 // 8-bit pictures of named frame-graph buffers, for people to look at: colour images as they are,
-// depth maps in false colour (depth_preview), normal maps colour-coded (normal_preview). Shared by
+// depth maps in false colour (depth_preview), normal maps colour-coded (normal_preview), the
+// virtual coverage as grey (0 real .. 255 virtual). Shared by
 // the per-frame PNG writer and the report's contact sheet so both show the same pictures.
 // Reads: every buffer registered with add() before the owning stage declares its inputs.
 #include <functional>
@@ -9,14 +10,15 @@
 
 #include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
+#include "relight/render/path_tracer.h"  // CoverageImage
 
 namespace relight::app {
 
 class BufferPreviews {
  public:
-  enum class Kind { Color, Depth, Normals };
+  enum class Kind { Color, Depth, Normals, Coverage };
 
-  void add(std::string buffer, Kind kind) { entries_.push_back({std::move(buffer), kind, {}, {}, {}}); }
+  void add(std::string buffer, Kind kind) { entries_.push_back({std::move(buffer), kind, {}, {}, {}, {}}); }
   [[nodiscard]] bool empty() const { return entries_.empty(); }
   void declare(StageBuilder& builder);
   /// Calls `visit(buffer name, picture)` for each registered buffer, in registration order.
@@ -29,6 +31,7 @@ class BufferPreviews {
     Read<ColorImage> color;
     Read<DepthMap> depth;
     Read<NormalMap> normals;
+    Read<render::CoverageImage> coverage;
   };
   std::vector<Entry> entries_;
 };

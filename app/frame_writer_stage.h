@@ -20,6 +20,8 @@ class FrameWriterStage final : public Stage {
   void add_depth(std::string buffer) { previews_.add(std::move(buffer), BufferPreviews::Kind::Depth); }
   /// A NormalMap, written as relight::normal_preview's colour coding.
   void add_normals(std::string buffer) { previews_.add(std::move(buffer), BufferPreviews::Kind::Normals); }
+  /// A CoverageImage (the virtual share of each pixel), written as grey.
+  void add_coverage(std::string buffer) { previews_.add(std::move(buffer), BufferPreviews::Kind::Coverage); }
   /// A RadianceImage, written as OpenEXR (linear, full range).
   void add_radiance(std::string buffer) { radiance_names_.push_back(std::move(buffer)); }
 

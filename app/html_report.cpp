@@ -68,11 +68,16 @@ void summary_section(std::ostringstream& html, const Json& timing) {
                                                  : value.dump();
     html << "<tr><td>" << key << "<td class=l>" << html_escape(text);
   }
-  if (timing.contains("marker_pose")) {
-    html << "<tr><td>marker_pose<td class=l>";
-    for (const auto& [key, value] : timing["marker_pose"].items()) {
-      html << html_escape(key) << " = "
-           << html_escape(value.is_number_float() ? format("%.3g", value.get<double>()) : value.dump()) << "; ";
+  // Summaries of one level: "key = value; ..." (lists as their length: the report.json has them).
+  for (const char* section : {"latency_ms", "tracking", "marker_pose"}) {
+    if (!timing.contains(section) || !timing[section].is_object()) continue;
+    html << "<tr><td>" << section << "<td class=l>";
+    for (const auto& [key, value] : timing[section].items()) {
+      const std::string text = value.is_number_float() ? format("%.3g", value.get<double>())
+                               : value.is_array()      ? std::to_string(value.size()) + " entries"
+                               : value.is_object()     ? "(see report.json)"
+                                                       : value.dump();
+      html << html_escape(key) << " = " << html_escape(text) << "; ";
     }
   }
   html << "</table>\n";

@@ -16,6 +16,8 @@
 
 #include "commands.h"
 #include "interrupt.h"
+#include "latency_stage.h"
+#include "object_placement_stage.h"
 #include "camera_trajectory_stage.h"
 #include "marker_trajectory_stage.h"
 #include "relight/capture/openni_source.h"
@@ -103,6 +105,7 @@ int run_live(const LiveOptions& options) {
   device_options.uri = options.device;
   auto device = std::make_unique<OpenNiSource>(device_options);
   if (device->is_file()) throw Error(options.device + " is a recording: use relight replay for .oni files");
+  const std::filesystem::path device_scene = device->scene_folder();
   auto source = std::make_unique<StoppableSource>(std::move(device), options.frames);
   const StoppableSource& stoppable = *source;
   const std::string description = source->describe();
@@ -112,6 +115,7 @@ int run_live(const LiveOptions& options) {
 
   ReplayOptions replay = options.replay;
   replay.live_device = options.device.empty() ? "the first OpenNI2 device" : options.device;
+  replay.device_scene = device_scene;
   ReplayPipeline pipeline = build_replay_pipeline(std::move(source), replay);
   FrameGraph& graph = *pipeline.graph;
   graph.compile();
@@ -144,6 +148,8 @@ int run_live(const LiveOptions& options) {
     std::cerr << pipeline.markers->no_tag_warning(options.replay.markers);
   }
   report["tracking"] = pipeline.trajectory->summary();
+  report["latency_ms"] = pipeline.latency->summary();
+  if (pipeline.placement) report["placements"] = pipeline.placement->summary();
   write_reports(options.replay.out, "relight live: " + description, graph, report, pipeline.report);
   if (!quiet) {
     std::cerr << "relight live: " << graph.frames_run() << " frames in " << seconds << " s ("
@@ -283,7 +289,6 @@ void register_live(CLI::App& app, Runners& runners) {
   runners[devices] = [] { return run_devices(); };
 
   auto live_options = std::make_shared<LiveOptions>();
-  live_options->replay.markers = "none";
   live_options->replay.out.clear();
   CLI::App* live = app.add_subcommand("live", "Run the pipeline (as replay) on a live OpenNI2 device");
   live->add_option("--device", live_options->device,
@@ -294,7 +299,9 @@ void register_live(CLI::App& app, Runners& runners) {
   live->add_option("--out", live_options->replay.out, "Output folder")->required();
   live->add_flag("--quiet", live_options->replay.quiet, "No progress or summary on stderr");
   live->add_flag("!--no-frames", live_options->replay.write_frames, "Do not write per-frame images");
-  live->add_option("--markers", live_options->replay.markers, "AprilTag layout JSON for the camera pose, or none")
+  live->add_option("--markers", live_options->replay.markers,
+                   "AprilTag layout for the camera pose: auto (the layout the device's scene describes, relight's "
+                   "virtual devices), none, or a layout JSON file")
       ->capture_default_str();
   add_pose_option(*live, live_options->replay);
   add_live_compute_options(*live, live_options->replay);

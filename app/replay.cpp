@@ -11,6 +11,7 @@
 #include "frame_range.h"
 #include "frame_writer_stage.h"
 #include "interrupt.h"
+#include "latency_stage.h"
 #include "camera_trajectory_stage.h"
 #include "marker_trajectory_stage.h"
 #include "mixed_reality_scene.h"
@@ -160,11 +161,23 @@ std::unique_ptr<vk::VulkanContext> make_vulkan(const ReplayOptions& options, vk:
   return vk::try_create_vulkan(vulkan_options);
 }
 
-// "auto" uses the sequence's scene.json when it describes a tag (sequences from `relight synth`).
+// The folder that may describe the scene (scene.json, probe.hdr): the sequence's, or a live
+// device's when it serves one (relight's own driver); none for other live devices.
+std::optional<std::filesystem::path> scene_folder(const ReplayOptions& options) {
+  if (!options.live_device.empty()) {
+    if (options.device_scene.empty()) return std::nullopt;
+    return options.device_scene;
+  }
+  return options.sequence.empty() ? default_sequence() : options.sequence;
+}
+
+// "auto" uses the scene's scene.json when it describes a tag (sequences from `relight synth`).
 std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
   if (options.markers == "none") return std::nullopt;
   if (options.markers != "auto") return read_tag_layout(options.markers);
-  const auto scene = (options.sequence.empty() ? default_sequence() : options.sequence) / "scene.json";
+  const auto folder = scene_folder(options);
+  if (!folder) return std::nullopt;
+  const auto scene = *folder / "scene.json";
   if (!std::filesystem::exists(scene)) return std::nullopt;
   const std::string text = read_text_file(scene);
   if (text.find("\"tag\"") == std::string::npos) return std::nullopt;
@@ -216,15 +229,15 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   if (options.objects.empty() && options.virtual_lights.empty() && options.virtual_spots.empty()) return;
   if (options.vpls < 0 || options.vpls > 4096) throw Error("--vpls must be 0 to 4096");
   if (!(options.exposure > 0.f)) throw Error("--exposure must be positive");
-  const auto sequence = options.sequence.empty() ? default_sequence() : options.sequence;
-  const bool synthetic = sequence.extension() != ".oni" && is_synthetic(sequence);
-  if (!options.live_device.empty() && options.lights.empty()) {
+  const auto scene = scene_folder(options);
+  const bool synthetic = scene && scene->extension() != ".oni" && is_synthetic(*scene);
+  if (!scene && options.lights.empty()) {
     throw Error("the device " + options.live_device +
                 " serves no light probe: give its lights with --lights FILE (from `relight lights`)");
   }
   const LightSet measured = options.lights.empty() && !options.latlong_probe.empty()
                                 ? lights_from_latlong_probe(options.latlong_probe, 8)
-                                : real_light_set(synthetic && options.live_device.empty(), sequence, options.lights);
+                                : real_light_set(synthetic, scene.value_or(""), options.lights);
   render::DirSceneContent content;
   render::MrScene lights;
   render::add_lights(lights, measured);
@@ -311,7 +324,8 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
 // How warnings name the AprilTag layout in use.
 std::string marker_layout_name(const ReplayOptions& options) {
   if (options.markers != "auto") return options.markers;
-  return ((options.sequence.empty() ? default_sequence() : options.sequence) / "scene.json").string();
+  const auto folder = scene_folder(options);
+  return folder ? (*folder / "scene.json").string() : "the device's scene";
 }
 
 }  // namespace
@@ -375,6 +389,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   graph.keep("positions");
   add_camera_pose(pipeline, options);
   add_differential_rendering(pipeline, options, per_pixel);
+  pipeline.latency = &graph.emplace<LatencyStage>(pipeline.renders ? pipeline.final_composite : "");
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
     writer->add_color("color");
@@ -390,6 +405,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
     if (pipeline.renders && options.write_buffers) {
       writer->add_radiance("L_rv");
       writer->add_radiance("L_r");
+      writer->add_coverage("virtual_coverage");
       if (pipeline.final_composite != "composite") writer->add_radiance("delta_L");  // the colour-mapped difference
     }
     graph.add(std::move(writer));
@@ -431,6 +447,7 @@ int run_replay(const ReplayOptions& options) {
     std::cerr << pipeline.markers->no_tag_warning(marker_layout_name(options));
   }
   report["tracking"] = pipeline.trajectory->summary();
+  report["latency_ms"] = pipeline.latency->summary();
   if (pipeline.placement) {
     report["placements"] = pipeline.placement->summary();
     if (!options.quiet) std::cerr << pipeline.placement->describe();

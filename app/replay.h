@@ -15,6 +15,7 @@ class VulkanContext;
 namespace relight::app {
 
 class CameraTrajectoryStage;
+class LatencyStage;
 class MarkerTrajectoryStage;
 class ObjectPlacementStage;
 class ReportCollectorStage;
@@ -71,6 +72,10 @@ struct ReplayOptions {
   bool video = true;                           ///< composite.mp4
   /// `relight live`: the device the frames come from (it has no sequence folder; errors name it).
   std::string live_device;
+  /// `relight live`: the folder with scene.json / probe.hdr the device serves (relight's own
+  /// driver, OpenNiSource::scene_folder), which then takes the sequence folder's part: its
+  /// lights, its tag layout for --markers auto, the synthetic default placement.
+  std::filesystem::path device_scene;
 };
 
 
@@ -82,6 +87,7 @@ struct ReplayPipeline {
   app::MarkerTrajectoryStage* markers = nullptr;  ///< set when the marker pose runs
   app::CameraTrajectoryStage* trajectory = nullptr;  ///< the tracked pose of every frame
   app::ObjectPlacementStage* placement = nullptr;  ///< set when there are virtual objects
+  app::LatencyStage* latency = nullptr;           ///< capture to final picture, every frame
   bool renders = false;                           ///< the DIR stage is in the graph
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".
   std::string final_composite = "composite";

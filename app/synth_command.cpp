@@ -20,6 +20,7 @@ struct SynthCommandOptions {
   std::vector<double> white_balance{1.0, 1.0, 1.0};
   double exposure = 1.0;
   int threads = 0;
+  std::string size = "640x480";
   bool no_ground_truth = false;
   bool quiet = false;
 };
@@ -33,6 +34,12 @@ int run_synth(const SynthCommandOptions& command) {
   options.color.gains = {command.white_balance[0], command.white_balance[1], command.white_balance[2]};
   options.color.exposure = command.exposure;
   options.threads = command.threads;
+  if (command.size == "320x240") {
+    options.width = 320;
+    options.height = 240;
+  } else if (command.size != "640x480") {
+    throw Error("--size '" + command.size + "' is not 640x480 or 320x240");
+  }
   options.ground_truth = !command.no_ground_truth;
 
   ProgressBar progress("synth", command.frames, command.quiet);
@@ -69,6 +76,10 @@ void register_synth(CLI::App& app, Runners& runners) {
       ->check(CLI::PositiveNumber);
   synth->add_option("--exposure", options->exposure, "Colour camera exposure multiplier")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  synth->add_option("--size", options->size,
+                    "Image size: 640x480 (Kinect v1) or 320x240 (its QVGA mode, the intrinsics halved)")
+      ->check(CLI::IsMember({"640x480", "320x240"}))
       ->capture_default_str();
   synth->add_option("--threads", options->threads, "Render threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   synth->add_flag("--no-gt", options->no_ground_truth, "Skip the gt/ folder");

@@ -1,12 +1,18 @@
 #include "frame_producer.h"
 
+#include <stdlib.h>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
+#include <mutex>
 
 #include "relight/capture/depth_millimetres.h"
 #include "relight/capture/tum_sequence.h"
+#include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
+#include "relight/core/image_io.h"
 #include "relight/synth/kinect_noise.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/scene.h"
@@ -96,6 +102,30 @@ class SyntheticProducer final : public FrameProducer {
   std::string name() const override { return "relight synthetic RGB-D (" + uri_.trajectory + ")"; }
   std::string serial() const override { return "synthetic-" + std::to_string(uri_.seed); }
 
+  ~SyntheticProducer() override {
+    std::error_code ignored;
+    if (!scene_folder_.empty()) std::filesystem::remove_all(scene_folder_, ignored);
+  }
+
+  // What `relight synth` writes besides the frames (scene.json, probe.hdr), in a folder of its
+  // own under the temporary directory; made on the first call (the probe takes a moment).
+  std::string scene_folder() const override {
+    std::lock_guard lock(scene_folder_mutex_);
+    if (!scene_folder_.empty()) return scene_folder_.string();
+    std::string pattern = (std::filesystem::temp_directory_path() / "relight-device-XXXXXX").string();
+    if (mkdtemp(pattern.data()) == nullptr) return "";
+    const std::filesystem::path folder = pattern;
+    synth::SynthOptions options;
+    options.width = resolutions().front().width;
+    options.height = resolutions().front().height;
+    options.trajectory = synth::parse_trajectory(uri_.trajectory);
+    options.seed = uri_.seed;
+    write_radiance(folder / "probe.hdr", synth::render_probe(scene_, synth::default_probe(scene_), options.threads));
+    write_file_atomically(folder / "scene.json", synth::scene_json(scene_, options));
+    scene_folder_ = folder;
+    return scene_folder_.string();
+  }
+
  private:
   static PinholeIntrinsics intrinsics(Resolution size) {
     synth::SynthOptions options;
@@ -117,6 +147,8 @@ class SyntheticProducer final : public FrameProducer {
   std::vector<Pose> poses_;
   // (loop index, width) -> frame; only the device's frame thread calls produce().
   mutable std::map<std::pair<int, int>, ProducedFrame> cache_;
+  mutable std::mutex scene_folder_mutex_;
+  mutable std::filesystem::path scene_folder_;
 };
 
 // A TUM RGB-D folder, looping. Timestamps are the folder's depth timestamps; each further pass
@@ -157,6 +189,12 @@ class TumProducer final : public FrameProducer {
   std::pair<float, float> field_of_view(Resolution) const override { return fov_of(sequence_.intrinsics()); }
   std::string name() const override { return "relight TUM folder " + uri_.folder.filename().string(); }
   std::string serial() const override { return "tum-" + uri_.folder.filename().string(); }
+  // A folder of `relight synth` (or one with a probe) already is a scene folder.
+  std::string scene_folder() const override {
+    const bool has_scene = std::filesystem::exists(uri_.folder / "scene.json") ||
+                           std::filesystem::exists(uri_.folder / "probe.hdr");
+    return has_scene ? std::filesystem::absolute(uri_.folder).string() : "";
+  }
 
  private:
   DeviceUri uri_;

@@ -38,6 +38,9 @@ class FrameProducer {
   [[nodiscard]] virtual std::pair<float, float> field_of_view(Resolution size) const = 0;
   [[nodiscard]] virtual std::string name() const = 0;    ///< OniDeviceInfo::name
   [[nodiscard]] virtual std::string serial() const = 0;  ///< ONI_DEVICE_PROPERTY_SERIAL_NUMBER
+  /// kRelightDeviceSceneFolderProperty (relight/capture/relight_device.h): a folder with the
+  /// scene's scene.json and probe.hdr, "" when there is none. Any thread may call it.
+  [[nodiscard]] virtual std::string scene_folder() const = 0;
 };
 
 /// The producer a URI names. Throws relight::Error (missing TUM folder, unsupported size, ...).

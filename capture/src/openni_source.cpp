@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <mutex>
 
 #include "relight/capture/depth_millimetres.h"
+#include "relight/capture/relight_device.h"
 #include "relight/core/error.h"
 
 namespace relight {
@@ -229,6 +231,9 @@ struct OpenNiSource::Impl {
   std::int64_t dropped = 0;
   std::uint64_t half_period_us = 16667;
   std::uint64_t last_timestamp_us = 0;
+  /// Host clock minus device clock, the smallest seen: the frame that reached us fastest sets it,
+  /// so a frame that waited in a queue shows its wait (capture_time below).
+  std::optional<double> host_minus_device;
   int last_depth_index = -1;
   std::optional<openni::VideoFrameRef> pending_depth, pending_color;
 
@@ -315,6 +320,12 @@ RgbdFrame OpenNiSource::Impl::convert(const openni::VideoFrameRef& depth_frame, 
   frame.info.timestamp = static_cast<double>(depth_frame.getTimestamp()) * 1e-6;
   frame.info.intrinsics = intrinsics;
   last_timestamp_us = depth_frame.getTimestamp();
+  if (!file) {
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    const double offset = now - frame.info.timestamp;
+    if (!host_minus_device || offset < *host_minus_device) host_minus_device = offset;
+    frame.info.capture_time = frame.info.timestamp + *host_minus_device;
+  }
   return frame;
 }
 
@@ -402,6 +413,16 @@ bool OpenNiSource::is_file() const { return impl_->file; }
 const std::string& OpenNiSource::uri() const { return impl_->uri; }
 std::int64_t OpenNiSource::dropped() const { return impl_->dropped; }
 std::uint64_t OpenNiSource::last_timestamp_us() const { return impl_->last_timestamp_us; }
+
+std::filesystem::path OpenNiSource::scene_folder() const {
+  openni::Device& device = impl_->device.device;
+  if (impl_->file || !device.isPropertySupported(kRelightDeviceSceneFolderProperty)) return {};
+  std::vector<char> text(4096, '\0');
+  int size = static_cast<int>(text.size());
+  if (device.getProperty(kRelightDeviceSceneFolderProperty, text.data(), &size) != openni::STATUS_OK) return {};
+  text.back() = '\0';
+  return std::filesystem::path(text.data());
+}
 
 void OpenNiSource::start_recording(const std::filesystem::path& file) {
   Impl& s = *impl_;

@@ -1,5 +1,7 @@
 #include "relight/capture/source_stage.h"
 
+#include <chrono>
+
 namespace relight {
 
 void SourceStage::declare(StageBuilder& builder) {
@@ -11,6 +13,10 @@ void SourceStage::declare(StageBuilder& builder) {
 void SourceStage::run(StageContext& context) {
   auto frame = source_->next();
   if (!frame) return context.end_of_stream();
+  if (frame->info.capture_time == 0.0) {
+    frame->info.capture_time =
+        std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
   context.get(color_) = std::move(frame->color);
   context.get(depth_) = std::move(frame->depth);
   context.get(frame_) = std::move(frame->info);

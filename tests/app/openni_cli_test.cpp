@@ -81,20 +81,32 @@ TEST(OpenNiCli, LiveRunsTheReplayGraphForNFrames) {
 
 // live tracks the device's camera (no poses come from a device: auto is odometry) and writes its
 // trajectory; rendering without --lights names the device, not the embedded sample.
-TEST(OpenNiCli, LiveTracksTheCameraAndNamesTheDeviceWhenLightsAreMissing) {
+TEST(OpenNiCli, LiveTracksTheCameraAndLightsAVirtualDeviceFromTheSceneItServes) {
   TempDir dir;
   const auto result =
-      relight("live --quiet --no-frames --device \"relight://synthetic?trajectory=orbit&size=320x240\" --frames 3 --out " +
-              dir.path().string());
+      relight("live --quiet --no-frames --markers none --device \"relight://synthetic?trajectory=orbit&size=320x240\" "
+              "--frames 3 --out " + dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const auto report = read_report(dir.path());
-  EXPECT_EQ(report["tracking"]["source"], "odometry");
+  EXPECT_EQ(report["tracking"]["source"], "odometry");  // no layout: markerless
   EXPECT_EQ(report["tracking"]["frames_tracked"], 3) << report["tracking"].dump();
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "camera_trajectory.txt"));
+  // The virtual device serves its scene (probe, tag layout): live lights and tracks it as replay
+  // would the same sequence; a device without a scene needs --lights, and the error names it.
   const std::string model = std::string(RELIGHT_TEST_DATA) + "/models/glossy_pebble.gltf";
-  expect_one_line_error(relight("live --quiet --device relight://synthetic --frames 1 --object " + model +
-                                " --place 0,0,0.8 --out " + (dir.path() / "render").string()),
-                        "the device relight://synthetic serves no light probe");
+  const auto rendered = dir.path() / "render";
+  const auto lit = relight("live --quiet --no-video --device \"relight://synthetic?size=320x240\" --frames 1 --vpls 8 --object " +
+                           model + " --out " + rendered.string());
+  ASSERT_EQ(lit.exit_code, 0) << lit.err;
+  EXPECT_TRUE(std::filesystem::exists(rendered / "frames" / "000000_composite.png"));
+  const auto lit_report = read_report(rendered);
+  EXPECT_EQ(lit_report["tracking"]["source"], "marker+odometry");  // --markers auto: the device's tag
+  EXPECT_EQ(lit_report["latency_ms"]["frames"], 1);
+  EXPECT_GT(lit_report["latency_ms"]["median_ms"].get<double>(), 0.0);
+  const std::string tum = "relight://tum/" + std::string(RELIGHT_TEST_DATA) + "/tum_fr1_rpy";
+  expect_one_line_error(relight("live --quiet --device " + tum + " --frames 1 --object " + model +
+                                " --place 0,0,0.8 --out " + (dir.path() / "tum").string()),
+                        "the device " + tum + " serves no light probe");
 }
 
 TEST(OpenNiCli, UnknownDeviceIsAClearError) {

@@ -4,11 +4,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
 #include "relight/core/atomic_file.h"
+#include "relight/core/image_io.h"
 #include "temp_dir.h"
 
 namespace relight {
@@ -101,6 +105,66 @@ TEST(ReplayTracking, PoseSourcesTheSequenceCannotGiveAreOneLineErrors) {
   const auto tracked = dir.path() / "tracked";
   ASSERT_EQ(relight("replay --quiet --no-frames " + copy.string() + " --out " + tracked.string()).exit_code, 0);
   EXPECT_EQ(tracking_of(tracked)["source"], "marker+odometry");
+}
+
+/// Timestamps of a TUM trajectory file, in order.
+std::vector<double> trajectory_timestamps(const std::filesystem::path& file) {
+  std::vector<double> out;
+  std::istringstream text(read_text_file(file));
+  for (std::string line; std::getline(text, line);) {
+    if (!line.empty() && line[0] != '#') out.push_back(std::stod(line));
+  }
+  return out;
+}
+
+/// The pebble's pixels: virtual coverage (written with --buffers) above one half.
+std::vector<bool> virtual_pixels(const std::filesystem::path& frames, const std::string& frame) {
+  const ColorImage coverage = read_color(frames / (frame + "_virtual_coverage.png"));
+  std::vector<bool> mask(coverage.pixels().size());
+  for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = coverage.pixels()[i].r > 127;
+  return mask;
+}
+
+// Live mixed reality that holds still: `relight live` on the virtual device's orbit, tracked
+// (marker+odometry from the layout the device serves, lit by the probe it serves), draws the
+// pebble where a replay of the same frames with the true poses draws it. Measured: IoU 0.96 to
+// 0.97 per frame (the pebble is ~650 pixels at 320x240; the marker pose that sets the world is
+// good to about a centimetre).
+TEST(ReplayTracking, LiveOrbitDrawsThePebbleWhereAReplayWithTheTruePosesDoes) {
+  TempDir dir;
+  const std::string pebble = std::string(RELIGHT_TEST_DATA) + "/models/glossy_pebble.gltf";
+  constexpr int kFps = 3;  // slow enough for the pipeline to take every frame, mostly
+  const auto live = dir.path() / "live";
+  const auto ran = relight("live --quiet --no-video --buffers --vpls 16 --device \"relight://synthetic?trajectory=orbit&size=320x240&fps=" +
+                           std::to_string(kFps) + "\" --frames 5 --object " + pebble + " --out " + live.string());
+  ASSERT_EQ(ran.exit_code, 0) << ran.err;
+  EXPECT_EQ(tracking_of(live)["source"], "marker+odometry");
+  const auto sequence = cli_test::synthetic_sequence("--frames 12 --trajectory orbit --noise none --size 320x240 --no-gt");
+  const auto replay = dir.path() / "replay";
+  ASSERT_EQ(relight("replay --quiet --no-video --buffers --vpls 16 --pose sequence " + sequence.string() + " --object " + pebble +
+                    " --out " + replay.string())
+                .exit_code,
+            0);
+  const auto timestamps = trajectory_timestamps(live / "camera_trajectory.txt");
+  ASSERT_EQ(timestamps.size(), 5u);
+  for (std::size_t i = 0; i < timestamps.size(); ++i) {
+    // The device's frame k has timestamp 1 s + k / fps; the replay's frame k is the same view.
+    const auto k = static_cast<int>(std::lround((timestamps[i] - 1.0) * kFps));
+    ASSERT_LT(k, 12) << "the device dropped more frames than the replay holds";
+    char live_name[32], replay_name[32];
+    std::snprintf(live_name, sizeof live_name, "%06zu", i);
+    std::snprintf(replay_name, sizeof replay_name, "%06d", k);
+    const auto a = virtual_pixels(live / "frames", live_name), b = virtual_pixels(replay / "frames", replay_name);
+    std::size_t both = 0, either = 0;
+    for (std::size_t p = 0; p < a.size(); ++p) {
+      both += a[p] && b[p];
+      either += a[p] || b[p];
+    }
+    ASSERT_GT(either, 100u) << "the pebble is in view in frame " << i;
+    const double iou = static_cast<double>(both) / static_cast<double>(either);
+    std::printf("live frame %zu (device frame %d): IoU %.3f of %zu pixels\n", i, k, iou, either);
+    EXPECT_GE(iou, 0.95) << "frame " << i;
+  }
 }
 
 }  // namespace

@@ -78,6 +78,9 @@ class OpenNiSource final : public FrameSource {
   [[nodiscard]] std::int64_t dropped() const;
   /// Device timestamp of the last frame next() returned, microseconds (as OpenNI2 reports it).
   [[nodiscard]] std::uint64_t last_timestamp_us() const;
+  /// The folder with the device scene's scene.json and probe.hdr that relight's own driver
+  /// serves (relight_device.h); empty for any other device.
+  [[nodiscard]] std::filesystem::path scene_folder() const;
 
   /// Records both streams into a .oni file with openni::Recorder (lossless) until stop_recording().
   void start_recording(const std::filesystem::path& file);

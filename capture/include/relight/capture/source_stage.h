@@ -2,7 +2,8 @@
 // Frame-graph stage that pulls frames from a FrameSource.
 // Writes: "color" (ColorImage), "depth" (DepthMap, metres), "frame" (FrameInfo; another name
 // when a camera tracking stage writes "frame" from it: replay and live call it "source_frame").
-// Signals end of stream when the source is exhausted.
+// Signals end of stream when the source is exhausted. A frame without a capture time (FrameInfo::
+// capture_time) gets the time it was delivered.
 #include <memory>
 #include <string>
 
