@@ -132,6 +132,12 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_flag("--buffers", options.write_buffers,
                    "Also write L_rv, L_r and (with colour mapping) delta_L per frame as EXR under frames/");
   command.add_flag("!--no-video", options.video, "Do not write composite.mp4");
+  command.add_flag("--view", options.view,
+                   "Show the final picture in a window as it is made, with fps, tracking state and dropped frames; "
+                   "keys: q quit, space pause, s snapshot (to DIR/snapshots/)");
+  command.add_option("--view-side", options.view_side, "With --view: a buffer shown beside the picture")
+      ->check(CLI::IsMember({"color", "depth", "depth_smoothed", "depth_filtered", "normals", "composite",
+                             "virtual_coverage"}));
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <functional>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -17,6 +18,8 @@
 #include "commands.h"
 #include "interrupt.h"
 #include "latency_stage.h"
+#include "live_view.h"
+#include "view_stage.h"
 #include "object_placement_stage.h"
 #include "camera_trajectory_stage.h"
 #include "marker_trajectory_stage.h"
@@ -71,7 +74,7 @@ class StoppableSource final : public FrameSource {
  public:
   StoppableSource(std::unique_ptr<OpenNiSource> source, std::int64_t limit) : source_(std::move(source)), limit_(limit) {}
   std::optional<RgbdFrame> next() override {
-    if (InterruptGuard::interrupted() || (limit_ > 0 && frames_ >= limit_)) return std::nullopt;
+    if (InterruptGuard::interrupted() || (limit_ > 0 && frames_ >= limit_) || (stop_ && stop_())) return std::nullopt;
     auto frame = source_->next();
     if (frame) ++frames_;
     return frame;
@@ -79,9 +82,12 @@ class StoppableSource final : public FrameSource {
   std::int64_t size_hint() const override { return limit_; }
   std::string describe() const override { return source_->describe(); }
   [[nodiscard]] const OpenNiSource& device() const { return *source_; }
+  /// Also ends the stream when `stop` says so (the view's quit key).
+  void stop_when(std::function<bool()> stop) { stop_ = std::move(stop); }
 
  private:
   std::unique_ptr<OpenNiSource> source_;
+  std::function<bool()> stop_;
   std::int64_t limit_;
   std::int64_t frames_ = 0;
 };
@@ -107,7 +113,7 @@ int run_live(const LiveOptions& options) {
   if (device->is_file()) throw Error(options.device + " is a recording: use relight replay for .oni files");
   const std::filesystem::path device_scene = device->scene_folder();
   auto source = std::make_unique<StoppableSource>(std::move(device), options.frames);
-  const StoppableSource& stoppable = *source;
+  StoppableSource& stoppable = *source;
   const std::string description = source->describe();
   std::error_code ec;
   std::filesystem::create_directories(options.replay.out, ec);
@@ -117,6 +123,11 @@ int run_live(const LiveOptions& options) {
   replay.live_device = options.device.empty() ? "the first OpenNI2 device" : options.device;
   replay.device_scene = device_scene;
   ReplayPipeline pipeline = build_replay_pipeline(std::move(source), replay);
+  if (pipeline.view) {
+    LiveView& view = *pipeline.view;
+    stoppable.stop_when([&view] { return view.quit_requested(); });
+    pipeline.view_stage->count_dropped([&stoppable] { return stoppable.device().dropped(); });
+  }
   FrameGraph& graph = *pipeline.graph;
   graph.compile();
   write_file_atomically(options.replay.out / "graph.dot", graph.to_dot());
@@ -142,7 +153,12 @@ int run_live(const LiveOptions& options) {
   report["source"] = description;
   report["compute"] = pipeline.compute;
   report["dropped_frames"] = dropped;
-  report["stopped_by"] = !failure.empty() ? "error: " + failure : InterruptGuard::interrupted() ? "interrupt" : "end";
+  const bool quit_from_view = pipeline.view && pipeline.view->quit_requested();
+  report["stopped_by"] = !failure.empty()                ? "error: " + failure
+                         : InterruptGuard::interrupted() ? "interrupt"
+                         : quit_from_view                ? "view"
+                                                         : "end";
+  if (pipeline.view) report["view"] = {{"drawn", pipeline.view->drawn()}, {"skipped", pipeline.view->skipped()}};
   if (pipeline.markers) {
     report["marker_pose"] = pipeline.markers->summary();
     std::cerr << pipeline.markers->no_tag_warning(options.replay.markers);

@@ -12,6 +12,7 @@
 #include "frame_writer_stage.h"
 #include "interrupt.h"
 #include "latency_stage.h"
+#include "live_view.h"
 #include "camera_trajectory_stage.h"
 #include "marker_trajectory_stage.h"
 #include "mixed_reality_scene.h"
@@ -44,6 +45,7 @@
 #include "report.h"
 #include "report_collector_stage.h"
 #include "video_writer_stage.h"
+#include "view_stage.h"
 
 namespace relight::app {
 
@@ -304,6 +306,28 @@ void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
   pipeline.trajectory = &pipeline.graph->emplace<CameraTrajectoryStage>(options.out / "camera_trajectory.txt");
 }
 
+/// The kind of picture a --view-side buffer is.
+BufferPreviews::Kind view_side_kind(const std::string& buffer) {
+  if (buffer.rfind("depth", 0) == 0) return BufferPreviews::Kind::Depth;
+  if (buffer == "normals") return BufferPreviews::Kind::Normals;
+  if (buffer == "virtual_coverage") return BufferPreviews::Kind::Coverage;
+  return BufferPreviews::Kind::Color;
+}
+
+/// --view: the window (opened now, so that a missing display fails before any frame) and the
+/// stage that feeds it the final picture.
+void add_view(ReplayPipeline& pipeline, const ReplayOptions& options, bool method2) {
+  const std::string& side = options.view_side;
+  const bool needs_render = side == "composite" || side == "virtual_coverage";
+  if (needs_render && !pipeline.renders) throw Error("--view-side " + side + " needs something to render (--object)");
+  if (side == "depth_filtered" && !method2) throw Error("--view-side depth_filtered needs --geometry method2");
+  pipeline.view = std::make_unique<LiveView>("relight " + (options.live_device.empty() ? std::string("replay")
+                                                                                       : "live: " + options.live_device),
+                                             options.out / "snapshots");
+  pipeline.view_stage = &pipeline.graph->emplace<ViewStage>(*pipeline.view, pipeline.renders ? pipeline.final_composite : "color",
+                                                            side, view_side_kind(side));
+}
+
 void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, bool method2) {
   using Kind = BufferPreviews::Kind;
   auto collector = std::make_unique<ReportCollectorStage>(total_frames);
@@ -390,6 +414,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   add_camera_pose(pipeline, options);
   add_differential_rendering(pipeline, options, per_pixel);
   pipeline.latency = &graph.emplace<LatencyStage>(pipeline.renders ? pipeline.final_composite : "");
+  if (options.view) add_view(pipeline, options, method2);
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
     writer->add_color("color");
@@ -432,16 +457,19 @@ int run_replay(const ReplayOptions& options) {
 
   ProgressBar progress("replay", total, options.quiet);
   const auto start = std::chrono::steady_clock::now();
-  while (!InterruptGuard::interrupted() && graph.run_frame()) progress.update(graph.frames_run());
+  const auto view_quit = [&pipeline] { return pipeline.view && pipeline.view->quit_requested(); };
+  while (!InterruptGuard::interrupted() && !view_quit() && graph.run_frame()) progress.update(graph.frames_run());
   progress.finish();
   graph.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const bool interrupted = InterruptGuard::interrupted();
+  const bool quit_from_view = !interrupted && view_quit();
 
   auto report = timing_report(graph, seconds);
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
-  report["stopped_by"] = interrupted ? "interrupt" : "end";
+  report["stopped_by"] = interrupted ? "interrupt" : quit_from_view ? "view" : "end";
+  if (pipeline.view) report["view"] = {{"drawn", pipeline.view->drawn()}, {"skipped", pipeline.view->skipped()}};
   if (pipeline.markers) {
     report["marker_pose"] = pipeline.markers->summary();
     std::cerr << pipeline.markers->no_tag_warning(marker_layout_name(options));
@@ -460,7 +488,8 @@ int run_replay(const ReplayOptions& options) {
     return 130;
   }
   if (!options.quiet) {
-    std::cerr << "relight replay: " << graph.frames_run() << " frames in " << seconds << " s; results in "
+    std::cerr << "relight replay: " << graph.frames_run() << " frames in " << seconds << " s"
+              << (quit_from_view ? " (stopped from the view)" : "") << "; results in "
               << options.out.string() << " (report.html, report.json, graph.dot, camera_trajectory.txt, frames/"
               << (pipeline.renders && options.video ? ", composite.mp4" : "") << ")\n";
   }

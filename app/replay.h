@@ -17,7 +17,9 @@ namespace relight::app {
 class CameraTrajectoryStage;
 class LatencyStage;
 class MarkerTrajectoryStage;
+class LiveView;
 class ObjectPlacementStage;
+class ViewStage;
 class ReportCollectorStage;
 
 struct ReplayOptions {
@@ -70,6 +72,10 @@ struct ReplayOptions {
   std::string colormap_model = "affine_3x4";  ///< sample mapping: per_channel_affine | linear_3x3 | affine_3x4
   bool channel_swap = false;                  ///< sample mapping: add channel-permuted pairs
   bool video = true;                           ///< composite.mp4
+  /// A window showing the final picture as it is made (live_view.h), with `view_side` (a buffer:
+  /// color, depth, normals, ...; empty none) beside it.
+  bool view = false;
+  std::string view_side;
   /// `relight live`: the device the frames come from (it has no sequence folder; errors name it).
   std::string live_device;
   /// `relight live`: the folder with scene.json / probe.hdr the device serves (relight's own
@@ -82,12 +88,14 @@ struct ReplayOptions {
 /// A built replay graph with the Vulkan context its stages use (the context outlives the graph).
 struct ReplayPipeline {
   std::unique_ptr<relight::vk::VulkanContext> vulkan;
+  std::unique_ptr<app::LiveView> view;  ///< with --view; outlives the graph, whose view stage draws into it
   std::unique_ptr<FrameGraph> graph;
   std::string compute;  ///< one line: which backend runs the per-pixel stages, on which device
   app::MarkerTrajectoryStage* markers = nullptr;  ///< set when the marker pose runs
   app::CameraTrajectoryStage* trajectory = nullptr;  ///< the tracked pose of every frame
   app::ObjectPlacementStage* placement = nullptr;  ///< set when there are virtual objects
   app::LatencyStage* latency = nullptr;           ///< capture to final picture, every frame
+  app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".
   std::string final_composite = "composite";
