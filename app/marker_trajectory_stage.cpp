@@ -1,8 +1,69 @@
 #include "marker_trajectory_stage.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
+#include <cstdio>
+
+#include "relight/core/error.h"
 
 namespace relight::app {
+
+namespace {
+
+// Sightings before the check, and after which it is not repeated; the sequence's camera must
+// have moved this far for a scale to mean anything.
+constexpr int kMinSightings = 8;
+constexpr int kMaxSightings = 64;
+constexpr double kMinSpreadM = 0.05;
+constexpr double kMaxScaleRatio = 1.25;  // the aligned scale in [1/1.25, 1.25]
+constexpr double kMaxResidualM = 0.05;   // RMS after the alignment (a marker pose is good to ~1 cm)
+
+}  // namespace
+
+void MarkerTrajectoryStage::run(StageContext& context) {
+  PoseTrajectoryStage::run(context);
+  if (!checked_) check_against_sequence_poses();
+}
+
+void MarkerTrajectoryStage::check_against_sequence_poses() {
+  std::vector<Eigen::Vector3d> marker, sequence;
+  for (const auto& entry : entries()) {
+    if (!entry.pose.valid || entry.pose.held || !entry.reference) continue;
+    marker.push_back(entry.pose.camera_to_world.translation());
+    sequence.push_back(entry.reference->translation());
+  }
+  const auto n = static_cast<int>(marker.size());
+  if (n < kMinSightings || (n % 4 != 0 && n < kMaxSightings)) return;
+  Eigen::Matrix3Xd from(3, n), to(3, n);
+  for (int i = 0; i < n; ++i) {
+    from.col(i) = marker[static_cast<std::size_t>(i)];
+    to.col(i) = sequence[static_cast<std::size_t>(i)];
+  }
+  const Eigen::Vector3d mean = to.rowwise().mean();
+  const double spread = (to.colwise() - mean).colwise().norm().maxCoeff();
+  if (spread < kMinSpreadM) {
+    if (n >= kMaxSightings) checked_ = true;  // a camera that never moved: nothing to compare
+    return;
+  }
+  const Eigen::Matrix4d alignment = Eigen::umeyama(from, to, true);
+  const double scale = alignment.block<3, 1>(0, 0).norm();
+  const Eigen::Matrix3Xd aligned = (alignment.block<3, 3>(0, 0) * from).colwise() + alignment.block<3, 1>(0, 3);
+  const double rms = std::sqrt((aligned - to).colwise().squaredNorm().mean());
+  char numbers[160];
+  if (scale > kMaxScaleRatio || scale < 1.0 / kMaxScaleRatio) {
+    std::snprintf(numbers, sizeof numbers, "%.2f times", 1.0 / scale);
+    throw Error("the tag layout " + layout_ + " contradicts the sequence's camera poses: over the first " +
+                std::to_string(n) + " sightings the marker trajectory is " + numbers +
+                " the size of the sequence's (a wrong tag size in the layout, or poses in other units?)");
+  }
+  if (rms > kMaxResidualM) {
+    std::snprintf(numbers, sizeof numbers, "%.1f cm", 100.0 * rms);
+    throw Error("the tag layout " + layout_ + " contradicts the sequence's camera poses: over the first " +
+                std::to_string(n) + " sightings the marker poses are " + numbers +
+                " (RMS) off the sequence's after aligning them (are the tags where the layout says?)");
+  }
+  if (n >= kMaxSightings) checked_ = true;
+}
 
 nlohmann::ordered_json MarkerTrajectoryStage::summary() const {
   int fresh = 0, held = 0, compared = 0;

@@ -5,6 +5,12 @@
 // groundtruth.txt, or a synthetic sequence's exact poses) it also measures the marker pose
 // against them; that comparison is meaningful when the tag layout and those poses share a world
 // frame, as they do for `relight synth` sequences.
+//
+// Whatever the frames, the marker trajectory must have the sequence's shape: after a similarity
+// alignment (Umeyama with scale) of the first sightings onto the sequence's poses the scale is
+// 1 and the positions agree. A layout that contradicts the poses - a wrong tag size scales the
+// marker trajectory, a tag placed elsewhere than the layout says bends it - stops the run with
+// a relight::Error naming the layout and what is off.
 // Reads: "marker_pose" (CameraPose), "source_frame" (FrameInfo: the sequence's own pose).
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -15,8 +21,11 @@ namespace relight::app {
 
 class MarkerTrajectoryStage final : public PoseTrajectoryStage {
  public:
-  explicit MarkerTrajectoryStage(std::filesystem::path file) : PoseTrajectoryStage(std::move(file), "marker_pose") {}
+  /// `layout`: how errors name the tag layout (its file).
+  MarkerTrajectoryStage(std::filesystem::path file, std::string layout)
+      : PoseTrajectoryStage(std::move(file), "marker_pose"), layout_(std::move(layout)) {}
   [[nodiscard]] std::string name() const override { return "marker_trajectory"; }
+  void run(StageContext& context) override;
 
   /// Frames, frames with a fresh / held pose, and the error against the sequence's poses.
   [[nodiscard]] nlohmann::ordered_json summary() const;
@@ -27,6 +36,9 @@ class MarkerTrajectoryStage final : public PoseTrajectoryStage {
 
  private:
   [[nodiscard]] std::string description() const override { return "camera poses from AprilTag markers (camera to world)"; }
+  void check_against_sequence_poses();
+  std::string layout_;
+  bool checked_ = false;  ///< the check passed on enough sightings; not repeated
 };
 
 }  // namespace relight::app

@@ -286,6 +286,13 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   pipeline.renders = true;
 }
 
+// How warnings name the AprilTag layout in use.
+std::string marker_layout_name(const ReplayOptions& options) {
+  if (options.markers != "auto") return options.markers;
+  const auto folder = scene_folder(options);
+  return folder ? (*folder / "scene.json").string() : "the device's scene";
+}
+
 /// The marker pose (when there is a layout) and the camera tracking stage that turns the
 /// source's frame into the tracked "frame" every pose reader uses.
 void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
@@ -300,7 +307,8 @@ void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
   tracking.has_marker_layout = layout.has_value();
   if (layout) {
     pipeline.graph->emplace<MarkerPoseStage>(std::move(*layout), TagDetectorOptions{}, "source_frame");
-    pipeline.markers = &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt");
+    pipeline.markers =
+        &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt", marker_layout_name(options));
   }
   pipeline.graph->emplace<CameraTrackingStage>(tracking);
   pipeline.trajectory = &pipeline.graph->emplace<CameraTrajectoryStage>(options.out / "camera_trajectory.txt");
@@ -345,12 +353,6 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
   pipeline.graph->add(std::move(collector));
 }
 
-// How warnings name the AprilTag layout in use.
-std::string marker_layout_name(const ReplayOptions& options) {
-  if (options.markers != "auto") return options.markers;
-  const auto folder = scene_folder(options);
-  return folder ? (*folder / "scene.json").string() : "the device's scene";
-}
 
 }  // namespace
 
