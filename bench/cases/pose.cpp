@@ -120,7 +120,7 @@ Json odometry_640x480(const bench::Options&) {
     return json;
   }
   TumOptions tum;
-  tum.intrinsics = PinholeIntrinsics::preset("fr1");
+  tum.intrinsics = PinholeIntrinsics::kinect_v1();  // as replay uses for TUM folders (tum_sequence.h)
   const TumSequence sequence = TumSequence::open(folder, tum);
   const PinholeIntrinsics intrinsics = sequence.intrinsics();
 

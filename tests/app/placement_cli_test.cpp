@@ -91,9 +91,9 @@ TEST(ReplayPlacement, TheMainJobStandsThePebbleOnTheSamplesDesk) {
   EXPECT_LT(degrees_between(vector_of(placement["up"]), Eigen::Vector3d::UnitZ()), 5.0) << placement.dump();
   // It is drawn where it stands: a 4 cm high pebble just above its foot point in frame 0.
   const Pose world_to_camera = first_pose(out / "camera_trajectory.txt").inverse();
-  const PinholeIntrinsics fr1 = *PinholeIntrinsics::preset("fr1");
+  const PinholeIntrinsics sample_camera = PinholeIntrinsics::kinect_v1();  // what relight uses for TUM folders
   const Eigen::Vector3d centre = vector_of(placement["position_m"]) + 0.02 * vector_of(placement["up"]);
-  const Eigen::Vector2d pixel = fr1.project(world_to_camera * centre);
+  const Eigen::Vector2d pixel = sample_camera.project(world_to_camera * centre);
   EXPECT_GT(changed_pixels_near(out / "frames", "000000", pixel, 25), 300) << pixel.transpose();
   // Geometry only on request.
   const auto geometry = dir.path() / "geometry";

@@ -9,7 +9,9 @@
 // two bracketing entries; frames outside the ground-truth time range get no pose.
 //
 // Intrinsics, first that applies: TumOptions::intrinsics, "intrinsics" in scene.json beside the
-// lists (relight synth writes it), the folder name (freiburg1/2/3 presets), Kinect v1 defaults.
+// lists (relight synth writes it), Kinect v1 / ROS defaults - also for the Freiburg folders,
+// whose depth the OpenNI driver registered to colour with the factory model (TUM recommends
+// these defaults for it; the calibrated colour cameras are the fr1/fr2/fr3 presets, on request).
 //
 // Every problem (missing folder or list, malformed or unsorted line, missing/corrupt/8-bit image,
 // a depth image without one valid pixel) throws relight::Error naming the file and line.
