@@ -1,10 +1,13 @@
 #include "object_placement_stage.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <sstream>
 
 #include "relight/capture/support_plane.h"
@@ -222,6 +225,16 @@ render::Placement ObjectPlacementStage::resolve(const PlacementRequest& request,
   render::Placement placement = request.placement;
   placement.position = camera_to_world * *point;
   placement.up = (camera_to_world.linear() * normal).normalized();
+  // Yaw 0 turns the model's front (+z) towards the first camera, so that the object looks the
+  // same whichever world frame the tracking chose (a levelled odometry world, mocap, a marker's).
+  const Eigen::Vector3d to_camera = camera_to_world.translation() - placement.position;
+  const Eigen::Vector3d along_surface = to_camera - to_camera.dot(placement.up) * placement.up;
+  if (along_surface.norm() > 1e-6) {
+    // transform(): front -> (sin yaw, -cos yaw, 0) in the z-up frame, then z is turned onto up.
+    const Eigen::Vector3d e =
+        Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), placement.up).inverse() * along_surface.normalized();
+    placement.yaw_degrees += std::atan2(e.x(), -e.y()) * 180.0 / std::numbers::pi;
+  }
   return placement;
 }
 
@@ -237,7 +250,9 @@ nlohmann::ordered_json ObjectPlacementStage::summary() const {
       entry["frame"] = resolved_frame_;
       entry["position_m"] = vector_json(placement.position);
       entry["up"] = vector_json(placement.up);
-      entry["yaw_degrees"] = placement.yaw_degrees;
+      entry["yaw_degrees"] = placement.yaw_degrees;  // about up, in the world frame
+      if (requests_[i].kind != PlacementRequest::Kind::World)
+        entry["yaw_from_camera_degrees"] = requests_[i].placement.yaw_degrees;  // as given
       entry["scale"] = placement.scale;
     } else {
       entry["frame"] = nullptr;  // no frame had a camera pose: the object was never drawn

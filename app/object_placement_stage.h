@@ -11,7 +11,9 @@
 //           metres), "camera_pose" (CameraPose: whether the world frame is known yet)
 //   writes: "object_placements" (render::ObjectPlacements), which DIR's mr_scene stage reads
 //
-// Surface placements are resolved once, on the first frame whose camera pose is valid (the
+// On a surface, yaw turns the object about the surface normal from facing the first camera (yaw
+// 0: the model's front, +z, towards it), so it looks the same in any world frame the tracking
+// chose. Surface placements are resolved once, on the first frame whose camera pose is valid (the
 // first frame, except with a marker pose before the first tag sighting), and then held: an
 // object stays where it was put, in the world frame, while the camera moves. The surface is a
 // local plane fit (capture/support_plane.h), not one pixel's noisy normal. A pixel outside the

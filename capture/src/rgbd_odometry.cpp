@@ -451,7 +451,11 @@ Alignment align(const Pyramid& current, const std::vector<KeyframeView>& keys, c
     for (int it = 0; it < iterations; ++it) {
       Normal6 system;
       std::int64_t first_inliers = 0, first_valid = 0;
-      for (std::size_t k = 0; k < keys.size(); ++k) {
+      // Coarse levels bring the pose near (against the nearest keyframes only); the finest
+      // level refines it against the whole model.
+      const std::size_t models =
+          l == finest ? keys.size() : std::min(keys.size(), static_cast<std::size_t>(std::max(1, options.coarse_model_keyframes)));
+      for (std::size_t k = 0; k < models; ++k) {
         Reference reference;
         reference.key = &keys[k].key->pyramid[level];
         reference.prepared = &(*keys[k].prepared)[level];

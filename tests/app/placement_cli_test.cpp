@@ -139,7 +139,7 @@ TEST(ReplayPlacement, PlaceAtStandsTheObjectOnTheSurfaceSeenAtThePixel) {
   EXPECT_NEAR(position.z(), 0.75, 0.01) << on_table.dump();
   EXPECT_LT(std::abs(position.x()), 0.6);
   EXPECT_LT(std::abs(position.y()), 0.4);
-  EXPECT_EQ(on_table["yaw_degrees"], 30.0);
+  EXPECT_EQ(on_table["yaw_from_camera_degrees"], 30.0);
   EXPECT_LT(degrees_between(vector_of(on_table["up"]), Eigen::Vector3d::UnitZ()), 3.0) << on_table.dump();
 }
 

@@ -63,6 +63,10 @@ struct RgbdOdometryOptions {
   float keyframe_distance_m = 0.06f;
   float keyframe_min_overlap = 0.65f;  ///< inlier share below which the frame becomes a keyframe
   int model_keyframes = 3;             ///< keyframes aligned against together (the nearest ones)
+  /// Of those, the ones the levels above the finest align against: the nearest alone brings the
+  /// pose near, the finest level refines it against all (TUM fr1/rpy slice, Release: 16.8 ms a
+  /// frame and ATE 1.91 cm, against 22.5 ms and 1.87 cm with all three on every level).
+  int coarse_model_keyframes = 1;
   float model_radius_deg = 12.f;       ///< farther keyframes (pose distance, 1 cm = 1 deg) are not
   int max_keyframes = 96;              ///< the least recently used is dropped beyond this
   // Failure detection.
