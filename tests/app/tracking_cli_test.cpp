@@ -213,6 +213,16 @@ std::vector<bool> virtual_pixels(const std::filesystem::path& frames, const std:
   return mask;
 }
 
+/// Intersection over union of two pixel masks, and the size of their union.
+std::pair<double, std::size_t> pebble_overlap(const std::vector<bool>& a, const std::vector<bool>& b) {
+  std::size_t both = 0, either = 0;
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    both += a[p] && b[p];
+    either += a[p] || b[p];
+  }
+  return {either ? static_cast<double>(both) / static_cast<double>(either) : 0.0, either};
+}
+
 // Live mixed reality that holds still: `relight live` on the virtual device's orbit, tracked
 // (marker+odometry from the layout the device serves, lit by the probe it serves), draws the
 // pebble where a replay of the same frames with the true poses draws it. Measured: IoU 0.96 to
@@ -242,14 +252,9 @@ TEST(ReplayTracking, LiveOrbitDrawsThePebbleWhereAReplayWithTheTruePosesDoes) {
     char live_name[32], replay_name[32];
     std::snprintf(live_name, sizeof live_name, "%06zu", i);
     std::snprintf(replay_name, sizeof replay_name, "%06d", k);
-    const auto a = virtual_pixels(live / "frames", live_name), b = virtual_pixels(replay / "frames", replay_name);
-    std::size_t both = 0, either = 0;
-    for (std::size_t p = 0; p < a.size(); ++p) {
-      both += a[p] && b[p];
-      either += a[p] || b[p];
-    }
+    const auto [iou, either] =
+        pebble_overlap(virtual_pixels(live / "frames", live_name), virtual_pixels(replay / "frames", replay_name));
     ASSERT_GT(either, 100u) << "the pebble is in view in frame " << i;
-    const double iou = static_cast<double>(both) / static_cast<double>(either);
     std::printf("live frame %zu (device frame %d): IoU %.3f of %zu pixels\n", i, k, iou, either);
     EXPECT_GE(iou, 0.95) << "frame " << i;
   }
@@ -274,14 +279,10 @@ TEST(ReplayTracking, OdometryKeepsThePebbleWhereTheTruePosesPutIt) {
     for (int frame = 0; frame < 8; ++frame) {
       char name[32];
       std::snprintf(name, sizeof name, "%06d", frame);
-      const auto a = virtual_pixels(tracked / "frames", name), b = virtual_pixels(truth / "frames", name);
-      std::size_t both = 0, either = 0;
-      for (std::size_t p = 0; p < a.size(); ++p) {
-        both += a[p] && b[p];
-        either += a[p] || b[p];
-      }
+      const auto [iou, either] =
+          pebble_overlap(virtual_pixels(tracked / "frames", name), virtual_pixels(truth / "frames", name));
       ASSERT_GT(either, 100u) << trajectory << " frame " << frame;
-      worst = std::min(worst, static_cast<double>(both) / static_cast<double>(either));
+      worst = std::min(worst, iou);
     }
     std::printf("%s: worst pebble IoU odometry vs true poses %.3f\n", trajectory.c_str(), worst);
     EXPECT_GE(worst, 0.95) << trajectory;
