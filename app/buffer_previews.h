@@ -10,7 +10,7 @@
 
 #include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
-#include "relight/render/path_tracer.h"  // CoverageImage
+#include "relight/render/differential_images.h"
 
 namespace relight::app {
 

@@ -7,7 +7,7 @@
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
 #include "relight/lights/light_output.h"
-#include "relight/render/model_io.h"
+#include "relight/render/scene/model_io.h"
 #include "relight/core/image_io.h"
 #include "relight/lights/light_stages.h"
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "relight/lights/light_set.h"
-#include "relight/render/mr_scene.h"
-#include "relight/render/virtual_model.h"
+#include "relight/render/scene/mr_scene.h"
+#include "relight/render/scene/virtual_model.h"
 
 namespace relight::app {
 

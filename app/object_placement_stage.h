@@ -27,7 +27,7 @@
 #include "relight/capture/camera_pose.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
-#include "relight/render/virtual_model.h"
+#include "relight/render/scene/virtual_model.h"
 
 namespace relight::app {
 

@@ -15,12 +15,13 @@
 #include "relight/core/error.h"
 #include "relight/core/image_io.h"
 #include "relight/core/progress.h"
-#include "relight/render/composite.h"
-#include "relight/render/depth_mesh.h"
-#include "relight/render/model_io.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/scene_from_synth.h"
-#include "relight/render/scene_lights.h"
+#include "relight/render/reference/path_tracer.h"
+#include "relight/render/dir/composite.h"
+#include "relight/render/scene/depth_mesh.h"
+#include "relight/render/scene/model_io.h"
+#include "relight/render/scene/procedural_models.h"
+#include "relight/render/scene/scene_from_synth.h"
+#include "relight/render/scene/scene_lights.h"
 
 namespace relight::app {
 

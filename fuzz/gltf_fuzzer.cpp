@@ -4,7 +4,7 @@
 // an accepted model the renderer could not index (model_checks.h) is a finding.
 #include "fuzz_input.h"
 #include "model_checks.h"
-#include "relight/render/model_io.h"
+#include "relight/render/scene/model_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const auto text = relight::fuzz::as_text(data, size);

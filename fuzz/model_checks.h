@@ -7,7 +7,7 @@
 #include <cstdlib>
 
 #include "relight/core/error.h"
-#include "relight/render/virtual_model.h"
+#include "relight/render/scene/virtual_model.h"
 
 namespace relight::fuzz {
 

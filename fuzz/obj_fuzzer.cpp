@@ -5,7 +5,7 @@
 // finding.
 #include "fuzz_input.h"
 #include "model_checks.h"
-#include "relight/render/model_io.h"
+#include "relight/render/scene/model_io.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using relight::fuzz::scratch;

@@ -1,4 +1,4 @@
-// Differential instant radiosity against the path tracer (render/dir_cpu.h, render/path_tracer.h)
+// Differential instant radiosity against the path tracer (render/reference/dir_exact.h, render/reference/path_tracer.h)
 // on the synthetic scene with the shipped pebble on the table, 640x480 (the camera's size; the
 // same comparison at 320x240 under "at_320x240"), one indirect bounce in both, the sky switched
 // off (DIR lights the environment with directional lights, direct only).
@@ -8,7 +8,7 @@
 // shadows and colour bleeding), the composite's RMSE (the camera image being the reference's
 // TM(L_r)), and the path tracer's composite RMSE when it gets DIR's wall time (equal time).
 // The renderer measured is the Vulkan one (VPL generation included in its time); the CPU DIR
-// with exact visibility (dir_cpu.h) reports the same fields under "cpu_exact_visibility".
+// with exact visibility (reference/dir_exact.h) reports the same fields under "cpu_exact_visibility".
 // dir/gbuffer_640x480: the first Vulkan stage of DIR against its ray-cast reference.
 // dir/frame_640x480_64vpl, dir/frame_640x480_256vpl: one whole frame at 640x480 (VPLs on the
 // CPU, then G-buffer, shadow maps, ISMs and shading on the GPU), with the GPU time per step.
@@ -23,13 +23,13 @@
 #include <cmath>
 
 #include "bench.h"
-#include "relight/render/cone_search_vk.h"
-#include "relight/render/dir_cpu.h"
-#include "relight/render/dir_vk.h"
-#include "relight/render/gbuffer_vk.h"
-#include "relight/render/path_tracer.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/scene_from_synth.h"
+#include "relight/render/vpl/cone_search_vk.h"
+#include "relight/render/reference/dir_exact.h"
+#include "relight/render/dir/dir_vk.h"
+#include "relight/render/dir/gbuffer_vk.h"
+#include "relight/render/reference/path_tracer.h"
+#include "relight/render/scene/procedural_models.h"
+#include "relight/render/scene/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
 

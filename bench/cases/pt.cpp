@@ -11,10 +11,10 @@
 #include <cmath>
 
 #include "bench.h"
-#include "relight/render/model_io.h"
-#include "relight/render/path_tracer.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/scene_from_synth.h"
+#include "relight/render/scene/model_io.h"
+#include "relight/render/reference/path_tracer.h"
+#include "relight/render/scene/procedural_models.h"
+#include "relight/render/scene/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
 
 namespace {

@@ -1,6 +1,6 @@
 // modulate_camera_albedo (camera_albedo.h) on a hand-built G-buffer: which pixels it changes,
 // and by how much.
-#include "relight/render/camera_albedo.h"
+#include "relight/render/dir/camera_albedo.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The point-cone search (cone_search.h): its rules on hand-placed points, and the Vulkan twin
 // against the CPU reference on the synthetic scene's surface points.
-#include "relight/render/cone_search.h"
+#include "relight/render/vpl/cone_search.h"
 
 #include <gtest/gtest.h>
 
@@ -10,14 +10,14 @@
 
 #include "../reconstruct/vulkan_test_env.h"
 #include "relight/core/error.h"
-#include "relight/render/cone_search_vk.h"
-#include "relight/render/phong_brdf.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/ray_tracer.h"
-#include "relight/render/virtual_model.h"
-#include "relight/render/vpl.h"
-#include "relight/render/sampler.h"
-#include "relight/render/scene_from_synth.h"
+#include "relight/render/vpl/cone_search_vk.h"
+#include "relight/render/scene/phong_brdf.h"
+#include "relight/render/scene/procedural_models.h"
+#include "relight/render/reference/ray_tracer.h"
+#include "relight/render/scene/virtual_model.h"
+#include "relight/render/vpl/vpl.h"
+#include "relight/render/scene/sampler.h"
+#include "relight/render/scene/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
 
 namespace relight::render {

@@ -1,9 +1,9 @@
-#include "relight/render/depth_mesh.h"
+#include "relight/render/scene/depth_mesh.h"
 
 #include <gtest/gtest.h>
 
 #include "relight/core/error.h"
-#include "relight/render/ray_tracer.h"
+#include "relight/render/reference/ray_tracer.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 

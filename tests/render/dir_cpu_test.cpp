@@ -1,6 +1,6 @@
 // Differential instant radiosity on the CPU: the four light interactions of Knecht's Fig. 5.7,
 // no double shadowing (Figs. 5.5/5.6), VPL generation, and agreement with the path tracer.
-#include "relight/render/dir_cpu.h"
+#include "relight/render/reference/dir_exact.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <tuple>
 
 #include "relight/core/error.h"
-#include "relight/render/shadow_maps.h"
+#include "relight/render/dir/shadow_maps.h"
 #include "test_scenes.h"
 
 namespace relight::render {

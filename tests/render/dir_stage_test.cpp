@@ -1,15 +1,15 @@
 // The DIR frame-graph stage on a synthetic frame: the reconstruction becomes the real mesh, the
 // pebble is composited in, and the camera image stays untouched where nothing virtual changes
 // the light; the Vulkan renderer and the CPU fallback give the same picture.
-#include "relight/render/dir_stage.h"
+#include "relight/render/dir/dir_stage.h"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
 #include "../reconstruct/vulkan_test_env.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/scene_from_synth.h"
+#include "relight/render/scene/procedural_models.h"
+#include "relight/render/scene/scene_from_synth.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"

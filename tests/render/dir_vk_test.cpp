@@ -1,7 +1,7 @@
 // Differential instant radiosity on Vulkan: every GPU step against its CPU reference (shadow
 // maps by ray casting, ISMs by the same splats, shading by shade_dir_from_maps), then the whole
 // method against the exact-visibility CPU DIR and the path tracer.
-#include "relight/render/dir_vk.h"
+#include "relight/render/dir/dir_vk.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // The rasterised G-buffer against the ray-cast reference on the synthetic scene with the
 // shipped pebble: same surface, flag and material at every pixel away from triangle edges.
-#include "relight/render/gbuffer_vk.h"
+#include "relight/render/dir/gbuffer_vk.h"
 
 #include <gtest/gtest.h>
 

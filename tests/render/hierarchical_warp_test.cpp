@@ -1,7 +1,7 @@
 // Hierarchical warping (hierarchical_warp.h): the warped texels follow the importance map, never
 // land on zero importance, keep a uniform map's stratification, and the Vulkan version picks the
 // same texels as the CPU reference.
-#include "relight/render/hierarchical_warp.h"
+#include "relight/render/vpl/hierarchical_warp.h"
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,8 @@
 
 #include "../reconstruct/vulkan_test_env.h"
 #include "relight/core/error.h"
-#include "relight/render/hierarchical_warp_vk.h"
-#include "relight/render/sampler.h"
+#include "relight/render/vpl/hierarchical_warp_vk.h"
+#include "relight/render/scene/sampler.h"
 #include "relight/vk/buffer.h"
 #include "relight/vk/transfer.h"
 

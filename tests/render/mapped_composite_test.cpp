@@ -1,14 +1,14 @@
 // The colour-mapped differential composite: camera pixels without virtual content stay bit for
 // bit, covered pixels show the mapped virtual radiance itself (the real texture behind a virtual
 // object does not show through), and on the synthetic camera it reaches the colour goal.
-#include "relight/render/mapped_composite_stage.h"
+#include "relight/render/dir/mapped_composite_stage.h"
 
 #include <gtest/gtest.h>
 
 #include "colormap/colormap_test_scene.h"
 #include "relight/colormap/color_space.h"
 #include "relight/core/error.h"
-#include "relight/render/composite.h"
+#include "relight/render/dir/composite.h"
 
 namespace relight::render {
 namespace {

@@ -4,8 +4,8 @@
 #include <fstream>
 
 #include "relight/core/error.h"
-#include "relight/render/model_io.h"
-#include "relight/render/procedural_models.h"
+#include "relight/render/scene/model_io.h"
+#include "relight/render/scene/procedural_models.h"
 #include "temp_dir.h"
 
 namespace relight::render {

@@ -1,4 +1,4 @@
-#include "relight/render/path_tracer.h"
+#include "relight/render/reference/path_tracer.h"
 
 #include <gtest/gtest.h>
 

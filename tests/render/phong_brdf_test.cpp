@@ -1,11 +1,11 @@
-#include "relight/render/phong_brdf.h"
+#include "relight/render/scene/phong_brdf.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "relight/render/sampler.h"
+#include "relight/render/scene/sampler.h"
 
 namespace relight::render {
 namespace {

@@ -8,9 +8,9 @@
 
 #include "../reconstruct/vulkan_test_env.h"
 #include "relight/core/error.h"
-#include "relight/render/reflective_shadow_map.h"
-#include "relight/render/reflective_shadow_map_vk.h"
-#include "relight/render/vpl.h"
+#include "relight/render/vpl/reflective_shadow_map.h"
+#include "relight/render/vpl/reflective_shadow_map_vk.h"
+#include "relight/render/vpl/vpl.h"
 #include "test_scenes.h"
 
 namespace relight::render {

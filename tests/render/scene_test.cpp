@@ -3,8 +3,8 @@
 #include <cmath>
 
 #include "relight/core/error.h"
-#include "relight/render/ray_tracer.h"
-#include "relight/render/scene_from_synth.h"
+#include "relight/render/reference/ray_tracer.h"
+#include "relight/render/scene/scene_from_synth.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 

@@ -9,7 +9,7 @@
 
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
-#include "relight/render/depth_mesh.h"
+#include "relight/render/scene/depth_mesh.h"
 #include "relight/synth/raycast.h"
 
 namespace relight::render::test {

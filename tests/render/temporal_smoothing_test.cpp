@@ -1,7 +1,7 @@
 // Temporal smoothing of the indirect light (eqs. 5.11-5.15): blends where the surface is the
 // same, takes the new value at disocclusions and where r(p) changes (no ghosting of a moved
 // virtual object), and lowers the frame-to-frame flicker of the DIR stage on noisy depth.
-#include "relight/render/temporal_smoothing.h"
+#include "relight/render/dir/temporal_smoothing.h"
 
 #include <gtest/gtest.h>
 
@@ -9,9 +9,9 @@
 #include "relight/reconstruct/depth_warp_merge.h"
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
-#include "relight/render/dir_stage.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/scene_from_synth.h"
+#include "relight/render/dir/dir_stage.h"
+#include "relight/render/scene/procedural_models.h"
+#include "relight/render/scene/scene_from_synth.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"

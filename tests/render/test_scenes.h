@@ -7,12 +7,12 @@
 #include <vector>
 
 #include "relight/core/image.h"
-#include "relight/render/mr_scene.h"
-#include "relight/render/path_tracer.h"
-#include "relight/render/procedural_models.h"
-#include "relight/render/ray_tracer.h"
-#include "relight/render/scene_from_synth.h"
-#include "relight/render/virtual_model.h"
+#include "relight/render/scene/mr_scene.h"
+#include "relight/render/reference/path_tracer.h"
+#include "relight/render/scene/procedural_models.h"
+#include "relight/render/reference/ray_tracer.h"
+#include "relight/render/scene/scene_from_synth.h"
+#include "relight/render/scene/virtual_model.h"
 #include "relight/synth/trajectory.h"
 
 namespace relight::render::test {

@@ -1,0 +1,196 @@
+#pragma once
+// Differential instant radiosity (dir_vk.h) as frame-graph stages, one per step, so that the
+// graph times each step and keeps each step's output (add_dir_stages() adds all five):
+//
+//   mr_scene                 reads  FrameInfo "frame" (camera_to_world: identity when absent),
+//                                   PositionMap "positions" and NormalMap "normals" (camera frame,
+//                                   reconstruct/), brdf::Materials when `materials_buffer` is set,
+//                                   ObjectPlacements when `placements_buffer` is set
+//                            writes MrScene "mr_scene": the reconstruction's position map as the
+//                                   real mesh, the configured real and virtual lights, the
+//                                   configured virtual objects (at the placements of that
+//                                   buffer when set, none while it is unresolved)
+//   vpls                     reads  MrScene "mr_scene"; with VplBudget::ByPreviousFlux also the
+//                                   previous frame's VplSet "vpls" (its flux per light)
+//                            writes VplSet "vpls" (vpl.h)
+//   dir                      reads  FrameInfo "frame", ColorImage "color" and PositionMap
+//                                   "positions" (the image size, which they must share),
+//                                   MrScene "mr_scene", VplSet "vpls"; when `albedo_buffer` is
+//                                   set, that RadianceImage (per-pixel k_d) and Mask
+//                                   "<albedo_buffer>_valid" (camera_albedo.h)
+//                            writes DifferentialImages "dir_images" (L_rv, L_r, coverage and
+//                                   their indirect parts, one shading pass) and GBuffer
+//                                   "dir_gbuffer"
+//   indirect_smoothing       reads  DifferentialImages "dir_images", GBuffer "dir_gbuffer",
+//                                   FrameInfo "frame"
+//                            writes RadianceImage "L_rv", "L_r", "L_rv_indirect" (the VPL part
+//                                   of L_rv) and CoverageImage "virtual_coverage", the indirect
+//                                   light smoothed over time (temporal_smoothing.h, eq.
+//                                   5.11-5.15) with the stage's own history of the last frame
+//                                   (G-buffer, camera, indirect light); unchanged when off
+//   differential_composite   reads  ColorImage "color", RadianceImage "L_rv", "L_r",
+//                                   CoverageImage "virtual_coverage"
+//                            writes ColorImage "composite" (composite.h, eq. 5.1)
+//
+// With a Vulkan context `dir` renders with DirRendererVk (made on the first frame, remade when
+// the frame size changes); without one, with render_dir_cpu() (same algorithm, much slower).
+// Real surfaces take the material of their pixel's BRDF cluster; pixels without one (shadows,
+// too dark to estimate) take the pixel-weighted mean of the clusters, and without any Materials
+// every real surface is `reconstruction_material`. The real materials matter for the picture:
+// the differential adds TM(L_rv) - TM(L_r) to the camera image, so a virtual shadow computed
+// with a grey albedo on a brown table subtracts grey and tints the shadow orange.
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "relight/brdf/materials.h"
+#include "relight/colormap/tone_map.h"
+#include "relight/core/frame_graph.h"
+#include "relight/core/rgbd_frame.h"
+#include "relight/render/vpl/cone_search_vk.h"
+#include "relight/render/scene/depth_mesh.h"
+#include "relight/render/dir/dir_vk.h"
+#include "relight/render/vpl/reflective_shadow_map_vk.h"
+#include "relight/render/dir/temporal_smoothing.h"
+#include "relight/render/scene/virtual_model.h"
+#include "relight/render/vpl/vpl.h"
+
+namespace relight::render {
+
+struct DirStageOptions {
+  DirVkOptions renderer{};
+  VplOptions vpls{.count = 64};
+  DepthMeshOptions mesh{.stride = 2};
+  PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
+  colormap::ToneMap tone_map{};
+  std::string materials_buffer;  ///< empty: no Materials input
+  /// ObjectPlacements of the objects (virtual_model.h), e.g. resolved on a real surface at the
+  /// first frame; empty: the placements in DirSceneContent.
+  std::string placements_buffer;
+  /// Per-pixel k_d of the camera's real surfaces (brdf/'s "kd"), modulating the cluster k_d of
+  /// diffuse real surfaces (camera_albedo.h); empty: the clusters' k_d alone.
+  std::string albedo_buffer;
+  bool temporal_smoothing = true;
+  TemporalOptions temporal{};
+};
+
+/// What the stages add to every frame's real geometry.
+struct DirSceneContent {
+  std::vector<MrLight> lights;  ///< real (measured) and virtual lights
+  std::vector<std::pair<VirtualModel, Placement>> objects;
+};
+
+/// Adds the five stages above. `context` may be null (CPU rendering); it must outlive the graph.
+void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneContent content,
+                    const DirStageOptions& options = {});
+
+/// Step 1 (scene): the mixed-reality scene of the frame.
+class MrSceneStage final : public Stage {
+ public:
+  MrSceneStage(DirSceneContent content, const DirStageOptions& options);
+  [[nodiscard]] std::string name() const override { return "mr_scene"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  DirSceneContent content_;
+  DepthMeshOptions mesh_;
+  PhongMaterial reconstruction_material_;
+  std::string materials_buffer_;
+  std::string placements_buffer_;
+  Read<FrameInfo> frame_;
+  Read<PositionMap> positions_;
+  Read<NormalMap> normals_;
+  Read<brdf::Materials> materials_;
+  Read<ObjectPlacements> placements_;
+  Write<MrScene> scene_;
+};
+
+/// Step 2 (primary lights and VPLs). With a Vulkan context (may be null), the cone searches of
+/// BounceMethod::PointCone (bounces >= 2) and the RSMs of VplSource::ReflectiveShadowMaps
+/// (rasterised, reflective_shadow_map_vk.h) run on the GPU.
+class VplStage final : public Stage {
+ public:
+  explicit VplStage(VplOptions options, vk::VulkanContext* context = nullptr);
+  ~VplStage() override;
+  [[nodiscard]] std::string name() const override { return "vpls"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  VplOptions options_;
+  std::unique_ptr<ConeSearchVk> cone_search_;
+  std::unique_ptr<ReflectiveShadowMapsVk> reflective_shadow_maps_;
+  Read<MrScene> scene_;
+  ReadPrevious<VplSet> previous_;
+  Write<VplSet> vpls_;
+};
+
+/// Steps 3-4 (G-buffer, shadow maps, ISMs, one-pass shading of L_rv and L_r).
+class DirRenderStage final : public Stage {
+ public:
+  /// `albedo_buffer`: DirStageOptions::albedo_buffer.
+  DirRenderStage(vk::VulkanContext* context, DirVkOptions options, std::string albedo_buffer = {});
+  ~DirRenderStage() override;
+  [[nodiscard]] std::string name() const override { return "dir"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  vk::VulkanContext* context_;
+  DirVkOptions options_;
+  std::string albedo_buffer_;
+  std::unique_ptr<DirRendererVk> renderer_;
+  std::pair<int, int> renderer_size_{0, 0};
+  Read<FrameInfo> frame_;
+  Read<ColorImage> color_;
+  Read<PositionMap> positions_;
+  Read<MrScene> scene_;
+  Read<VplSet> vpls_;
+  Read<RadianceImage> albedo_;
+  Read<Mask> albedo_valid_;
+  Write<DifferentialImages> images_;
+  Write<GBuffer> gbuffer_;
+};
+
+/// Step 6 (temporal smoothing of the indirect light).
+class IndirectSmoothingStage final : public Stage {
+ public:
+  IndirectSmoothingStage(bool enabled, TemporalOptions options) : enabled_(enabled), options_(options) {}
+  [[nodiscard]] std::string name() const override { return "indirect_smoothing"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  bool enabled_;
+  TemporalOptions options_;
+  std::optional<TemporalHistory> history_;
+  Read<DifferentialImages> images_;
+  Read<GBuffer> gbuffer_;
+  Read<FrameInfo> frame_;
+  Write<RadianceImage> real_virtual_;
+  Write<RadianceImage> real_;
+  Write<RadianceImage> indirect_;
+  Write<CoverageImage> coverage_;
+};
+
+/// Step 7 (tone mapping and differential composite).
+class DifferentialCompositeStage final : public Stage {
+ public:
+  explicit DifferentialCompositeStage(colormap::ToneMap tone_map) : tone_map_(tone_map) {}
+  [[nodiscard]] std::string name() const override { return "differential_composite"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+ private:
+  colormap::ToneMap tone_map_;
+  Read<ColorImage> color_;
+  Read<RadianceImage> real_virtual_;
+  Read<RadianceImage> real_;
+  Read<CoverageImage> coverage_;
+  Write<ColorImage> composite_;
+};
+
+}  // namespace relight::render

@@ -1,0 +1,80 @@
+#pragma once
+// Shadow maps of the primary lights for the Vulkan DIR renderer (Knecht et al. 2010 use the
+// depth of each light's reflective shadow map). Every light is seen through one or six views:
+//   spot light, half-angle <= 75 deg  one perspective view along its axis;
+//   point light or wider spot          six cube faces (+x, -x, +y, -y, +z, -z);
+//   directional light                  one orthographic view over the scene's bounding sphere.
+// Each view is rendered twice, through the real and through the virtual layer, so that the
+// shading pass gets V_r and V_v separately (eqs. 5.1-5.5 need min(V_r, V_v) and V_r). A
+// directional light's virtual-layer view covers only the virtual objects' bounding sphere: the
+// virtual layer casts no shadow outside it, and an orthographic view over the whole room gives
+// a small object a few texels (256-texel tiles over a 5 m room: 2 cm each), which smeared its
+// contact shadow over the real surface around it.
+//
+// A texel stores the nearest surface's "light depth": the distance to the light for point and
+// spot lights, and the distance along the light's direction for a directional light
+// (light_depth()). Texels where nothing is seen hold kShadowEmpty.
+//
+// The atlas is one float image: `columns` tiles of `tile` x `tile` texels per row, the real
+// layer's views first (rows 0..rows-1) and then the virtual layer's. shadow_atlas_cpu() is the
+// ray-cast reference of the rasterised atlas (shadow_maps_vk.h); shadow_visibility() is the
+// lookup that the shading pass mirrors in GLSL (dir_shade.comp).
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "relight/render/scene/mr_scene.h"
+#include "relight/render/reference/ray_tracer.h"
+
+namespace relight::render {
+
+inline constexpr float kShadowEmpty = 1e30f;
+
+struct ShadowView {
+  Eigen::Matrix4f world_to_clip;  ///< Vulkan clip space: x right, y down, z in [0, 1]
+  /// w = 1: the light's position; w = 0: the unit direction towards the light.
+  Eigen::Vector4f eye;
+  /// World size of one texel at light depth 1 (perspective) or anywhere (orthographic, w = 0):
+  /// the receiver is pushed off its surface by a multiple of it before the lookup.
+  float texel_size = 0.f;
+};
+
+struct ShadowLayout {
+  int tile = 512;
+  int columns = 8;
+  std::vector<ShadowView> views;          ///< through the real layer
+  std::vector<ShadowView> virtual_views;  ///< through the virtual layer, one per entry of `views`
+  /// Per MrScene light: first view and view count (1 or 6).
+  std::vector<std::array<std::uint32_t, 2>> light_views;
+
+  [[nodiscard]] int rows() const { return (static_cast<int>(views.size()) + columns - 1) / columns; }
+  [[nodiscard]] int atlas_width() const { return columns * tile; }
+  /// Both layers; at least one row so that an empty atlas is still a valid image.
+  [[nodiscard]] int atlas_height() const { return 2 * std::max(rows(), 1) * tile; }
+  /// View `index` of layer 0 (real) or 1 (virtual).
+  [[nodiscard]] const ShadowView& view(std::size_t index, int layer) const {
+    return layer == 0 ? views[index] : virtual_views[index];
+  }
+  /// Top-left texel of view `view` in layer 0 (real) or 1 (virtual).
+  [[nodiscard]] std::array<int, 2> tile_origin(int view, int layer) const {
+    return {(view % columns) * tile, (layer * std::max(rows(), 1) + view / columns) * tile};
+  }
+};
+
+/// The views of every light of `scene` (tile: texels per side, at least 16).
+[[nodiscard]] ShadowLayout plan_shadow_views(const MrScene& scene, int tile = 512);
+
+/// What a texel of `view` stores for a surface at `point`.
+[[nodiscard]] float light_depth(const ShadowView& view, const Eigen::Vector3f& point);
+
+/// The atlas by casting one ray per texel centre through each layer (row-major floats).
+[[nodiscard]] std::vector<float> shadow_atlas_cpu(const RayTracer& tracer, const ShadowLayout& layout, int threads = 0);
+
+/// 1 when `point` (on a surface of unit normal `normal`, facing the light or not) is lit by light
+/// `light` through layer `layer` according to `atlas`, else 0. Points outside every view are lit.
+[[nodiscard]] float shadow_visibility(const ShadowLayout& layout, std::span<const float> atlas, std::uint32_t light,
+                                      int layer, const Eigen::Vector3f& point, const Eigen::Vector3f& normal);
+
+}  // namespace relight::render

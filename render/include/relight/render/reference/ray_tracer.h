@@ -1,0 +1,57 @@
+#pragma once
+// Ray queries against an MrScene with Embree 3, split into two acceleration structures: one of
+// the real meshes and one of the virtual meshes. Differential rendering needs every ray answered
+// both with and without the virtual objects; two scenes answer that with one query each (the
+// nearest hit of the whole scene is the nearer of the two), so no ray is traced twice.
+#include <Eigen/Core>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <optional>
+
+#include "relight/render/scene/mr_scene.h"
+
+namespace relight::render {
+
+enum class Layer { Real, Virtual };
+
+struct SurfaceHit {
+  float t = 0.f;
+  Eigen::Vector3f point;
+  Eigen::Vector3f geometric_normal;  ///< unit, as the triangle's winding gives it
+  Eigen::Vector3f shading_normal;    ///< unit, interpolated vertex normal (or the geometric one)
+  std::uint32_t material = 0;
+  bool real = true;
+};
+
+class RayTracer {
+ public:
+  /// Builds both acceleration structures; copies what shading needs from `scene`.
+  /// Throws relight::Error when the scene is invalid or Embree cannot start.
+  /// High: the slowest build and the fastest rays (Embree's spatial splits), for renderers
+  /// that trace millions of rays; Fast: a quick build for a scene that changes every frame and
+  /// sees few rays (the DIR stage's VPL generation on the reconstruction).
+  enum class Build { High, Fast };
+  explicit RayTracer(const MrScene& scene, Build build = Build::High);
+  ~RayTracer();
+  RayTracer(const RayTracer&) = delete;
+  RayTracer& operator=(const RayTracer&) = delete;
+
+  /// Nearest hit of `layer` along origin + t direction with t in (0, t_max); direction unit.
+  [[nodiscard]] std::optional<SurfaceHit> intersect(Layer layer, const Eigen::Vector3f& origin,
+                                                    const Eigen::Vector3f& direction,
+                                                    float t_max = std::numeric_limits<float>::infinity()) const;
+  /// Whether anything of `layer` lies along the ray with t in (0, t_max).
+  [[nodiscard]] bool occluded(Layer layer, const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
+                              float t_max) const;
+
+  [[nodiscard]] bool has_virtual_geometry() const;
+  /// The tracer's own copy of the scene (hits index its meshes and materials).
+  [[nodiscard]] const MrScene& scene() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace relight::render

@@ -1,0 +1,32 @@
+#pragma once
+// Reading and writing virtual-object models: OBJ/MTL (tinyobjloader) and glTF 2.0 (.gltf with
+// embedded or external buffers, .glb; tinygltf).
+//
+// Materials become Phong (k_d, k_s, n) or emissive:
+// - MTL: k_d = Kd, k_s = mean of Ks (highlights are white), n = Ns, emission = Ke.
+// - glTF: a material's extras {"relight_phong": {"kd": [r, g, b], "ks": s, "n": n}} are taken
+//   as they are (relight writes them, so its own models round-trip exactly). Otherwise the
+//   metallic-roughness parameters are mapped: k_d = baseColor (1 - metallic),
+//   k_s = 0.04 (1 - metallic) + luminance(baseColor) metallic, and the Phong exponent that
+//   matches a Beckmann lobe of slope alpha = roughness^2, n = 2 / alpha^2 - 2 (Walter et al.
+//   2007), clamped to [1, 10000]; emission = emissiveFactor times KHR_materials_emissive_strength.
+// Textures are ignored (the factor alone is used). Meshes keep the file's axes (y-up, see
+// virtual_model.h); glTF node transforms are applied.
+#include <filesystem>
+
+#include "relight/render/scene/virtual_model.h"
+
+namespace relight::render {
+
+/// Loads by extension (.obj, .gltf, .glb). Throws relight::Error with one line naming the file
+/// when it is missing, unreadable, malformed or holds no triangles.
+[[nodiscard]] VirtualModel load_model(const std::filesystem::path& path);
+[[nodiscard]] VirtualModel load_obj(const std::filesystem::path& path);
+[[nodiscard]] VirtualModel load_gltf(const std::filesystem::path& path);
+
+/// Writes an OBJ file and its MTL file (same stem) atomically.
+void save_obj(const std::filesystem::path& path, const VirtualModel& model);
+/// Writes a .gltf with the buffer embedded (base64) atomically, Phong parameters in extras.
+void save_gltf(const std::filesystem::path& path, const VirtualModel& model);
+
+}  // namespace relight::render

@@ -1,0 +1,214 @@
+// shade_dir_from_maps(): the CPU mirror of dir_shade.comp (see dir_vk.h). Keep the two in step.
+#include <algorithm>
+
+#include "relight/core/error.h"
+#include "relight/core/parallel.h"
+#include "relight/render/dir/dir_vk.h"
+#include "relight/render/scene/phong_brdf.h"
+#include "scene/surface_shading.h"
+
+namespace relight::render {
+namespace {
+
+using Vec3 = Eigen::Vector3f;
+
+struct Radiance {
+  Vec3 real_virtual = Vec3::Zero();  ///< direct + emission
+  Vec3 real = Vec3::Zero();
+  Vec3 indirect_real_virtual = Vec3::Zero();  ///< this pixel's VPL subset, scaled by n^2
+  Vec3 indirect_real = Vec3::Zero();
+};
+
+class MapShader {
+ public:
+  MapShader(const MrScene& scene, const ShadowLayout& layout, std::span<const float> shadow_atlas,
+            std::span<const Vpl> vpls, std::span<const float> ism_atlas, const Eigen::Vector4f& virtual_bounds,
+            const DirVkOptions& options)
+      : scene_(scene), layout_(layout), shadow_atlas_(shadow_atlas), vpls_(vpls),
+        ism_(ism_atlas, options.ism, vpls, virtual_bounds), options_(options) {}
+
+  [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
+                               float real_pixel, std::uint32_t subset) const {
+    Radiance out;
+    out.real_virtual = m.emission;
+    out.real = real_pixel * m.emission;
+    if (options_.shading.direct) add_direct(point, normal, wo, m, real_pixel, out);
+    if (options_.shading.indirect) add_indirect(point, normal, wo, m, real_pixel, subset, out);
+    return out;
+  }
+
+ private:
+  [[nodiscard]] bool want_rv() const { return options_.output != DirOutput::RealOnly; }
+  [[nodiscard]] bool want_r() const { return options_.output != DirOutput::RealVirtualOnly; }
+
+  void add_direct(const Vec3& point, const Vec3& n, const Vec3& wo, const PhongMaterial& m, float real_pixel,
+                  Radiance& out) const {
+    for (std::size_t l = 0; l < scene_.lights.size(); ++l) {
+      const MrLight& light = scene_.lights[l];
+      const std::optional<detail::LightSample> sample = detail::sample_light(light, point);
+      if (!sample) continue;
+      const float cos_i = sample->wi.dot(n);
+      if (cos_i <= 0.f) continue;
+      const Vec3 contribution = phong_brdf(m, n, sample->wi, wo).cwiseProduct(sample->irradiance) * cos_i;
+      const auto index = static_cast<std::uint32_t>(l);
+      if (shadow_visibility(layout_, shadow_atlas_, index, 0, point, n) == 0.f) continue;
+      if (want_rv()) out.real_virtual += contribution * shadow_visibility(layout_, shadow_atlas_, index, 1, point, n);
+      out.real += contribution * ((light.real ? 1.f : 0.f) * real_pixel);
+    }
+  }
+
+  void add_indirect(const Vec3& point, const Vec3& n, const Vec3& wo, const PhongMaterial& m, float real_pixel,
+                    std::uint32_t subset, Radiance& out) const {
+    const float min_distance2 = options_.shading.min_distance * options_.shading.min_distance;
+    const auto count = static_cast<std::uint32_t>(vpls_.size());
+    const auto subsets = static_cast<std::uint32_t>(options_.interleave * options_.interleave);
+    Vec3 rv = Vec3::Zero(), r = Vec3::Zero();
+    for (std::uint32_t j = subset; j < count; j += subsets) {
+      const Vpl& vpl = vpls_[j];
+      const bool in_rv = want_rv() && vpl.in_real_virtual;
+      const bool in_r = want_r() && vpl.in_real && real_pixel > 0.f;
+      if (!in_rv && !in_r) continue;
+      const Vec3 to_vpl = vpl.position - point;
+      const float distance2 = to_vpl.squaredNorm();
+      if (!(distance2 > 0.f)) continue;
+      const Vec3 wi = to_vpl / std::sqrt(distance2);
+      const float cos_x = wi.dot(n), cos_y = -wi.dot(vpl.normal);
+      if (cos_x <= 0.f || cos_y <= 0.f) continue;
+      const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(scene_.materials[vpl.material], vpl.normal, vpl.incident, -wi))
+                                    .cwiseProduct(phong_brdf(m, n, wi, wo)) *
+                                (cos_x * cos_y / std::max(distance2, min_distance2));
+      const IsmLookup::Visibility seen = ism_(j, point);
+      if (seen.real == 0.f) continue;
+      if (in_rv) rv += contribution * seen.virtual_;
+      if (in_r) r += contribution;
+    }
+    out.indirect_real_virtual = rv * static_cast<float>(subsets);
+    out.indirect_real = r * static_cast<float>(subsets);
+  }
+
+  const MrScene& scene_;
+  const ShadowLayout& layout_;
+  std::span<const float> shadow_atlas_;
+  std::span<const Vpl> vpls_;
+  IsmLookup ism_;
+  const DirVkOptions& options_;
+};
+
+/// Whether neighbour (qx, qy) may lend pixel (x, y) its indirect light: inside the image, on the
+/// same kind of surface, within 5 % of its distance and with a normal within ~25 degrees.
+bool similar(const GBuffer& g, int x, int y, int qx, int qy) {
+  if (qx < 0 || qy < 0 || qx >= g.distance.width() || qy >= g.distance.height()) return false;
+  const float distance = g.distance(y, x), dq = g.distance(qy, qx);
+  if (dq == 0.f || (g.virtual_surface(qy, qx) != 0) != (g.virtual_surface(y, x) != 0)) return false;
+  if (std::abs(dq - distance) > 0.05f * distance) return false;
+  return dot(g.normal(qy, qx), g.normal(y, x)) >= 0.9f;
+}
+
+/// merge_interleaved: dir_merge.comp's geometry-aware average of the indirect light, direct
+/// light added unblurred. The n x n window holds one pixel of every VPL subset; a subset whose
+/// pixel there is not similar is looked for one period further out (its 8 pixels at ±n), and
+/// the found pixels of a subset are averaged first, so that every subset found counts once.
+/// Without that search, a pixel next to an edge loses the same subsets as its neighbours, and
+/// their indirect light shows as light or dark blocks.
+Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, int y, int n) {
+  const Radiance& own = shaded(y, x);
+  Vec3 sum_rv = own.indirect_real_virtual, sum_r = own.indirect_real;
+  float weight = 1.f;
+  if (n > 1 && g.distance(y, x) != 0.f) {
+    for (int dy = -n / 2; dy < n - n / 2; ++dy)
+      for (int dx = -n / 2; dx < n - n / 2; ++dx) {
+        if (dx == 0 && dy == 0) continue;
+        const int qx = x + dx, qy = y + dy;
+        if (similar(g, x, y, qx, qy)) {
+          sum_rv += shaded(qy, qx).indirect_real_virtual;
+          sum_r += shaded(qy, qx).indirect_real;
+          weight += 1.f;
+          continue;
+        }
+        Vec3 subset_rv = Vec3::Zero(), subset_r = Vec3::Zero();
+        float found = 0.f;
+        for (int b = -1; b <= 1; ++b)
+          for (int a = -1; a <= 1; ++a) {
+            const int sx = qx + a * n, sy = qy + b * n;
+            if ((a == 0 && b == 0) || !similar(g, x, y, sx, sy)) continue;
+            subset_rv += shaded(sy, sx).indirect_real_virtual;
+            subset_r += shaded(sy, sx).indirect_real;
+            found += 1.f;
+          }
+        if (found == 0.f) continue;
+        sum_rv += subset_rv / found;
+        sum_r += subset_r / found;
+        weight += 1.f;
+      }
+  }
+  Radiance out;
+  out.indirect_real_virtual = sum_rv / weight;
+  out.indirect_real = sum_r / weight;
+  out.real_virtual = own.real_virtual + out.indirect_real_virtual;
+  out.real = own.real + out.indirect_real;
+  return out;
+}
+
+}  // namespace
+
+DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene, const Vec3& camera_centre,
+                                       const ShadowLayout& layout, std::span<const float> shadow_atlas,
+                                       std::span<const Vpl> vpls, std::span<const float> ism_atlas,
+                                       const Eigen::Vector4f& virtual_bounds, const DirVkOptions& options) {
+  const int width = gbuffer.position.width(), height = gbuffer.position.height();
+  if (shadow_atlas.size() < static_cast<std::size_t>(layout.atlas_width()) * static_cast<std::size_t>(layout.atlas_height()))
+    throw Error("shade_dir_from_maps: the shadow atlas is smaller than its layout");
+  const std::size_t ism_texels = 2 * vpls.size() * static_cast<std::size_t>(options.ism.tile) * static_cast<std::size_t>(options.ism.tile);
+  if (ism_atlas.size() < ism_texels) throw Error("shade_dir_from_maps: the ISM atlas is smaller than its VPLs need");
+  if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
+  const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, virtual_bounds, options);
+  const Vec3 environment = scene.environment.radiance;
+  const int n = options.interleave;
+  Image<Radiance> shaded(width, height);
+  parallel_rows(height, options.shading.threads, [&](int begin, int end) {
+    for (int y = begin; y < end; ++y)
+      for (int x = 0; x < width; ++x) {
+        if (gbuffer.distance(y, x) == 0.f) {
+          shaded(y, x).real_virtual = shaded(y, x).real = environment;
+          continue;
+        }
+        const auto& p = gbuffer.position(y, x);
+        const auto& nn = gbuffer.normal(y, x);
+        const Vec3 point(p.x, p.y, p.z), normal(nn.x, nn.y, nn.z);
+        const float real_pixel = gbuffer.virtual_surface(y, x) ? 0.f : 1.f;
+        const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));
+        shaded(y, x) = shader.shade(point, normal, (camera_centre - point).normalized(),
+                                    scene.materials[gbuffer.material(y, x) - 1u], real_pixel, subset);
+      }
+  }, 4);
+  DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,
+                         RadianceImage(width, height), RadianceImage(width, height)};
+  parallel_rows(height, options.shading.threads, [&](int begin, int end) {
+    for (int y = begin; y < end; ++y)
+      for (int x = 0; x < width; ++x) {
+        const Radiance r = merged_pixel(gbuffer, shaded, x, y, n);
+        out.real_virtual(y, x) = {r.real_virtual.x(), r.real_virtual.y(), r.real_virtual.z()};
+        out.real(y, x) = {r.real.x(), r.real.y(), r.real.z()};
+        out.indirect_real_virtual(y, x) = {r.indirect_real_virtual.x(), r.indirect_real_virtual.y(), r.indirect_real_virtual.z()};
+        out.indirect_real(y, x) = {r.indirect_real.x(), r.indirect_real.y(), r.indirect_real.z()};
+        out.virtual_coverage(y, x) = gbuffer.distance(y, x) != 0.f && gbuffer.virtual_surface(y, x) ? 1.f : 0.f;
+      }
+  }, 8);
+  return out;
+}
+
+DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
+                                  const DirVkOptions& options, GBuffer* gbuffer_out) {
+  const RayTracer tracer(scene);
+  GBuffer local;
+  GBuffer& gbuffer = gbuffer_out ? *gbuffer_out : local;
+  gbuffer = gbuffer_cpu(tracer, camera, options.shading.threads);
+  const ShadowLayout layout = plan_shadow_views(scene, options.shadow_tile);
+  const std::vector<float> shadow_atlas = shadow_atlas_cpu(tracer, layout, options.shading.threads);
+  const IsmPointPools points = sample_ism_points(scene, options.ism);
+  const std::vector<float> ism_atlas = ism_atlas_cpu(points, vpls, options.ism);
+  return shade_dir_from_maps(gbuffer, scene, camera.camera_to_world.translation().cast<float>(), layout, shadow_atlas,
+                             vpls, ism_atlas, points.virtual_bounds, options);
+}
+
+}  // namespace relight::render

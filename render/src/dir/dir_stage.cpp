@@ -1,0 +1,223 @@
+#include "relight/render/dir/dir_stage.h"
+
+#include "relight/core/error.h"
+#include "relight/render/dir/camera_albedo.h"
+#include "relight/render/dir/composite.h"
+#include "relight/render/reference/ray_tracer.h"
+
+namespace relight::render {
+
+namespace {
+
+/// The clusters as MrScene materials (index = cluster), and the fallback for pixels without one.
+void add_cluster_materials(MrScene& scene, const brdf::Materials& materials, DepthMeshMaterials& mesh_materials,
+                           const PhongMaterial& fallback) {
+  Eigen::Vector3f weighted = Eigen::Vector3f::Zero();
+  float pixels = 0.f;
+  mesh_materials.material_of_label.push_back(0);  // label 0: no cluster, replaced below
+  for (std::size_t i = 0; i < materials.clusters.size(); ++i) {
+    const brdf::MaterialParams& c = materials.clusters[i];
+    mesh_materials.material_of_label.push_back(
+        scene.add_material({"cluster " + std::to_string(i), c.kd, c.ks, std::max(c.n, 1.f), Eigen::Vector3f::Zero()}));
+    weighted += static_cast<float>(c.pixels) * c.kd;
+    pixels += static_cast<float>(c.pixels);
+  }
+  PhongMaterial unclustered = fallback;
+  unclustered.name = "unclustered";
+  if (pixels > 0.f) unclustered.kd = weighted / pixels;
+  mesh_materials.material = scene.add_material(unclustered);
+  mesh_materials.material_of_label[0] = mesh_materials.material;
+  mesh_materials.labels = &materials.ids;
+}
+
+/// The frame's camera for images of the given size.
+MrCamera frame_camera(const FrameInfo& frame, int width, int height) {
+  MrCamera camera{frame.intrinsics, frame.camera_to_world.value_or(Pose::Identity())};
+  camera.intrinsics.width = width;
+  camera.intrinsics.height = height;
+  return camera;
+}
+
+}  // namespace
+
+void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneContent content,
+                    const DirStageOptions& options) {
+  graph.emplace<MrSceneStage>(std::move(content), options);
+  graph.emplace<VplStage>(options.vpls, context);
+  graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffer);
+  graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
+  graph.emplace<DifferentialCompositeStage>(options.tone_map);
+}
+
+// ---- mr_scene ----------------------------------------------------------------------------------
+
+MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& options)
+    : content_(std::move(content)),
+      mesh_(options.mesh),
+      reconstruction_material_(options.reconstruction_material),
+      materials_buffer_(options.materials_buffer),
+      placements_buffer_(options.placements_buffer) {}
+
+void MrSceneStage::declare(StageBuilder& builder) {
+  frame_ = builder.read<FrameInfo>("frame");
+  positions_ = builder.read<PositionMap>("positions");
+  normals_ = builder.read<NormalMap>("normals");
+  if (!materials_buffer_.empty()) materials_ = builder.read<brdf::Materials>(materials_buffer_);
+  if (!placements_buffer_.empty()) placements_ = builder.read<ObjectPlacements>(placements_buffer_);
+  scene_ = builder.write<MrScene>("mr_scene");
+}
+
+void MrSceneStage::run(StageContext& context) {
+  const PositionMap& positions = context.get(positions_);
+  const brdf::Materials* cluster_materials = materials_buffer_.empty() ? nullptr : &context.get(materials_);
+  MrScene& scene = context.get(scene_);
+  scene = MrScene{};
+  DepthMeshMaterials materials;
+  if (cluster_materials && cluster_materials->ids.width() == positions.width() &&
+      cluster_materials->ids.height() == positions.height())
+    add_cluster_materials(scene, *cluster_materials, materials, reconstruction_material_);
+  else
+    materials.material = scene.add_material(reconstruction_material_);
+  const Pose camera_to_world = context.get(frame_).camera_to_world.value_or(Pose::Identity());
+  TriangleMesh mesh = mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, mesh_);
+  mesh.name = "reconstruction";
+  scene.meshes.push_back(std::move(mesh));
+  scene.lights = content_.lights;
+  if (placements_buffer_.empty()) {
+    for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
+    return;
+  }
+  const ObjectPlacements& placements = context.get(placements_);
+  if (!placements.resolved) return;
+  if (placements.placements.size() != content_.objects.size())
+    throw LogicError("mr_scene: " + std::to_string(placements.placements.size()) + " placements for " +
+                     std::to_string(content_.objects.size()) + " objects");
+  for (std::size_t i = 0; i < content_.objects.size(); ++i)
+    add_virtual_model(scene, content_.objects[i].first, placements.placements[i]);
+}
+
+// ---- vpls --------------------------------------------------------------------------------------
+
+VplStage::VplStage(VplOptions options, vk::VulkanContext* context) : options_(std::move(options)) {
+  if (context && options_.bounces > 1 && options_.bounce_method == BounceMethod::PointCone)
+    cone_search_ = std::make_unique<ConeSearchVk>(*context);
+  if (context && options_.source == VplSource::ReflectiveShadowMaps)
+    reflective_shadow_maps_ = std::make_unique<ReflectiveShadowMapsVk>(*context);
+}
+
+VplStage::~VplStage() = default;
+
+void VplStage::declare(StageBuilder& builder) {
+  scene_ = builder.read<MrScene>("mr_scene");
+  if (options_.budget == VplBudget::ByPreviousFlux) previous_ = builder.read_previous<VplSet>("vpls");
+  vpls_ = builder.write<VplSet>("vpls");
+}
+
+void VplStage::run(StageContext& context) {
+  const MrScene& scene = context.get(scene_);
+  if (options_.budget == VplBudget::ByPreviousFlux) {
+    const VplSet* previous = context.get(previous_);
+    options_.previous_flux = previous ? vpl_flux_per_light(previous->vpls, scene.lights.size()) : std::vector<double>{};
+  }
+  if (reflective_shadow_maps_) reflective_shadow_maps_->set_scene(scene);
+  context.get(vpls_).vpls = generate_vpls(scene, RayTracer(scene, RayTracer::Build::Fast), options_,
+                                          {.cone_search = cone_search_.get(),
+                                           .reflective_shadow_maps = reflective_shadow_maps_.get()});
+}
+
+// ---- dir ---------------------------------------------------------------------------------------
+
+DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirVkOptions options, std::string albedo_buffer)
+    : context_(context), options_(std::move(options)), albedo_buffer_(std::move(albedo_buffer)) {}
+
+DirRenderStage::~DirRenderStage() = default;
+
+void DirRenderStage::declare(StageBuilder& builder) {
+  frame_ = builder.read<FrameInfo>("frame");
+  color_ = builder.read<ColorImage>("color");
+  positions_ = builder.read<PositionMap>("positions");
+  scene_ = builder.read<MrScene>("mr_scene");
+  vpls_ = builder.read<VplSet>("vpls");
+  if (!albedo_buffer_.empty()) {
+    albedo_ = builder.read<RadianceImage>(albedo_buffer_);
+    albedo_valid_ = builder.read<Mask>(albedo_buffer_ + "_valid");
+  }
+  images_ = builder.write<DifferentialImages>("dir_images");
+  gbuffer_ = builder.write<GBuffer>("dir_gbuffer");
+}
+
+void DirRenderStage::run(StageContext& context) {
+  const ColorImage& color = context.get(color_);
+  const int width = color.width(), height = color.height();
+  const PositionMap& positions = context.get(positions_);
+  if (positions.width() != width || positions.height() != height)
+    throw Error("dir: the colour image (" + std::to_string(width) + "x" + std::to_string(height) +
+                ") and the position map (" + std::to_string(positions.width()) + "x" +
+                std::to_string(positions.height()) + ") differ in size");
+  const MrCamera camera = frame_camera(context.get(frame_), width, height);
+  const MrScene& scene = context.get(scene_);
+  const std::vector<Vpl>& vpls = context.get(vpls_).vpls;
+  DifferentialImages& images = context.get(images_);
+  GBuffer& gbuffer = context.get(gbuffer_);
+  if (!context_) {
+    images = render_dir_cpu(scene, camera, vpls, options_, &gbuffer);
+  } else {
+    if (!renderer_ || renderer_size_ != std::pair{width, height}) {
+      renderer_ = std::make_unique<DirRendererVk>(*context_, width, height);
+      renderer_size_ = {width, height};
+    }
+    renderer_->set_scene(scene, options_);
+    images = renderer_->render(camera, vpls, options_);
+    gbuffer = renderer_->last_gbuffer();
+  }
+  if (!albedo_buffer_.empty()) {
+    modulate_camera_albedo(images, gbuffer, scene, context.get(albedo_), context.get(albedo_valid_));
+  }
+}
+
+// ---- indirect_smoothing ------------------------------------------------------------------------
+
+void IndirectSmoothingStage::declare(StageBuilder& builder) {
+  images_ = builder.read<DifferentialImages>("dir_images");
+  gbuffer_ = builder.read<GBuffer>("dir_gbuffer");
+  frame_ = builder.read<FrameInfo>("frame");
+  real_virtual_ = builder.write<RadianceImage>("L_rv");
+  real_ = builder.write<RadianceImage>("L_r");
+  indirect_ = builder.write<RadianceImage>("L_rv_indirect");
+  coverage_ = builder.write<CoverageImage>("virtual_coverage");
+}
+
+void IndirectSmoothingStage::run(StageContext& context) {
+  DifferentialImages images = context.get(images_);
+  if (enabled_) {
+    const MrCamera camera = frame_camera(context.get(frame_), images.real_virtual.width(), images.real_virtual.height());
+    history_ = smooth_indirect(images, context.get(gbuffer_), camera, history_ ? &*history_ : nullptr, options_);
+  }
+  context.get(real_virtual_) = std::move(images.real_virtual);
+  context.get(real_) = std::move(images.real);
+  context.get(indirect_) = std::move(images.indirect_real_virtual);
+  context.get(coverage_) = std::move(images.virtual_coverage);
+}
+
+// ---- differential_composite --------------------------------------------------------------------
+
+void DifferentialCompositeStage::declare(StageBuilder& builder) {
+  color_ = builder.read<ColorImage>("color");
+  real_virtual_ = builder.read<RadianceImage>("L_rv");
+  real_ = builder.read<RadianceImage>("L_r");
+  coverage_ = builder.read<CoverageImage>("virtual_coverage");
+  composite_ = builder.write<ColorImage>("composite");
+}
+
+void DifferentialCompositeStage::run(StageContext& context) {
+  const ColorImage& color = context.get(color_);
+  const RadianceImage& real_virtual = context.get(real_virtual_);
+  if (color.width() != real_virtual.width() || color.height() != real_virtual.height())
+    throw Error("differential_composite: the colour image (" + std::to_string(color.width()) + "x" +
+                std::to_string(color.height()) + ") and the rendered image (" + std::to_string(real_virtual.width()) +
+                "x" + std::to_string(real_virtual.height()) + ") differ in size");
+  context.get(composite_) =
+      differential_composite(color, real_virtual, context.get(real_), context.get(coverage_), tone_map_);
+}
+
+}  // namespace relight::render

@@ -1,0 +1,288 @@
+#include "relight/render/dir/dir_vk.h"
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <cstring>
+#include <optional>
+
+#include "dir/ism_vk.h"
+#include "relight/core/error.h"
+#include "relight/render/dir/gbuffer_vk.h"
+#include "relight/shaders/dir_merge_comp.h"
+#include "relight/shaders/dir_shade_comp.h"
+#include "relight/vk/barrier.h"
+#include "relight/vk/buffer.h"
+#include "relight/vk/compute_pipeline.h"
+#include "relight/vk/context.h"
+#include "relight/vk/timer.h"
+#include "relight/vk/transfer.h"
+#include "dir/shadow_maps_vk.h"
+
+namespace relight::render {
+namespace detail {
+
+struct ShadeParams {
+  std::uint32_t width, height, light_count, vpl_count;
+  std::int32_t shadow_tile, shadow_columns, shadow_rows, ism_tile;
+  float min_distance;
+  std::uint32_t flags, interleave, pad = 0;
+  float camera_centre[4];
+  float environment[4];
+  float virtual_bounds[4];
+};
+static_assert(sizeof(ShadeParams) <= 128);
+
+struct MergeParams {
+  std::uint32_t width, height, interleave;
+};
+
+}  // namespace detail
+
+namespace {
+
+using detail::MergeParams;
+using detail::ShadeParams;
+
+float bits(std::uint32_t value) { return std::bit_cast<float>(value); }
+
+std::vector<float> pack_materials(const MrScene& scene) {
+  std::vector<float> out;
+  for (const PhongMaterial& m : scene.materials)
+    out.insert(out.end(), {m.kd.x(), m.kd.y(), m.kd.z(), m.ks, m.emission.x(), m.emission.y(), m.emission.z(), m.n});
+  return out;
+}
+
+std::vector<float> pack_lights(const MrScene& scene, const ShadowLayout& layout) {
+  std::vector<float> out;
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+    const MrLight& l = scene.lights[i];
+    const Eigen::Vector3f d = l.direction.normalized();
+    const auto kind = static_cast<std::uint32_t>(l.kind == LightKind::Point ? 0 : l.kind == LightKind::Spot ? 1 : 2);
+    out.insert(out.end(), {l.position.x(), l.position.y(), l.position.z(), bits(kind), d.x(), d.y(), d.z(),
+                           l.real ? 1.f : 0.f, l.intensity.x(), l.intensity.y(), l.intensity.z(), l.cos_inner,
+                           l.cos_outer, bits(layout.light_views[i][0]), bits(layout.light_views[i][1]), 0.f});
+  }
+  return out;
+}
+
+/// The real layer's views, padded to rows x columns, then the virtual layer's: the shader finds
+/// view i of layer l at i + l x rows x columns (dir_shade.comp, shadow_visibility).
+std::vector<float> pack_views(const ShadowLayout& layout) {
+  std::vector<float> out;
+  const std::size_t slots = static_cast<std::size_t>(std::max(layout.rows(), 1) * layout.columns);
+  for (int layer = 0; layer < 2; ++layer) {
+    for (std::size_t i = 0; i < slots; ++i) {
+      const ShadowView v = i < layout.views.size() ? layout.view(i, layer) : ShadowView{Eigen::Matrix4f::Zero(), {}, 0.f};
+      out.insert(out.end(), v.world_to_clip.data(), v.world_to_clip.data() + 16);
+      out.insert(out.end(), {v.eye.x(), v.eye.y(), v.eye.z(), v.eye.w(), v.texel_size, 0.f, 0.f, 0.f});
+    }
+  }
+  return out;
+}
+
+std::vector<float> pack_vpls(std::span<const Vpl> vpls) {
+  std::vector<float> out;
+  out.reserve(vpls.size() * 16);
+  for (const Vpl& v : vpls) {
+    const std::uint32_t flags = (v.on_real_surface ? 1u : 0u) | (v.in_real_virtual ? 2u : 0u) | (v.in_real ? 4u : 0u);
+    out.insert(out.end(), {v.position.x(), v.position.y(), v.position.z(), bits(v.material), v.normal.x(), v.normal.y(),
+                           v.normal.z(), bits(flags), v.incident.x(), v.incident.y(), v.incident.z(), 0.f, v.flux.x(),
+                           v.flux.y(), v.flux.z(), 0.f});
+  }
+  return out;
+}
+
+std::uint32_t shade_flags(const DirVkOptions& options) {
+  const bool rv = options.output != DirOutput::RealOnly, r = options.output != DirOutput::RealVirtualOnly;
+  return (options.shading.direct ? 1u : 0u) | (options.shading.indirect ? 2u : 0u) | (rv ? 4u : 0u) | (r ? 8u : 0u);
+}
+
+}  // namespace
+
+struct DirRendererVk::Impl {
+  Impl(vk::VulkanContext& context, int width, int height)
+      : context(context),
+        width(width),
+        height(height),
+        gbuffer(context, width, height),
+        shadow_maps(context),
+        ism(context),
+        shade(context, {.spirv = shaders::dir_shade_comp, .storage_buffers = 8,
+                        .push_constant_bytes = sizeof(ShadeParams), .max_descriptor_sets = 2}),
+        merge(context, {.spirv = shaders::dir_merge_comp, .storage_buffers = 3,
+                        .push_constant_bytes = sizeof(MergeParams), .max_descriptor_sets = 2}),
+        gbuffer_buffer(context, GBufferVk::packed_bytes(width, height)),
+        shaded(context, 16 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
+        output(context, 16 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
+        merge_set(merge.bind({&gbuffer_buffer, &shaded, &output})),
+        timers{vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context),
+               vk::GpuTimer(context), vk::GpuTimer(context)} {}
+
+  /// `slot` holds at least `data` (grown, never shrunk) with `data` uploaded.
+  void upload(std::unique_ptr<vk::VulkanBuffer>& slot, const std::vector<float>& data) {
+    const std::size_t bytes = std::max<std::size_t>(data.size(), 4) * sizeof(float);
+    if (!slot || slot->size_bytes() < bytes) slot = std::make_unique<vk::VulkanBuffer>(context, bytes);
+    if (!data.empty()) context.transfer().upload(std::as_bytes(std::span(data)), *slot);
+  }
+
+  vk::VulkanContext& context;
+  int width, height;
+  GBufferVk gbuffer;
+  detail::ShadowMapsVk shadow_maps;
+  detail::IsmVk ism;
+  vk::ComputePipeline shade, merge;
+  vk::VulkanBuffer gbuffer_buffer, shaded, output;
+  vk::UniqueDescriptorSet merge_set;
+  std::unique_ptr<vk::VulkanBuffer> materials, lights, views, vpls;
+  vk::UniqueDescriptorSet shade_set;
+  std::array<vk::GpuTimer, 6> timers;
+  std::optional<MrScene> scene;
+  ShadowLayout layout;
+  IsmPointPools points;
+  DirVkTimings timings;
+  std::uint32_t vpl_count = 0;
+  std::vector<float> cpu_ism_atlas;  // of the last render when it shaded on the CPU
+  std::optional<GBuffer> last_gbuffer;  // read back on demand, dropped by the next render
+};
+
+DirRendererVk::DirRendererVk(vk::VulkanContext& context, int width, int height) {
+  if (width <= 0 || height <= 0) throw Error("the render size must be positive");
+  impl_ = std::make_unique<Impl>(context, width, height);
+}
+
+DirRendererVk::~DirRendererVk() = default;
+
+void DirRendererVk::set_scene(const MrScene& scene, const DirVkOptions& options) {
+  Impl& d = *impl_;
+  scene.validate();
+  d.gbuffer.set_scene(scene);
+  d.shadow_maps.set_scene(scene);
+  d.layout = plan_shadow_views(scene, options.shadow_tile);
+  d.points = sample_ism_points(scene, options.ism);
+  d.ism.set_points(d.points);
+  d.upload(d.materials, pack_materials(scene));
+  d.upload(d.lights, pack_lights(scene, d.layout));
+  d.upload(d.views, pack_views(d.layout));
+  d.scene = scene;
+}
+
+DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const Vpl> vpls, const DirVkOptions& options) {
+  Impl& d = *impl_;
+  if (!d.scene) throw LogicError("DirRendererVk::set_scene must come before render");
+  if (options.shadow_tile != d.layout.tile) throw Error("DirRendererVk: the shadow tile differs from set_scene's");
+  if (!(options.shading.min_distance > 0.f)) throw Error("the VPL clamp distance must be positive");
+  if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
+  d.upload(d.vpls, pack_vpls(vpls));
+  d.vpl_count = static_cast<std::uint32_t>(vpls.size());
+  d.last_gbuffer.reset();
+
+  const Eigen::Vector3f centre = camera.camera_to_world.translation().cast<float>();
+  const Eigen::Vector3f environment = d.scene->environment.radiance;
+  const ShadeParams params{static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
+                           static_cast<std::uint32_t>(d.scene->lights.size()), d.vpl_count, d.layout.tile,
+                           d.layout.columns, d.layout.rows(), options.ism.tile, options.shading.min_distance,
+                           shade_flags(options), static_cast<std::uint32_t>(options.interleave), 0,
+                           {centre.x(), centre.y(), centre.z(), 1.f},
+                           {environment.x(), environment.y(), environment.z(), 0.f},
+                           {d.points.virtual_bounds.x(), d.points.virtual_bounds.y(), d.points.virtual_bounds.z(),
+                            d.points.virtual_bounds.w()}};
+  const bool cpu_shading =
+      options.backend == DirBackend::Cpu || (options.backend == DirBackend::Auto && d.context.is_cpu_device());
+  d.context.submit([&](VkCommandBuffer cmd) {
+    d.timers[5].start(cmd);
+    d.timers[0].start(cmd);
+    d.gbuffer.record(cmd, camera, d.gbuffer_buffer);
+    d.timers[0].stop(cmd);
+    d.timers[1].start(cmd);
+    d.shadow_maps.record(cmd, d.layout);
+    d.timers[1].stop(cmd);
+    if (!cpu_shading) record_shading(cmd, params, options);
+    d.timers[5].stop(cmd);
+  });
+  const auto ms = [&](std::size_t k) { return d.timers[k].elapsed_ms().value_or(0.0); };
+  d.timings = {ms(0), ms(1), ms(2), ms(3), ms(4), ms(5), cpu_shading};
+  if (cpu_shading) return shade_on_cpu(camera, vpls, options);
+
+  std::vector<float> radiance(static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) * 16);
+  d.context.transfer().download(d.output, std::as_writable_bytes(std::span(radiance)));
+  DifferentialImages out{RadianceImage(d.width, d.height), RadianceImage(d.width, d.height), CoverageImage(d.width, d.height), 1,
+                         RadianceImage(d.width, d.height), RadianceImage(d.width, d.height)};
+  for (std::size_t i = 0; i < out.real.pixels().size(); ++i) {
+    const float* p = &radiance[16 * i];
+    out.real_virtual.pixels()[i] = {p[0], p[1], p[2]};
+    out.virtual_coverage.pixels()[i] = p[3];
+    out.real.pixels()[i] = {p[4], p[5], p[6]};
+    out.indirect_real_virtual.pixels()[i] = {p[8], p[9], p[10]};
+    out.indirect_real.pixels()[i] = {p[12], p[13], p[14]};
+  }
+  return out;
+}
+
+void DirRendererVk::record_shading(VkCommandBuffer cmd, const detail::ShadeParams& params, const DirVkOptions& options) {
+  Impl& d = *impl_;
+  d.timers[2].start(cmd);
+  d.ism.record(cmd, *d.vpls, d.vpl_count, options.ism);
+  d.timers[2].stop(cmd);
+  vk::compute_barrier(cmd);
+  d.shade_set = {};
+  d.shade_set = d.shade.bind({&d.gbuffer_buffer, d.materials.get(), d.lights.get(), d.views.get(),
+                              &d.shadow_maps.atlas(), d.vpls.get(), &d.ism.atlas(), &d.shaded});
+  const auto n = static_cast<std::uint32_t>(options.interleave);
+  d.timers[3].start(cmd);
+  d.shade.dispatch(cmd, d.shade_set, params, vk::ComputePipeline::group_count((params.width + n - 1) / n * n, 8),
+                   vk::ComputePipeline::group_count((params.height + n - 1) / n * n, 8));
+  d.timers[3].stop(cmd);
+  vk::compute_barrier(cmd);
+  d.timers[4].start(cmd);
+  d.merge.dispatch(cmd, d.merge_set, detail::MergeParams{params.width, params.height, n},
+                   vk::ComputePipeline::group_count(params.width, 8), vk::ComputePipeline::group_count(params.height, 8));
+  d.timers[4].stop(cmd);
+}
+
+DifferentialImages DirRendererVk::shade_on_cpu(const MrCamera& camera, std::span<const Vpl> vpls,
+                                               const DirVkOptions& options) {
+  Impl& d = *impl_;
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  d.cpu_ism_atlas = ism_atlas_cpu(d.points, vpls, options.ism);
+  const auto ism_done = Clock::now();
+  DifferentialImages out = shade_dir_from_maps(last_gbuffer(), *d.scene, camera.camera_to_world.translation().cast<float>(),
+                                               d.layout, last_shadow_atlas(), vpls, d.cpu_ism_atlas,
+                                               d.points.virtual_bounds, options);
+  const auto done = Clock::now();
+  d.timings.ism_ms = std::chrono::duration<double, std::milli>(ism_done - start).count();
+  d.timings.shading_ms = std::chrono::duration<double, std::milli>(done - ism_done).count();
+  d.timings.total_ms += std::chrono::duration<double, std::milli>(done - start).count();
+  return out;
+}
+
+const DirVkTimings& DirRendererVk::last_timings() const { return impl_->timings; }
+const ShadowLayout& DirRendererVk::shadow_layout() const { return impl_->layout; }
+const IsmPointPools& DirRendererVk::ism_points() const { return impl_->points; }
+
+const GBuffer& DirRendererVk::last_gbuffer() const {
+  // Read back once per render: the CPU backend shades from it and the DIR stage smooths with it.
+  if (!impl_->last_gbuffer) {
+    std::vector<float> data(impl_->gbuffer_buffer.size_bytes() / sizeof(float));
+    impl_->context.transfer().download(impl_->gbuffer_buffer, std::as_writable_bytes(std::span(data)));
+    impl_->last_gbuffer = GBufferVk::unpack(data, impl_->width, impl_->height);
+  }
+  return *impl_->last_gbuffer;
+}
+
+std::vector<float> DirRendererVk::last_shadow_atlas() const {
+  std::vector<float> data(static_cast<std::size_t>(impl_->layout.atlas_width()) *
+                          static_cast<std::size_t>(impl_->layout.atlas_height()));
+  impl_->context.transfer().download(impl_->shadow_maps.atlas(), std::as_writable_bytes(std::span(data)));
+  return data;
+}
+
+std::vector<float> DirRendererVk::last_ism_atlas() const {
+  if (impl_->timings.cpu_shading) return impl_->cpu_ism_atlas;
+  std::vector<float> data(impl_->ism.atlas().size_bytes() / sizeof(float));
+  impl_->context.transfer().download(impl_->ism.atlas(), std::as_writable_bytes(std::span(data)));
+  return data;
+}
+
+}  // namespace relight::render

@@ -1,0 +1,207 @@
+#include "dir/mesh_raster_vk.h"
+
+#include <algorithm>
+#include <array>
+#include <vector>
+
+#include "relight/vk/check.h"
+#include "relight/vk/context.h"
+#include "relight/vk/storage_buffer_sets.h"  // create_shader_module
+
+namespace relight::render::detail {
+
+SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers) {
+  scene.validate();
+  std::vector<RasterVertex> vertices;
+  for (const TriangleMesh& mesh : scene.meshes) {
+    if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const std::uint32_t info = mesh.triangle_material[t] | (mesh.real ? 0u : 0x80000000u);
+      const auto& tri = mesh.triangles[t];
+      Eigen::Vector3f flat = Eigen::Vector3f::Zero();
+      if (mesh.normals.empty())
+        flat = (mesh.positions[tri[1]] - mesh.positions[tri[0]]).cross(mesh.positions[tri[2]] - mesh.positions[tri[0]]).normalized();
+      for (std::uint32_t v : tri) {
+        const Eigen::Vector3f& p = mesh.positions[v];
+        const Eigen::Vector3f n = mesh.normals.empty() ? flat : mesh.normals[v];
+        vertices.push_back({{p.x(), p.y(), p.z()}, {n.x(), n.y(), n.z()}, info});
+      }
+    }
+  }
+  SceneVertices out;
+  out.buffer = std::make_unique<vk::VulkanBuffer>(context, std::max<std::size_t>(4, vertices.size() * sizeof(RasterVertex)),
+                                                  vk::BufferDomain::Upload, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  if (!vertices.empty()) out.buffer->write(std::as_bytes(std::span(vertices)));
+  out.count = static_cast<std::uint32_t>(vertices.size());
+  return out;
+}
+
+vk::UniqueRenderPass create_raster_pass(VkDevice device, std::span<const VkFormat> colour_formats, VkFormat depth_format) {
+  std::vector<VkAttachmentDescription> attachments;
+  std::vector<VkAttachmentReference> colour;
+  for (VkFormat format : colour_formats) {
+    colour.push_back({static_cast<std::uint32_t>(attachments.size()), VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL});
+    attachments.push_back({0, format, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_CLEAR, VK_ATTACHMENT_STORE_OP_STORE,
+                           VK_ATTACHMENT_LOAD_OP_DONT_CARE, VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_UNDEFINED,
+                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL});
+  }
+  const VkAttachmentReference depth{static_cast<std::uint32_t>(attachments.size()),
+                                    VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL};
+  attachments.push_back({0, depth_format, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_CLEAR,
+                         VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                         VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL});
+  VkSubpassDescription subpass{};
+  subpass.pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS;
+  subpass.colorAttachmentCount = static_cast<std::uint32_t>(colour.size());
+  subpass.pColorAttachments = colour.data();
+  subpass.pDepthStencilAttachment = &depth;
+  // Earlier copies out of the targets finish before the pass writes them; the pass's writes
+  // finish before the copies that follow it.
+  const std::array<VkSubpassDependency, 2> dependencies{{
+      {VK_SUBPASS_EXTERNAL, 0, VK_PIPELINE_STAGE_TRANSFER_BIT,
+       VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT,
+       VK_ACCESS_TRANSFER_READ_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, 0},
+      {0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+       VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT, 0},
+  }};
+  VkRenderPassCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO;
+  info.attachmentCount = static_cast<std::uint32_t>(attachments.size());
+  info.pAttachments = attachments.data();
+  info.subpassCount = 1;
+  info.pSubpasses = &subpass;
+  info.dependencyCount = static_cast<std::uint32_t>(dependencies.size());
+  info.pDependencies = dependencies.data();
+  VkRenderPass pass = VK_NULL_HANDLE;
+  RELIGHT_VK_CHECK(vkCreateRenderPass(device, &info, nullptr, &pass));
+  return vk::UniqueRenderPass(device, pass);
+}
+
+vk::UniqueFramebuffer create_framebuffer(VkDevice device, VkRenderPass pass, std::span<const VkImageView> views,
+                                         std::uint32_t width, std::uint32_t height) {
+  VkFramebufferCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO;
+  info.renderPass = pass;
+  info.attachmentCount = static_cast<std::uint32_t>(views.size());
+  info.pAttachments = views.data();
+  info.width = width;
+  info.height = height;
+  info.layers = 1;
+  VkFramebuffer raw = VK_NULL_HANDLE;
+  RELIGHT_VK_CHECK(vkCreateFramebuffer(device, &info, nullptr, &raw));
+  return vk::UniqueFramebuffer(device, raw);
+}
+
+namespace {
+
+vk::UniquePipelineLayout create_layout(VkDevice device, std::uint32_t push_constant_bytes) {
+  const VkPushConstantRange push{VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0, push_constant_bytes};
+  VkPipelineLayoutCreateInfo info{};
+  info.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+  info.pushConstantRangeCount = push_constant_bytes > 0 ? 1 : 0;
+  info.pPushConstantRanges = &push;
+  VkPipelineLayout raw = VK_NULL_HANDLE;
+  RELIGHT_VK_CHECK(vkCreatePipelineLayout(device, &info, nullptr, &raw));
+  return vk::UniquePipelineLayout(device, raw);
+}
+
+}  // namespace
+
+MeshPipeline create_mesh_pipeline(VkDevice device, const MeshPipelineInfo& info) {
+  MeshPipeline out;
+  out.vertex_shader = vk::create_shader_module(device, info.vertex_spirv);
+  out.fragment_shader = vk::create_shader_module(device, info.fragment_spirv);
+  out.layout = create_layout(device, info.push_constant_bytes);
+  out.push_constant_bytes = info.push_constant_bytes;
+
+  const std::array<VkPipelineShaderStageCreateInfo, 2> stages{{
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_VERTEX_BIT,
+       out.vertex_shader.get(), "main", nullptr},
+      {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT,
+       out.fragment_shader.get(), "main", nullptr},
+  }};
+  const VkVertexInputBindingDescription binding{0, sizeof(RasterVertex), VK_VERTEX_INPUT_RATE_VERTEX};
+  const std::array<VkVertexInputAttributeDescription, 3> attributes{{
+      {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(RasterVertex, position)},
+      {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(RasterVertex, normal)},
+      {2, 0, VK_FORMAT_R32_UINT, offsetof(RasterVertex, info)},
+  }};
+  VkPipelineVertexInputStateCreateInfo vertex_input{};
+  vertex_input.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;
+  vertex_input.vertexBindingDescriptionCount = 1;
+  vertex_input.pVertexBindingDescriptions = &binding;
+  vertex_input.vertexAttributeDescriptionCount = info.position_only ? 1u : static_cast<std::uint32_t>(attributes.size());
+  vertex_input.pVertexAttributeDescriptions = attributes.data();
+  VkPipelineInputAssemblyStateCreateInfo assembly{};
+  assembly.sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO;
+  assembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
+  VkPipelineViewportStateCreateInfo viewport_state{};
+  viewport_state.sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO;
+  viewport_state.viewportCount = 1;
+  viewport_state.scissorCount = 1;
+  const std::array<VkDynamicState, 2> dynamic{VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
+  VkPipelineDynamicStateCreateInfo dynamic_state{};
+  dynamic_state.sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO;
+  dynamic_state.dynamicStateCount = static_cast<std::uint32_t>(dynamic.size());
+  dynamic_state.pDynamicStates = dynamic.data();
+  VkPipelineRasterizationStateCreateInfo raster{};
+  raster.sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO;
+  raster.polygonMode = VK_POLYGON_MODE_FILL;
+  raster.cullMode = VK_CULL_MODE_NONE;
+  raster.frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
+  raster.lineWidth = 1.f;
+  VkPipelineMultisampleStateCreateInfo multisample{};
+  multisample.sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO;
+  multisample.rasterizationSamples = VK_SAMPLE_COUNT_1_BIT;
+  VkPipelineDepthStencilStateCreateInfo depth{};
+  depth.sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO;
+  depth.depthTestEnable = VK_TRUE;
+  depth.depthWriteEnable = VK_TRUE;
+  depth.depthCompareOp = VK_COMPARE_OP_LESS;
+  std::vector<VkPipelineColorBlendAttachmentState> blend(info.colour_targets);
+  for (auto& b : blend)
+    b.colorWriteMask = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT | VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+  VkPipelineColorBlendStateCreateInfo colour_blend{};
+  colour_blend.sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO;
+  colour_blend.attachmentCount = static_cast<std::uint32_t>(blend.size());
+  colour_blend.pAttachments = blend.data();
+
+  VkGraphicsPipelineCreateInfo create{};
+  create.sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO;
+  create.stageCount = static_cast<std::uint32_t>(stages.size());
+  create.pStages = stages.data();
+  create.pVertexInputState = &vertex_input;
+  create.pInputAssemblyState = &assembly;
+  create.pViewportState = &viewport_state;
+  create.pRasterizationState = &raster;
+  create.pMultisampleState = &multisample;
+  create.pDepthStencilState = &depth;
+  create.pColorBlendState = &colour_blend;
+  create.pDynamicState = &dynamic_state;
+  create.layout = out.layout.get();
+  create.renderPass = info.render_pass;
+  VkPipeline raw = VK_NULL_HANDLE;
+  RELIGHT_VK_CHECK(vkCreateGraphicsPipelines(device, VK_NULL_HANDLE, 1, &create, nullptr, &raw));
+  out.pipeline = vk::UniquePipeline(device, raw);
+  return out;
+}
+
+void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const SceneVertices& vertices,
+                std::span<const std::byte> constants, const VkRect2D& area) {
+  if (vertices.count == 0) return;
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
+  const VkViewport viewport{static_cast<float>(area.offset.x), static_cast<float>(area.offset.y),
+                            static_cast<float>(area.extent.width), static_cast<float>(area.extent.height), 0.f, 1.f};
+  vkCmdSetViewport(cmd, 0, 1, &viewport);
+  vkCmdSetScissor(cmd, 0, 1, &area);
+  if (!constants.empty())
+    vkCmdPushConstants(cmd, pipeline.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                       static_cast<std::uint32_t>(constants.size()), constants.data());
+  const VkBuffer buffer = vertices.buffer->handle();
+  const VkDeviceSize offset = 0;
+  vkCmdBindVertexBuffers(cmd, 0, 1, &buffer, &offset);
+  vkCmdDraw(cmd, vertices.count, 1, 0, 0);
+}
+
+}  // namespace relight::render::detail

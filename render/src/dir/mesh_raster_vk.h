@@ -1,0 +1,74 @@
+#pragma once
+// What the renderer's rasterising passes share (the G-buffer, gbuffer_vk.h, and the light-view
+// shadow maps, shadow_maps_vk.h): the scene's triangles as one vertex buffer, a render pass
+// over colour targets + a depth buffer, and a triangle pipeline with dynamic viewport, so that
+// one pipeline can draw into any tile of an atlas.
+#include <vulkan/vulkan.h>
+
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "relight/render/scene/mr_scene.h"
+#include "relight/vk/buffer.h"
+#include "relight/vk/handles.h"
+
+namespace relight::vk {
+class VulkanContext;
+}
+
+namespace relight::render::detail {
+
+/// One triangle corner. Expanded per corner (no index buffer): the passes' cost is the
+/// rasterisation, not the vertex count, and the flat `info` attribute stands in for
+/// gl_PrimitiveID (which would need the geometry-shader feature).
+struct RasterVertex {
+  float position[3];
+  float normal[3];
+  std::uint32_t info;  ///< bits 0-30: material index; bit 31: virtual
+};
+
+struct SceneVertices {
+  std::unique_ptr<vk::VulkanBuffer> buffer;
+  std::uint32_t count = 0;
+};
+
+enum class MeshLayers { All, Real, Virtual };
+
+/// The triangles of `scene` in `layers`; meshes without vertex normals get their face normal.
+[[nodiscard]] SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene,
+                                                  MeshLayers layers = MeshLayers::All);
+
+/// Colour targets cleared and left in TRANSFER_SRC_OPTIMAL for a copy to a buffer; depth cleared
+/// and discarded.
+[[nodiscard]] vk::UniqueRenderPass create_raster_pass(VkDevice device, std::span<const VkFormat> colour_formats,
+                                                      VkFormat depth_format);
+[[nodiscard]] vk::UniqueFramebuffer create_framebuffer(VkDevice device, VkRenderPass pass,
+                                                       std::span<const VkImageView> views, std::uint32_t width,
+                                                       std::uint32_t height);
+
+struct MeshPipeline {
+  vk::UniqueShaderModule vertex_shader, fragment_shader;
+  vk::UniquePipelineLayout layout;
+  vk::UniquePipeline pipeline;
+  std::uint32_t push_constant_bytes = 0;
+};
+
+struct MeshPipelineInfo {
+  VkRenderPass render_pass = VK_NULL_HANDLE;
+  std::span<const std::uint32_t> vertex_spirv;
+  std::span<const std::uint32_t> fragment_spirv;
+  std::uint32_t colour_targets = 1;
+  std::uint32_t push_constant_bytes = 0;  ///< visible to both stages
+  bool position_only = false;             ///< the vertex shader reads location 0 only
+};
+
+/// Triangles with RasterVertex input, depth test LESS, no culling (reconstructed meshes and open
+/// models have no consistent winding), dynamic viewport and scissor.
+[[nodiscard]] MeshPipeline create_mesh_pipeline(VkDevice device, const MeshPipelineInfo& info);
+
+/// Binds `pipeline`, sets viewport + scissor to `area`, pushes `constants` and draws `vertices`.
+void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const SceneVertices& vertices,
+                std::span<const std::byte> constants, const VkRect2D& area);
+
+}  // namespace relight::render::detail

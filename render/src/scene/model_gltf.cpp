@@ -1,0 +1,397 @@
+// glTF 2.0 reading and writing (tinygltf).
+#include <tiny_gltf.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <sstream>
+
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+#include "relight/render/scene/model_io.h"
+
+namespace relight::render {
+namespace {
+
+using tinygltf::Value;
+
+float number(const Value& object, const char* key, float fallback) {
+  return object.Has(key) && object.Get(key).IsNumber() ? static_cast<float>(object.Get(key).GetNumberAsDouble())
+                                                       : fallback;
+}
+
+std::optional<PhongMaterial> phong_extras(const tinygltf::Material& m) {
+  if (!m.extras.IsObject() || !m.extras.Has("relight_phong")) return std::nullopt;
+  const Value& phong = m.extras.Get("relight_phong");
+  PhongMaterial out;
+  out.name = m.name;
+  if (phong.Has("kd") && phong.Get("kd").IsArray() && phong.Get("kd").ArrayLen() == 3)
+    for (int c = 0; c < 3; ++c) out.kd[c] = static_cast<float>(phong.Get("kd").Get(c).GetNumberAsDouble());
+  out.ks = number(phong, "ks", 0.f);
+  out.n = number(phong, "n", 1.f);
+  return out;
+}
+
+PhongMaterial from_gltf(const tinygltf::Material& m) {
+  PhongMaterial out;
+  const auto& pbr = m.pbrMetallicRoughness;
+  const Eigen::Vector3f base(static_cast<float>(pbr.baseColorFactor[0]), static_cast<float>(pbr.baseColorFactor[1]),
+                             static_cast<float>(pbr.baseColorFactor[2]));
+  if (const auto phong = phong_extras(m)) {
+    out = *phong;
+  } else {
+    const auto metallic = static_cast<float>(std::clamp(pbr.metallicFactor, 0.0, 1.0));
+    const auto roughness = static_cast<float>(std::clamp(pbr.roughnessFactor, 0.0, 1.0));
+    out.name = m.name;
+    out.kd = base * (1.f - metallic);
+    out.ks = 0.04f * (1.f - metallic) + (0.2126f * base.x() + 0.7152f * base.y() + 0.0722f * base.z()) * metallic;
+    const float alpha = std::max(1e-3f, roughness * roughness);
+    out.n = std::clamp(2.f / (alpha * alpha) - 2.f, 1.f, 10000.f);
+  }
+  float strength = 1.f;
+  if (const auto found = m.extensions.find("KHR_materials_emissive_strength"); found != m.extensions.end())
+    strength = number(found->second, "emissiveStrength", 1.f);
+  if (m.emissiveFactor.size() == 3)
+    for (int c = 0; c < 3; ++c) out.emission[c] = static_cast<float>(m.emissiveFactor[static_cast<std::size_t>(c)]) * strength;
+  return out;
+}
+
+class AccessorReader {
+ public:
+  AccessorReader(const tinygltf::Model& model, int index, const std::string& file) : file_(file) {
+    if (index < 0 || static_cast<std::size_t>(index) >= model.accessors.size()) fail("an accessor index is out of range");
+    accessor_ = &model.accessors[static_cast<std::size_t>(index)];
+    if (accessor_->sparse.isSparse) fail("sparse accessors are not supported");
+    if (accessor_->bufferView < 0 || static_cast<std::size_t>(accessor_->bufferView) >= model.bufferViews.size())
+      fail("an accessor has no buffer view");
+    const tinygltf::BufferView& view = model.bufferViews[static_cast<std::size_t>(accessor_->bufferView)];
+    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size()) fail("a buffer view has no buffer");
+    const std::vector<unsigned char>& data = model.buffers[static_cast<std::size_t>(view.buffer)].data;
+    const int components = tinygltf::GetNumComponentsInType(static_cast<std::uint32_t>(accessor_->type));
+    const int component_size = tinygltf::GetComponentSizeInBytes(static_cast<std::uint32_t>(accessor_->componentType));
+    if (components <= 0 || component_size <= 0) fail("an accessor has an unknown type");
+    element_size_ = static_cast<std::size_t>(components * component_size);
+    stride_ = view.byteStride != 0 ? view.byteStride : element_size_;
+    const std::size_t begin = view.byteOffset + accessor_->byteOffset;
+    const std::size_t span = accessor_->count == 0 ? 0 : (accessor_->count - 1) * stride_ + element_size_;
+    if (begin > data.size() || span > data.size() - begin || accessor_->byteOffset + span > view.byteLength)
+      fail("an accessor reaches past the end of its buffer");
+    bytes_ = data.data() + begin;
+  }
+
+  [[nodiscard]] std::size_t count() const { return accessor_->count; }
+
+  [[nodiscard]] Eigen::Vector3f vec3(std::size_t i) const {
+    if (accessor_->type != TINYGLTF_TYPE_VEC3 || accessor_->componentType != TINYGLTF_COMPONENT_TYPE_FLOAT)
+      fail("positions and normals must be float VEC3");
+    float v[3];
+    std::memcpy(v, bytes_ + i * stride_, sizeof v);
+    return {v[0], v[1], v[2]};
+  }
+
+  [[nodiscard]] std::uint32_t index(std::size_t i) const {
+    const unsigned char* p = bytes_ + i * stride_;
+    switch (accessor_->componentType) {
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return *p;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+        std::uint16_t v;
+        std::memcpy(&v, p, sizeof v);
+        return v;
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+        std::uint32_t v;
+        std::memcpy(&v, p, sizeof v);
+        return v;
+      }
+      default: fail("indices must be unsigned integers");
+    }
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const { throw Error(file_ + ": " + why); }
+
+  std::string file_;
+  const tinygltf::Accessor* accessor_ = nullptr;
+  const unsigned char* bytes_ = nullptr;
+  std::size_t element_size_ = 0;
+  std::size_t stride_ = 0;
+};
+
+Eigen::Affine3f node_transform(const tinygltf::Node& node) {
+  Eigen::Affine3f t = Eigen::Affine3f::Identity();
+  if (node.matrix.size() == 16) {
+    Eigen::Matrix4f m;
+    for (int i = 0; i < 16; ++i) m(i % 4, i / 4) = static_cast<float>(node.matrix[static_cast<std::size_t>(i)]);
+    t.matrix() = m;
+    return t;
+  }
+  if (node.translation.size() == 3)
+    t.translate(Eigen::Vector3f(static_cast<float>(node.translation[0]), static_cast<float>(node.translation[1]),
+                                static_cast<float>(node.translation[2])));
+  if (node.rotation.size() == 4)
+    t.rotate(Eigen::Quaternionf(static_cast<float>(node.rotation[3]), static_cast<float>(node.rotation[0]),
+                                static_cast<float>(node.rotation[1]), static_cast<float>(node.rotation[2]))
+                 .normalized());
+  if (node.scale.size() == 3)
+    t.scale(Eigen::Vector3f(static_cast<float>(node.scale[0]), static_cast<float>(node.scale[1]),
+                            static_cast<float>(node.scale[2])));
+  return t;
+}
+
+class GltfMeshCollector {
+ public:
+  GltfMeshCollector(const tinygltf::Model& gltf, VirtualModel& out, std::string file, std::uint32_t default_material)
+      : gltf_(gltf), out_(out), file_(std::move(file)), default_material_(default_material) {}
+
+  void visit(int node_index, const Eigen::Affine3f& parent, int depth) {
+    if (node_index < 0 || static_cast<std::size_t>(node_index) >= gltf_.nodes.size() || depth > 64)
+      throw Error(file_ + ": a node index is out of range or the node tree is cyclic");
+    const tinygltf::Node& node = gltf_.nodes[static_cast<std::size_t>(node_index)];
+    const Eigen::Affine3f transform = parent * node_transform(node);
+    if (node.mesh >= 0) add_mesh(node.mesh, transform);
+    for (int child : node.children) visit(child, transform, depth + 1);
+  }
+
+ private:
+  void add_mesh(int mesh_index, const Eigen::Affine3f& transform) {
+    if (static_cast<std::size_t>(mesh_index) >= gltf_.meshes.size()) throw Error(file_ + ": a mesh index is out of range");
+    const tinygltf::Mesh& source = gltf_.meshes[static_cast<std::size_t>(mesh_index)];
+    for (const tinygltf::Primitive& primitive : source.primitives) {
+      if (primitive.mode != -1 && primitive.mode != TINYGLTF_MODE_TRIANGLES)
+        throw Error(file_ + ": only triangle primitives are supported");
+      out_.meshes.push_back(primitive_mesh(source.name, primitive, transform));
+    }
+  }
+
+  TriangleMesh primitive_mesh(const std::string& name, const tinygltf::Primitive& primitive,
+                              const Eigen::Affine3f& transform) const {
+    const auto position = primitive.attributes.find("POSITION");
+    if (position == primitive.attributes.end()) throw Error(file_ + ": a primitive has no POSITION");
+    TriangleMesh mesh;
+    mesh.name = name;
+    const AccessorReader positions(gltf_, position->second, file_);
+    for (std::size_t i = 0; i < positions.count(); ++i) mesh.positions.push_back(transform * positions.vec3(i));
+    if (const auto normal = primitive.attributes.find("NORMAL"); normal != primitive.attributes.end()) {
+      const AccessorReader normals(gltf_, normal->second, file_);
+      const Eigen::Matrix3f normal_matrix = transform.linear().inverse().transpose();
+      for (std::size_t i = 0; i < normals.count(); ++i) mesh.normals.push_back((normal_matrix * normals.vec3(i)).normalized());
+    }
+    std::vector<std::uint32_t> indices;
+    if (primitive.indices >= 0) {
+      const AccessorReader reader(gltf_, primitive.indices, file_);
+      for (std::size_t i = 0; i < reader.count(); ++i) {
+        indices.push_back(reader.index(i));
+        if (indices.back() >= mesh.positions.size())
+          throw Error(file_ + ": a primitive refers to vertex " + std::to_string(indices.back()) + ", but it has " +
+                      std::to_string(mesh.positions.size()));
+      }
+    } else {
+      for (std::size_t i = 0; i < mesh.positions.size(); ++i) indices.push_back(static_cast<std::uint32_t>(i));
+    }
+    if (primitive.material >= 0 && static_cast<std::size_t>(primitive.material) >= gltf_.materials.size())
+      throw Error(file_ + ": a primitive uses material " + std::to_string(primitive.material) + ", but the file has " +
+                  std::to_string(gltf_.materials.size()));
+    const std::uint32_t material = primitive.material >= 0 ? static_cast<std::uint32_t>(primitive.material) : default_material_;
+    for (std::size_t i = 0; i + 2 < indices.size(); i += 3) {
+      mesh.triangles.push_back({indices[i], indices[i + 1], indices[i + 2]});
+      mesh.triangle_material.push_back(material);
+    }
+    if (mesh.normals.size() != mesh.positions.size()) compute_vertex_normals(mesh);
+    return mesh;
+  }
+
+  const tinygltf::Model& gltf_;
+  VirtualModel& out_;
+  std::string file_;
+  std::uint32_t default_material_;
+};
+
+// tinygltf's JSON errors quote what was last read, which can be a whole base64 buffer.
+std::string first_line(std::string text) {
+  text = text.substr(0, text.find('\n'));
+  while (!text.empty() && (text.back() == '\r' || text.back() == ' ')) text.pop_back();
+  constexpr std::size_t kLongest = 200;
+  if (text.size() > kLongest) text = text.substr(0, kLongest) + "...";
+  return text;
+}
+
+// Textures are not used (materials are Phong constants), so images are neither decoded nor
+// checked: a broken or hostile image cannot fail or slow down loading the geometry.
+bool skip_image(tinygltf::Image*, int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+  return true;
+}
+
+tinygltf::Model read_gltf(const std::filesystem::path& path, bool binary) {
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(skip_image, nullptr);
+  tinygltf::Model gltf;
+  std::string error, warning;
+  bool ok = false;
+  try {
+    ok = binary ? loader.LoadBinaryFromFile(&gltf, &error, &warning, path.string())
+                : loader.LoadASCIIFromFile(&gltf, &error, &warning, path.string());
+  } catch (const std::exception& e) {
+    // tinygltf 2.7 indexes with vector::at() in places where it does not check sizes first
+    // (a GLB buffer of byteLength 0, an empty embedded image): a malformed file, not a bug here.
+    error = e.what();
+  }
+  if (!ok) throw Error(path.string() + ": cannot read glTF: " + (error.empty() ? "unknown error" : first_line(error)));
+  return gltf;
+}
+
+}  // namespace
+
+VirtualModel load_gltf(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  const tinygltf::Model gltf = read_gltf(path, extension == ".glb");
+  VirtualModel model;
+  model.name = path.stem().string();
+  for (const tinygltf::Material& m : gltf.materials) model.materials.push_back(from_gltf(m));
+  const auto default_material = static_cast<std::uint32_t>(model.materials.size());
+  model.materials.push_back(PhongMaterial{"default", {0.8f, 0.8f, 0.8f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
+  GltfMeshCollector collector(gltf, model, path.string(), default_material);
+  const int scene = gltf.defaultScene >= 0 ? gltf.defaultScene : 0;
+  if (static_cast<std::size_t>(scene) < gltf.scenes.size()) {
+    for (int node : gltf.scenes[static_cast<std::size_t>(scene)].nodes) collector.visit(node, Eigen::Affine3f::Identity(), 0);
+  }
+  std::erase_if(model.meshes, [](const TriangleMesh& m) { return m.triangles.empty(); });
+  if (model.meshes.empty()) throw Error(path.string() + ": the glTF file holds no triangles");
+  check_model(model, path);
+  return model;
+}
+
+namespace {
+
+/// Appends raw bytes to the buffer and returns the new buffer view's index.
+int add_view(tinygltf::Model& gltf, const void* bytes, std::size_t size, int target) {
+  std::vector<unsigned char>& data = gltf.buffers[0].data;
+  while (data.size() % 4 != 0) data.push_back(0);
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = data.size();
+  view.byteLength = size;
+  view.target = target;
+  const auto* begin = static_cast<const unsigned char*>(bytes);
+  data.insert(data.end(), begin, begin + size);
+  gltf.bufferViews.push_back(view);
+  return static_cast<int>(gltf.bufferViews.size() - 1);
+}
+
+int add_vec3_accessor(tinygltf::Model& gltf, const std::vector<Eigen::Vector3f>& values, bool with_bounds) {
+  std::vector<float> flat;
+  Eigen::AlignedBox3f box;
+  for (const Eigen::Vector3f& v : values) {
+    flat.insert(flat.end(), {v.x(), v.y(), v.z()});
+    box.extend(v);
+  }
+  tinygltf::Accessor accessor;
+  accessor.bufferView = add_view(gltf, flat.data(), flat.size() * sizeof(float), TINYGLTF_TARGET_ARRAY_BUFFER);
+  accessor.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  accessor.type = TINYGLTF_TYPE_VEC3;
+  accessor.count = values.size();
+  if (with_bounds) {  // required for POSITION by the specification
+    accessor.minValues = {box.min().x(), box.min().y(), box.min().z()};
+    accessor.maxValues = {box.max().x(), box.max().y(), box.max().z()};
+  }
+  gltf.accessors.push_back(accessor);
+  return static_cast<int>(gltf.accessors.size() - 1);
+}
+
+int add_index_accessor(tinygltf::Model& gltf, const std::vector<std::uint32_t>& indices) {
+  tinygltf::Accessor accessor;
+  accessor.bufferView =
+      add_view(gltf, indices.data(), indices.size() * sizeof(std::uint32_t), TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  accessor.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  accessor.type = TINYGLTF_TYPE_SCALAR;
+  accessor.count = indices.size();
+  gltf.accessors.push_back(accessor);
+  return static_cast<int>(gltf.accessors.size() - 1);
+}
+
+tinygltf::Material to_gltf(const PhongMaterial& m) {
+  tinygltf::Material out;
+  out.name = m.name;
+  out.pbrMetallicRoughness.baseColorFactor = {m.kd.x(), m.kd.y(), m.kd.z(), 1.0};
+  out.pbrMetallicRoughness.metallicFactor = 0.0;
+  // Inverse of the exponent mapping in model_io.h, so that other viewers show a similar gloss.
+  out.pbrMetallicRoughness.roughnessFactor = std::sqrt(std::sqrt(2.0 / (m.n + 2.0)));
+  const float peak = m.emission.maxCoeff();
+  if (peak > 0.f) {
+    const Eigen::Vector3f factor = m.emission / std::max(1.f, peak);
+    out.emissiveFactor = {factor.x(), factor.y(), factor.z()};
+    if (peak > 1.f) {
+      tinygltf::Value::Object strength{{"emissiveStrength", tinygltf::Value(static_cast<double>(peak))}};
+      out.extensions["KHR_materials_emissive_strength"] = tinygltf::Value(strength);
+    }
+  }
+  tinygltf::Value::Array kd{tinygltf::Value(static_cast<double>(m.kd.x())), tinygltf::Value(static_cast<double>(m.kd.y())),
+                            tinygltf::Value(static_cast<double>(m.kd.z()))};
+  tinygltf::Value::Object phong{{"kd", tinygltf::Value(kd)},
+                                {"ks", tinygltf::Value(static_cast<double>(m.ks))},
+                                {"n", tinygltf::Value(static_cast<double>(m.n))}};
+  out.extras = tinygltf::Value(tinygltf::Value::Object{{"relight_phong", tinygltf::Value(phong)}});
+  return out;
+}
+
+}  // namespace
+
+void save_gltf(const std::filesystem::path& path, const VirtualModel& model) {
+  tinygltf::Model gltf;
+  gltf.asset.version = "2.0";
+  gltf.asset.generator = "relight";
+  gltf.buffers.resize(1);
+  for (const PhongMaterial& m : model.materials) gltf.materials.push_back(to_gltf(m));
+  if (std::any_of(model.materials.begin(), model.materials.end(), [](const PhongMaterial& m) { return m.emission.maxCoeff() > 1.f; }))
+    gltf.extensionsUsed.push_back("KHR_materials_emissive_strength");
+  tinygltf::Scene scene;
+  for (const TriangleMesh& source : model.meshes) {
+    tinygltf::Mesh mesh;
+    mesh.name = source.name;
+    const int positions = add_vec3_accessor(gltf, source.positions, true);
+    const int normals = source.normals.empty() ? -1 : add_vec3_accessor(gltf, source.normals, false);
+    // One primitive per material.
+    std::vector<std::uint32_t> materials = source.triangle_material;
+    std::sort(materials.begin(), materials.end());
+    materials.erase(std::unique(materials.begin(), materials.end()), materials.end());
+    for (std::uint32_t material : materials) {
+      std::vector<std::uint32_t> indices;
+      for (std::size_t t = 0; t < source.triangles.size(); ++t)
+        if (source.triangle_material[t] == material) indices.insert(indices.end(), source.triangles[t].begin(), source.triangles[t].end());
+      tinygltf::Primitive primitive;
+      primitive.attributes["POSITION"] = positions;
+      if (normals >= 0) primitive.attributes["NORMAL"] = normals;
+      primitive.indices = add_index_accessor(gltf, indices);
+      primitive.material = static_cast<int>(material);
+      primitive.mode = TINYGLTF_MODE_TRIANGLES;
+      mesh.primitives.push_back(primitive);
+    }
+    gltf.meshes.push_back(mesh);
+    tinygltf::Node node;
+    node.name = source.name;
+    node.mesh = static_cast<int>(gltf.meshes.size() - 1);
+    gltf.nodes.push_back(node);
+    scene.nodes.push_back(static_cast<int>(gltf.nodes.size() - 1));
+  }
+  gltf.scenes.push_back(scene);
+  gltf.defaultScene = 0;
+  std::ostringstream stream;
+  tinygltf::TinyGLTF writer;
+  if (!writer.WriteGltfSceneToStream(&gltf, stream, true, false))
+    throw Error(path.string() + ": cannot encode the glTF model");
+  write_file_atomically(path, stream.str());
+}
+
+VirtualModel load_model(const std::filesystem::path& path) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw Error(path.string() + ": no such model file");
+  std::string extension = path.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (extension == ".obj") return load_obj(path);
+  if (extension == ".gltf" || extension == ".glb") return load_gltf(path);
+  throw Error(path.string() + ": unknown model format (expected .obj, .gltf or .glb)");
+}
+
+}  // namespace relight::render

@@ -1,0 +1,77 @@
+#include "relight/render/scene/mr_scene.h"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <numbers>
+
+#include "relight/core/error.h"
+
+namespace relight::render {
+
+MrLight spot_light(const Eigen::Vector3f& position, const Eigen::Vector3f& direction, float outer_deg, float inner_deg,
+                   const Eigen::Vector3f& intensity, bool real) {
+  MrLight light;
+  light.kind = LightKind::Spot;
+  light.position = position;
+  light.direction = direction;
+  light.cos_outer = std::cos(outer_deg * std::numbers::pi_v<float> / 180.f);
+  light.cos_inner = std::cos(inner_deg * std::numbers::pi_v<float> / 180.f);
+  light.intensity = intensity;
+  light.real = real;
+  return light;
+}
+
+std::uint32_t MrScene::add_material(PhongMaterial material) {
+  materials.push_back(std::move(material));
+  return static_cast<std::uint32_t>(materials.size() - 1);
+}
+
+std::size_t MrScene::triangle_count(bool real) const {
+  std::size_t count = 0;
+  for (const TriangleMesh& mesh : meshes)
+    if (mesh.real == real) count += mesh.triangle_count();
+  return count;
+}
+
+namespace {
+
+void validate_mesh(const TriangleMesh& mesh, std::size_t material_count) {
+  const std::string where = "mesh '" + mesh.name + "': ";
+  if (mesh.triangle_material.size() != mesh.triangles.size())
+    throw Error(where + "needs one material per triangle");
+  if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
+    throw Error(where + "needs one normal per vertex or none");
+  for (const Eigen::Vector3f& p : mesh.positions)
+    if (!p.allFinite()) throw Error(where + "has a non-finite vertex position");
+  for (const auto& triangle : mesh.triangles)
+    for (std::uint32_t v : triangle)
+      if (v >= mesh.positions.size()) throw Error(where + "refers to a missing vertex");
+  for (std::uint32_t m : mesh.triangle_material)
+    if (m >= material_count) throw Error(where + "refers to a missing material");
+}
+
+}  // namespace
+
+void MrScene::validate() const {
+  for (const TriangleMesh& mesh : meshes) validate_mesh(mesh, materials.size());
+  for (const PhongMaterial& material : materials)
+    if (!material.kd.allFinite() || !std::isfinite(material.ks) || !std::isfinite(material.n) || material.n < 0.f ||
+        !material.emission.allFinite())
+      throw Error("material '" + material.name + "' has invalid Phong parameters");
+}
+
+BoundingSphere bounding_sphere(const MrScene& scene, SceneMeshes meshes) {
+  Eigen::AlignedBox3f box;
+  for (const TriangleMesh& mesh : scene.meshes) {
+    if (meshes == SceneMeshes::Virtual && mesh.real) continue;
+    for (const Eigen::Vector3f& p : mesh.positions) box.extend(p);
+  }
+  BoundingSphere sphere;
+  if (box.isEmpty()) return sphere;
+  sphere.centre = box.center();
+  sphere.radius = 0.5f * box.diagonal().norm() * 1.01f + 1e-3f;
+  return sphere;
+}
+
+}  // namespace relight::render

@@ -1,0 +1,17 @@
+#include "relight/render/scene/scene_lights.h"
+
+namespace relight::render {
+
+void add_lights(MrScene& scene, const LightSet& lights) {
+  for (const Light& light : lights.lights) {
+    MrLight out;
+    out.kind = light.kind == relight::LightKind::Directional ? LightKind::Directional : LightKind::Point;
+    out.direction = light.direction.normalized().cast<float>();
+    out.position = light.position.cast<float>();
+    out.intensity = light.power.cast<float>();
+    out.real = light.real;
+    scene.lights.push_back(out);
+  }
+}
+
+}  // namespace relight::render
