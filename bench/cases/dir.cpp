@@ -126,7 +126,7 @@ bench::Json equal_time_comparison(vk::VulkanContext& context, const render::MrSc
   const render::DifferentialImages reference = reference_images(scene, camera, 1);
   render::DirOptions cpu_options;
   cpu_options.min_distance = 0.05f;
-  render::DirVkOptions vk_options;
+  render::DirRenderOptions vk_options;
   vk_options.shading = cpu_options;
   render::DirRendererVk renderer(context, camera.intrinsics.width, camera.intrinsics.height);
   renderer.set_scene(scene, vk_options);
@@ -196,7 +196,7 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
   render::MrCamera camera = bench_camera();
   const render::DifferentialImages reference = reference_images(scene, camera, 2);
   const render::RayTracer tracer(scene);
-  render::DirVkOptions vk_options;
+  render::DirRenderOptions vk_options;
   vk_options.shading.min_distance = 0.05f;
   render::DirRendererVk renderer(*context, camera.intrinsics.width, camera.intrinsics.height);
   renderer.set_scene(scene, vk_options);
@@ -242,7 +242,7 @@ bench::Json frame_640x480(const bench::Options& options, int light_samples) {
   const render::MrScene scene = bench_scene();
   const render::MrCamera camera = kinect_camera();
   const render::RayTracer tracer(scene);
-  render::DirVkOptions automatic, on_gpu;
+  render::DirRenderOptions automatic, on_gpu;
   on_gpu.backend = render::DirBackend::Gpu;
   render::DirRendererVk renderer(*context, 640, 480);
   renderer.set_scene(scene, automatic);
@@ -251,7 +251,7 @@ bench::Json frame_640x480(const bench::Options& options, int light_samples) {
   std::vector<render::Vpl> vpls;
   double vpl_ms = 0.0;
   render::DirVkTimings t;
-  const auto frame = [&](const render::DirVkOptions& dir_options) {
+  const auto frame = [&](const render::DirRenderOptions& dir_options) {
     const auto start = Clock::now();
     vpls = render::generate_vpls(scene, tracer, vpl_options);
     vpl_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -283,13 +283,13 @@ bench::Json one_vs_two_pass(const bench::Options& options) {
   if (!context) return {{"skipped", "no Vulkan device"}};
   const render::MrScene scene = bench_scene();
   const render::MrCamera camera = kinect_camera();
-  render::DirVkOptions both;
+  render::DirRenderOptions both;
   render::DirRendererVk renderer(*context, 640, 480);
   renderer.set_scene(scene, both);
   render::VplOptions vpl_options;
   vpl_options.count = 256;
   const std::vector<render::Vpl> vpls = render::generate_vpls(scene, render::RayTracer(scene), vpl_options);
-  render::DirVkOptions rv_only = both, r_only = both;
+  render::DirRenderOptions rv_only = both, r_only = both;
   rv_only.output = render::DirOutput::RealVirtualOnly;
   r_only.output = render::DirOutput::RealOnly;
   const bench::Comparison c = bench::compare_interleaved([&] { (void)renderer.render(camera, vpls, both); },

@@ -31,8 +31,8 @@ MrScene cube_scene() {
   return scene;
 }
 
-DirVkOptions test_options() {
-  DirVkOptions options;
+DirRenderOptions test_options() {
+  DirRenderOptions options;
   options.shadow_tile = 256;
   options.ism.tile = 32;
   options.ism.points_per_vpl = 512;
@@ -59,7 +59,7 @@ TEST(DirMerge, InterleavedIndirectLightStaysCloseToTheFullSumAtEdges) {
   const MrScene scene = test::indoor_with_pebble();
   const MrCamera camera = camera_at({1.3, -1.1, 1.4}, {0.2, -0.1, 0.75}, 160, 120);
   const std::vector<Vpl> vpls = make_vpls(scene, 64);
-  DirVkOptions options = test_options();
+  DirRenderOptions options = test_options();
   options.backend = DirBackend::Cpu;
   GBuffer gbuffer;
   options.interleave = 1;
@@ -105,7 +105,7 @@ TEST_F(DirVkTest, ShadowAtlasMatchesTheRayCastReference) {
   sun.kind = LightKind::Directional;
   sun.direction = Eigen::Vector3f(0.3f, -0.4f, 1.f).normalized();
   scene.lights.push_back(sun);
-  DirVkOptions options = test_options();
+  DirRenderOptions options = test_options();
   options.shadow_tile = 128;
   DirRendererVk renderer(context, 32, 24);
   renderer.set_scene(scene, options);
@@ -139,7 +139,7 @@ TEST_F(DirVkTest, ShadowAtlasMatchesTheRayCastReference) {
 TEST_F(DirVkTest, IsmAtlasMatchesTheCpuSplatsAndPullPush) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const MrScene scene = cube_scene();
-  const DirVkOptions options = test_options();
+  const DirRenderOptions options = test_options();
   const std::vector<Vpl> vpls = make_vpls(scene, 48);
   DirRendererVk renderer(context, 32, 24);
   renderer.set_scene(scene, options);
@@ -165,7 +165,7 @@ TEST_F(DirVkTest, IsmAtlasMatchesTheCpuSplatsAndPullPush) {
 TEST_F(DirVkTest, ShadingMatchesTheCpuMirrorOnTheSameMaps) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const MrScene scene = cube_scene();
-  const DirVkOptions options = test_options();
+  const DirRenderOptions options = test_options();
   const std::vector<Vpl> vpls = make_vpls(scene, 64);
   const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 64, 48);
   DirRendererVk renderer(context, 64, 48);
@@ -203,7 +203,7 @@ TEST_F(DirVkTest, VirtualCubeShadowsAndBleedsOnlyWhereFig57Says) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const MrScene scene = open_cube_scene();
   const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 48, 36);
-  DirVkOptions options = test_options();
+  DirRenderOptions options = test_options();
   DirRendererVk renderer(context, 48, 36);
   renderer.set_scene(scene, options);
   const DifferentialImages images = renderer.render(camera, make_vpls(scene, 256), options);
@@ -239,7 +239,7 @@ TEST_F(DirVkTest, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions)
   const MrScene scene = open_cube_scene();
   const MrCamera camera = test::comparison_camera();
   const DifferentialImages pt = test::reference_images(scene, camera, 1);
-  DirVkOptions options;
+  DirRenderOptions options;
   options.shading.min_distance = 0.02f;
   options.shadow_tile = 512;
   options.backend = DirBackend::Gpu;
@@ -254,18 +254,18 @@ TEST_F(DirVkTest, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions)
 TEST_F(DirVkTest, CpuAndGpuBackendsAgreeAndAutoPicksTheCpuOnASoftwareDevice) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const MrScene scene = cube_scene();
-  DirVkOptions gpu_options = test_options();
+  DirRenderOptions gpu_options = test_options();
   const std::vector<Vpl> vpls = make_vpls(scene, 64);
   const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 64, 48);
   DirRendererVk renderer(context, 64, 48);
   renderer.set_scene(scene, gpu_options);
   const DifferentialImages gpu = renderer.render(camera, vpls, gpu_options);
   EXPECT_FALSE(renderer.last_timings().cpu_shading);
-  DirVkOptions auto_options = gpu_options;
+  DirRenderOptions auto_options = gpu_options;
   auto_options.backend = DirBackend::Auto;
   const DifferentialImages automatic = renderer.render(camera, vpls, auto_options);
   EXPECT_EQ(renderer.last_timings().cpu_shading, context.is_cpu_device());
-  DirVkOptions cpu_options = gpu_options;
+  DirRenderOptions cpu_options = gpu_options;
   cpu_options.backend = DirBackend::Cpu;
   const DifferentialImages cpu = renderer.render(camera, vpls, cpu_options);
   EXPECT_TRUE(renderer.last_timings().cpu_shading);
@@ -286,9 +286,9 @@ TEST_F(DirVkTest, RejectsMisuse) {
   DirRendererVk renderer(context, 16, 12);
   const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 16, 12);
   EXPECT_THROW((void)renderer.render(camera, {}), LogicError);
-  DirVkOptions options = test_options();
+  DirRenderOptions options = test_options();
   renderer.set_scene(open_cube_scene(), options);
-  DirVkOptions other = options;
+  DirRenderOptions other = options;
   other.shadow_tile = 128;
   EXPECT_THROW((void)renderer.render(camera, {}, other), Error);
   EXPECT_THROW((void)renderer.render(camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 32, 24), {}, options), Error);

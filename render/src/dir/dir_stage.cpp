@@ -127,7 +127,7 @@ void VplStage::run(StageContext& context) {
 
 // ---- dir ---------------------------------------------------------------------------------------
 
-DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirVkOptions options, std::string albedo_buffer)
+DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirRenderOptions options, std::string albedo_buffer)
     : context_(context), options_(std::move(options)), albedo_buffer_(std::move(albedo_buffer)) {}
 
 DirRenderStage::~DirRenderStage() = default;

@@ -93,7 +93,7 @@ std::vector<float> pack_vpls(std::span<const Vpl> vpls) {
   return out;
 }
 
-std::uint32_t shade_flags(const DirVkOptions& options) {
+std::uint32_t shade_flags(const DirRenderOptions& options) {
   const bool rv = options.output != DirOutput::RealOnly, r = options.output != DirOutput::RealVirtualOnly;
   return (options.shading.direct ? 1u : 0u) | (options.shading.indirect ? 2u : 0u) | (rv ? 4u : 0u) | (r ? 8u : 0u);
 }
@@ -144,6 +144,28 @@ struct DirRendererVk::Impl {
   std::uint32_t vpl_count = 0;
   std::vector<float> cpu_ism_atlas;  // of the last render when it shaded on the CPU
   std::optional<GBuffer> last_gbuffer;  // read back on demand, dropped by the next render
+
+  // Steps 3-5 (ISMs, shading, merge) into `cmd`.
+  void record_shading(VkCommandBuffer cmd, const ShadeParams& params, const DirRenderOptions& options) {
+    Impl& d = *this;
+    d.timers[2].start(cmd);
+    d.ism.record(cmd, *d.vpls, d.vpl_count, options.ism);
+    d.timers[2].stop(cmd);
+    vk::compute_barrier(cmd);
+    d.shade_set = {};
+    d.shade_set = d.shade.bind({&d.gbuffer_buffer, d.materials.get(), d.lights.get(), d.views.get(),
+                                &d.shadow_maps.atlas(), d.vpls.get(), &d.ism.atlas(), &d.shaded});
+    const auto n = static_cast<std::uint32_t>(options.interleave);
+    d.timers[3].start(cmd);
+    d.shade.dispatch(cmd, d.shade_set, params, vk::ComputePipeline::group_count((params.width + n - 1) / n * n, 8),
+                     vk::ComputePipeline::group_count((params.height + n - 1) / n * n, 8));
+    d.timers[3].stop(cmd);
+    vk::compute_barrier(cmd);
+    d.timers[4].start(cmd);
+    d.merge.dispatch(cmd, d.merge_set, detail::MergeParams{params.width, params.height, n},
+                     vk::ComputePipeline::group_count(params.width, 8), vk::ComputePipeline::group_count(params.height, 8));
+    d.timers[4].stop(cmd);
+  }
 };
 
 DirRendererVk::DirRendererVk(vk::VulkanContext& context, int width, int height) {
@@ -153,7 +175,7 @@ DirRendererVk::DirRendererVk(vk::VulkanContext& context, int width, int height) 
 
 DirRendererVk::~DirRendererVk() = default;
 
-void DirRendererVk::set_scene(const MrScene& scene, const DirVkOptions& options) {
+void DirRendererVk::set_scene(const MrScene& scene, const DirRenderOptions& options) {
   Impl& d = *impl_;
   scene.validate();
   d.gbuffer.set_scene(scene);
@@ -167,7 +189,7 @@ void DirRendererVk::set_scene(const MrScene& scene, const DirVkOptions& options)
   d.scene = scene;
 }
 
-DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const Vpl> vpls, const DirVkOptions& options) {
+DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const Vpl> vpls, const DirRenderOptions& options) {
   Impl& d = *impl_;
   if (!d.scene) throw LogicError("DirRendererVk::set_scene must come before render");
   if (options.shadow_tile != d.layout.tile) throw Error("DirRendererVk: the shadow tile differs from set_scene's");
@@ -197,7 +219,7 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
     d.timers[1].start(cmd);
     d.shadow_maps.record(cmd, d.layout);
     d.timers[1].stop(cmd);
-    if (!cpu_shading) record_shading(cmd, params, options);
+    if (!cpu_shading) d.record_shading(cmd, params, options);
     d.timers[5].stop(cmd);
   });
   const auto ms = [&](std::size_t k) { return d.timers[k].elapsed_ms().value_or(0.0); };
@@ -219,29 +241,8 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
   return out;
 }
 
-void DirRendererVk::record_shading(VkCommandBuffer cmd, const detail::ShadeParams& params, const DirVkOptions& options) {
-  Impl& d = *impl_;
-  d.timers[2].start(cmd);
-  d.ism.record(cmd, *d.vpls, d.vpl_count, options.ism);
-  d.timers[2].stop(cmd);
-  vk::compute_barrier(cmd);
-  d.shade_set = {};
-  d.shade_set = d.shade.bind({&d.gbuffer_buffer, d.materials.get(), d.lights.get(), d.views.get(),
-                              &d.shadow_maps.atlas(), d.vpls.get(), &d.ism.atlas(), &d.shaded});
-  const auto n = static_cast<std::uint32_t>(options.interleave);
-  d.timers[3].start(cmd);
-  d.shade.dispatch(cmd, d.shade_set, params, vk::ComputePipeline::group_count((params.width + n - 1) / n * n, 8),
-                   vk::ComputePipeline::group_count((params.height + n - 1) / n * n, 8));
-  d.timers[3].stop(cmd);
-  vk::compute_barrier(cmd);
-  d.timers[4].start(cmd);
-  d.merge.dispatch(cmd, d.merge_set, detail::MergeParams{params.width, params.height, n},
-                   vk::ComputePipeline::group_count(params.width, 8), vk::ComputePipeline::group_count(params.height, 8));
-  d.timers[4].stop(cmd);
-}
-
 DifferentialImages DirRendererVk::shade_on_cpu(const MrCamera& camera, std::span<const Vpl> vpls,
-                                               const DirVkOptions& options) {
+                                               const DirRenderOptions& options) {
   Impl& d = *impl_;
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();

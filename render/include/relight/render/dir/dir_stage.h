@@ -60,7 +60,7 @@
 namespace relight::render {
 
 struct DirStageOptions {
-  DirVkOptions renderer{};
+  DirRenderOptions renderer{};
   VplOptions vpls{.count = 64};
   DepthMeshOptions mesh{.stride = 2};
   PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
@@ -132,7 +132,7 @@ class VplStage final : public Stage {
 class DirRenderStage final : public Stage {
  public:
   /// `albedo_buffer`: DirStageOptions::albedo_buffer.
-  DirRenderStage(vk::VulkanContext* context, DirVkOptions options, std::string albedo_buffer = {});
+  DirRenderStage(vk::VulkanContext* context, DirRenderOptions options, std::string albedo_buffer = {});
   ~DirRenderStage() override;
   [[nodiscard]] std::string name() const override { return "dir"; }
   void declare(StageBuilder& builder) override;
@@ -140,7 +140,7 @@ class DirRenderStage final : public Stage {
 
  private:
   vk::VulkanContext* context_;
-  DirVkOptions options_;
+  DirRenderOptions options_;
   std::string albedo_buffer_;
   std::unique_ptr<DirRendererVk> renderer_;
   std::pair<int, int> renderer_size_{0, 0};

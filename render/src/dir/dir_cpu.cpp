@@ -3,7 +3,7 @@
 
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
-#include "relight/render/dir/dir_vk.h"
+#include "relight/render/dir/dir.h"
 #include "relight/render/scene/phong_brdf.h"
 #include "scene/surface_shading.h"
 
@@ -23,7 +23,7 @@ class MapShader {
  public:
   MapShader(const MrScene& scene, const ShadowLayout& layout, std::span<const float> shadow_atlas,
             std::span<const Vpl> vpls, std::span<const float> ism_atlas, const Eigen::Vector4f& virtual_bounds,
-            const DirVkOptions& options)
+            const DirRenderOptions& options)
       : scene_(scene), layout_(layout), shadow_atlas_(shadow_atlas), vpls_(vpls),
         ism_(ism_atlas, options.ism, vpls, virtual_bounds), options_(options) {}
 
@@ -91,7 +91,7 @@ class MapShader {
   std::span<const float> shadow_atlas_;
   std::span<const Vpl> vpls_;
   IsmLookup ism_;
-  const DirVkOptions& options_;
+  const DirRenderOptions& options_;
 };
 
 /// Whether neighbour (qx, qy) may lend pixel (x, y) its indirect light: inside the image, on the
@@ -154,7 +154,7 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
 DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene, const Vec3& camera_centre,
                                        const ShadowLayout& layout, std::span<const float> shadow_atlas,
                                        std::span<const Vpl> vpls, std::span<const float> ism_atlas,
-                                       const Eigen::Vector4f& virtual_bounds, const DirVkOptions& options) {
+                                       const Eigen::Vector4f& virtual_bounds, const DirRenderOptions& options) {
   const int width = gbuffer.position.width(), height = gbuffer.position.height();
   if (shadow_atlas.size() < static_cast<std::size_t>(layout.atlas_width()) * static_cast<std::size_t>(layout.atlas_height()))
     throw Error("shade_dir_from_maps: the shadow atlas is smaller than its layout");
@@ -198,7 +198,7 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
 }
 
 DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
-                                  const DirVkOptions& options, GBuffer* gbuffer_out) {
+                                  const DirRenderOptions& options, GBuffer* gbuffer_out) {
   const RayTracer tracer(scene);
   GBuffer local;
   GBuffer& gbuffer = gbuffer_out ? *gbuffer_out : local;
