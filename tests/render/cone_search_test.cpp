@@ -1,6 +1,7 @@
 // The point-cone search (cone_search.h): its rules on hand-placed points, and the Vulkan twin
 // against the CPU reference on the synthetic scene's surface points.
 #include "relight/render/vpl/cone_search.h"
+#include "relight/render/dir/ism.h"
 
 #include <gtest/gtest.h>
 

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "relight/core/error.h"
+#include "relight/render/dir/ism.h"  // sample_ism_points: the point pools the cone search reads
 #include "relight/render/vpl/cone_search.h"
 #include "relight/render/vpl/cone_search_vk.h"
 #include "relight/render/vpl/hierarchical_warp.h"

@@ -35,6 +35,7 @@
 #include <vector>
 
 #include "relight/render/scene/mr_scene.h"
+#include "relight/render/vpl/surface_points.h"
 #include "relight/render/vpl/vpl.h"
 
 namespace relight::render {
@@ -48,20 +49,6 @@ struct IsmOptions {
   int pull_push_levels = 3;    ///< coarser levels used to fill holes (tile >> levels >= 2)
   bool focus_virtual = true;   ///< the virtual tile looks at the virtual objects only (above)
   std::uint64_t seed = 7;
-};
-
-struct IsmPoint {
-  Eigen::Vector3f position;
-  Eigen::Vector3f normal;
-  float half_size = 0.f;  ///< half the side of the point's square splat (metres)
-  std::uint32_t material = 0;  ///< of the triangle the point lies on (MrScene::materials)
-};
-
-struct IsmPointPools {
-  std::vector<IsmPoint> real;
-  std::vector<IsmPoint> virtual_points;
-  /// Centre and radius of a sphere around every virtual point; radius 0 = none, or focus off.
-  Eigen::Vector4f virtual_bounds = Eigen::Vector4f::Zero();
 };
 
 /// How one VPL's tile maps directions: the paraboloid of the hemisphere around the VPL normal

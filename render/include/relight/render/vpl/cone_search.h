@@ -25,7 +25,7 @@
 #include <span>
 #include <vector>
 
-#include "relight/render/dir/ism.h"
+#include "relight/render/vpl/surface_points.h"
 
 namespace relight::render {
 
