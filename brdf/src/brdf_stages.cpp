@@ -6,7 +6,7 @@
 #include "relight/brdf/kmeans_vk.h"
 #include "relight/brdf/specular_objective_vk.h"
 #include "relight/core/error.h"
-#include "parallel_tbb.h"
+#include "relight/core/parallel.h"
 
 namespace relight::brdf {
 
@@ -73,8 +73,8 @@ void fit_materials(const ColorImage& color, const Mask* highlights, const Positi
       starts[k].start = best_grid_start(*gpu_start, problems[k], options.specular);
     }
   }
-  detail::parallel_ranges(
-      clusters, options.threads, 1,
+  parallel_rows(
+      clusters, options.threads,
       [&](int begin, int end) {
         for (int k = begin; k < end; ++k) {
           const auto index = static_cast<std::size_t>(k);
@@ -89,7 +89,8 @@ void fit_materials(const ColorImage& color, const Mask* highlights, const Positi
           m.n = fit.n;
           m.fit_rms = static_cast<float>(fit.rms);
         }
-      });
+      },
+      1);
 }
 
 void estimate_brdf(const ColorImage& color, const PositionMap& positions, const NormalMap& normals,
@@ -108,7 +109,7 @@ void estimate_brdf(const ColorImage& color, const PositionMap& positions, const 
 RadianceImage render_materials(const Materials& materials, const PositionMap& positions, const NormalMap& normals,
                                const ShadingLights& lights) {
   RadianceImage out(materials.ids.width(), materials.ids.height());
-  detail::parallel_each_row(out.height(), 0, [&](int r) {
+  parallel_for_each_row(out.height(), 0, [&](int r) {
     for (int c = 0; c < out.width(); ++c) {
       const int id = materials.ids(r, c);
       if (id == 0) continue;

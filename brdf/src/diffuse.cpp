@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "relight/core/error.h"
-#include "parallel_tbb.h"
+#include "relight/core/parallel.h"
 
 namespace relight::brdf {
 
@@ -119,7 +119,7 @@ void estimate(int width, int height, FillColour&& fill_colour, const PositionMap
   }
   kd.resize(width, height);
   valid.resize(width, height);
-  detail::parallel_ranges(height, options.threads, 8, [&](int begin, int end) {
+  parallel_rows(height, options.threads, [&](int begin, int end) {
     RowShading shading(width);
     RowReflectance reflectance(width);
     for (int r = begin; r < end; ++r) {
@@ -127,7 +127,7 @@ void estimate(int width, int height, FillColour&& fill_colour, const PositionMap
       fill_colour(r, reflectance.colour());
       reflectance.compute(r, positions, normals, shading, options, kd, valid);
     }
-  });
+  }, 8);
 }
 
 }  // namespace

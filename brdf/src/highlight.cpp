@@ -5,7 +5,7 @@
 #include <limits>
 #include <vector>
 
-#include "parallel_tbb.h"
+#include "relight/core/parallel.h"
 
 namespace relight::brdf {
 
@@ -31,7 +31,7 @@ void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
   // Rows without a set pixel within `radius` rows stay empty: highlights are rare, so most of
   // the image is skipped.
   std::vector<std::uint8_t> row_set(static_cast<std::size_t>(h), 0), row_near(static_cast<std::size_t>(h), 0);
-  detail::parallel_each_row(h, threads, [&](int r) {
+  parallel_for_each_row(h, threads, [&](int r) {
     const auto row = input.row(r);
     row_set[static_cast<std::size_t>(r)] = std::any_of(row.begin(), row.end(), [](std::uint8_t v) { return v != 0; });
   });
@@ -40,7 +40,7 @@ void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
     for (int rr = std::max(0, r - radius); rr <= std::min(h - 1, r + radius); ++rr) row_near[static_cast<std::size_t>(rr)] = 1;
   }
   std::vector<std::uint8_t> distance(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
-  detail::parallel_each_row(h, threads, [&](int r) {
+  parallel_for_each_row(h, threads, [&](int r) {
     std::uint8_t* d = distance.data() + static_cast<std::size_t>(r) * static_cast<std::size_t>(w);
     if (!row_set[static_cast<std::size_t>(r)]) {
       std::fill(d, d + w, static_cast<std::uint8_t>(far));
@@ -61,7 +61,7 @@ void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
   for (int dy = 0; dy <= radius; ++dy) {
     reach[static_cast<std::size_t>(dy)] = static_cast<int>(std::floor(std::sqrt(static_cast<double>(radius * radius - dy * dy))));
   }
-  detail::parallel_each_row(h, threads, [&](int r) {
+  parallel_for_each_row(h, threads, [&](int r) {
     if (!row_near[static_cast<std::size_t>(r)]) {
       const auto row = output.row(r);
       std::fill(row.begin(), row.end(), std::uint8_t{0});
@@ -83,12 +83,12 @@ void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
 void remove_highlights(const ColorImage& color, const HighlightOptions& options, ColorImage& cleaned, Mask& mask) {
   const int w = color.width(), h = color.height();
   Mask seeds(w, h);
-  detail::parallel_each_row(h, options.threads, [&](int r) {
+  parallel_for_each_row(h, options.threads, [&](int r) {
     for (int c = 0; c < w; ++c) seeds(r, c) = is_highlight(color(r, c), options) ? 1 : 0;
   });
   dilate_disk(seeds, options.dilate_radius, mask, options.threads);
   cleaned = color;
-  detail::parallel_each_row(h, options.threads, [&](int r) {
+  parallel_for_each_row(h, options.threads, [&](int r) {
     for (int c = 0; c < w; ++c) {
       if (!mask(r, c)) continue;
       for (int ring = 1; ring <= options.fill_radius_max; ++ring) {
