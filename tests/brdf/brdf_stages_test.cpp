@@ -8,7 +8,7 @@
 #include <map>
 
 #include "brdf_test_scene.h"
-#include "reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/vk/transfer.h"
 
 namespace relight::brdf {

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "brdf_test_scene.h"
-#include "reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/brdf/diffuse.h"
 #include "relight/brdf/highlight.h"
 

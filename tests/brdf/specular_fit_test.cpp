@@ -11,7 +11,7 @@
 #include <cstdio>
 
 #include "brdf_test_scene.h"
-#include "reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/brdf/specular_objective_vk.h"
 
 namespace relight::brdf {

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "colormap_test_scene.h"
-#include "reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/core/error.h"
 #include "relight/vk/transfer.h"
 

@@ -13,7 +13,7 @@
 
 #include "colormap_test_scene.h"
 #include "statistics_reference.h"
-#include "reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/colormap/statistics_transfer_vk.h"
 #include "relight/core/error.h"
 #include "relight/vk/buffer.h"

@@ -4,7 +4,7 @@
 #include "probes.h"
 #include "relight/lights/importance_sampling.h"
 #include "relight/vk/context.h"
-#include "../reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 
 namespace relight {
 namespace {

@@ -24,7 +24,7 @@
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
 #include "synthetic_sequence.h"
-#include "vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 
 namespace relight {
 namespace {

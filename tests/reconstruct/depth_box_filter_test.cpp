@@ -11,7 +11,7 @@
 
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
-#include "vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 
 namespace relight {
 

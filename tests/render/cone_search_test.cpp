@@ -9,7 +9,7 @@
 #include <numbers>
 #include <vector>
 
-#include "../reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/core/error.h"
 #include "relight/render/vpl/cone_search_vk.h"
 #include "relight/render/scene/phong_brdf.h"

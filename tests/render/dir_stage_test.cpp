@@ -7,7 +7,7 @@
 
 #include <algorithm>
 
-#include "../reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/render/scene/procedural_models.h"
 #include "relight/render/scene/scene_from_synth.h"
 #include "relight/synth/raycast.h"

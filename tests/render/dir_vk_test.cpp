@@ -7,7 +7,7 @@
 
 #include <algorithm>
 
-#include "../reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/core/error.h"
 #include "relight/synth/scene.h"
 #include "relight/vk/context.h"

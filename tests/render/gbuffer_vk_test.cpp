@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/core/error.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"

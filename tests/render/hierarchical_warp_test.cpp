@@ -9,7 +9,7 @@
 #include <limits>
 #include <vector>
 
-#include "../reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/core/error.h"
 #include "relight/render/vpl/hierarchical_warp_vk.h"
 #include "relight/render/scene/sampler.h"

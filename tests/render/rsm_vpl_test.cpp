@@ -6,7 +6,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "../reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/core/error.h"
 #include "relight/render/vpl/reflective_shadow_map.h"
 #include "relight/render/vpl/reflective_shadow_map_vk.h"

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../reconstruct/vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 #include "relight/reconstruct/depth_warp_merge.h"
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"

@@ -17,7 +17,7 @@
 #include "relight/vk/timer.h"
 #include "relight/vk/transfer.h"
 #include "relight/shaders/add_constant_test_comp.h"
-#include "vulkan_test_env.h"
+#include "support/vulkan_test_env.h"
 
 namespace relight::vk {
 namespace {
