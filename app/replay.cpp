@@ -18,6 +18,8 @@
 #include "mixed_reality_scene.h"
 #include "object_placement_stage.h"
 #include "relight/capture/camera_tracking_stage.h"
+#include "relight/capture/looping_source.h"
+#include "relight/capture/range_source.h"
 #include "relight/capture/marker_pose.h"
 #include "relight/capture/openni_source.h"
 #include "relight/capture/source_stage.h"
@@ -58,66 +60,6 @@ std::filesystem::path default_sequence() { return data_folder() / "tum_fr1_rpy";
 
 namespace {
 
-// Frames [first, last) of a source that can only be read sequentially (a .oni recording).
-class RangeSource final : public FrameSource {
- public:
-  RangeSource(std::unique_ptr<FrameSource> source, FrameRange range) : source_(std::move(source)), range_(range) {}
-  std::optional<RgbdFrame> next() override {
-    for (; position_ < range_.first; ++position_) {
-      if (!source_->next()) return std::nullopt;
-    }
-    if (range_.last && position_ >= *range_.last) return std::nullopt;
-    auto frame = source_->next();
-    if (frame) frame->info.index = static_cast<std::int64_t>(position_++ - range_.first);
-    return frame;
-  }
-  std::int64_t size_hint() const override {
-    const auto total = static_cast<std::size_t>(std::max<std::int64_t>(source_->size_hint(), 0));
-    const std::size_t end = std::min(total, range_.last.value_or(total));
-    return end > range_.first ? static_cast<std::int64_t>(end - range_.first) : 0;
-  }
-  std::string describe() const override { return source_->describe(); }
-
- private:
-  std::unique_ptr<FrameSource> source_;
-  FrameRange range_;
-  std::size_t position_ = 0;
-};
-
-// Plays the sequence `loops` times (soak tests, long benchmarks): frame indices keep counting and
-// timestamps keep increasing, so temporal stages see one long, continuous run.
-class LoopingSource final : public FrameSource {
- public:
-  using Opener = std::function<std::unique_ptr<FrameSource>()>;
-  LoopingSource(Opener open, int loops) : open_(std::move(open)), loops_(loops), source_(open_()) {}
-  std::optional<RgbdFrame> next() override {
-    for (;;) {
-      if (auto frame = source_->next()) {
-        if (loop_ == 0) last_timestamp_ = frame->info.timestamp;
-        if (index_ == 0) first_timestamp_ = frame->info.timestamp;
-        frame->info.index = index_++;
-        frame->info.timestamp += loop_ * (last_timestamp_ - first_timestamp_ + kFramePeriod);
-        return frame;
-      }
-      if (++loop_ >= loops_ || index_ == 0) return std::nullopt;
-      source_ = open_();
-    }
-  }
-  std::int64_t size_hint() const override { return source_->size_hint() * loops_; }
-  std::string describe() const override {
-    return source_->describe() + ", played " + std::to_string(loops_) + " times";
-  }
-
- private:
-  static constexpr double kFramePeriod = 1.0 / 30.0;
-  Opener open_;
-  int loops_;
-  std::unique_ptr<FrameSource> source_;
-  int loop_ = 0;
-  std::int64_t index_ = 0;
-  double first_timestamp_ = 0, last_timestamp_ = 0;
-};
-
 std::unique_ptr<FrameSource> open_source_once(const ReplayOptions& options) {
   TumOptions tum;
   if (!options.intrinsics.empty()) {
@@ -130,7 +72,7 @@ std::unique_ptr<FrameSource> open_source_once(const ReplayOptions& options) {
     OpenNiOptions oni;
     oni.uri = folder.string();
     oni.intrinsics = tum.intrinsics;
-    return std::make_unique<RangeSource>(std::make_unique<OpenNiSource>(oni), range);
+    return std::make_unique<RangeSource>(std::make_unique<OpenNiSource>(oni), range.first, range.last);
   }
   auto source = std::make_unique<TumSource>(TumSequence::open(folder, tum), range.first, range.last);
   if (options.skip_bad_frames) {
