@@ -122,7 +122,7 @@ void open_device(Device& device, const std::string& uri, bool file) {
   if (device.device.open(target) == openni::STATUS_OK) return;
   const std::string detail = extended_error();
   if (file) {
-    // OpenNI2 gives no message for a cut recording (platform.md): say what it most likely is.
+    // OpenNI2 gives no message for a cut recording (docs/platform.md): say what it most likely is.
     throw Error(uri + ": cannot play this .oni file (truncated or corrupt recording)" +
                 (detail.empty() ? std::string() : ": " + detail));
   }

@@ -24,7 +24,7 @@
 //     ceres::AutoDiffCostFunction over a 128-sample subset (stopped after a 5-iteration probe
 //     that lowers the cost by less than 10 %, or at a relative cost change of 1e-4); (k_s, n)
 //     again on all samples with the moved lights.
-// Ceres stays out of this header (compile time, shared/design/platform.md).
+// Ceres stays out of this header (compile time, docs/platform.md).
 //
 // When the fit's RMS residual stays above `max_rms`, or k_s comes out below `min_ks`, the cluster
 // is declared diffuse (k_s = 0).

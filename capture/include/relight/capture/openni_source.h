@@ -3,7 +3,7 @@
 // device relight://synthetic / relight://tum/<folder>, see capture/openni_driver/) or a recorded
 // .oni file played back through OpenNI2's file device. OpenNI.h stays out of this header.
 //
-// Reading follows ../shared/design/platform.md: every wait is OpenNI::waitForAnyStream with a
+// Reading follows docs/platform.md: every wait is OpenNI::waitForAnyStream with a
 // timeout (a plain readFrame blocks forever on an unplugged device), a device-disconnected
 // listener turns an unplug into a relight::Error, and .oni files are read sequentially (seek
 // crashes in this OpenNI2 version), their end being the wait timing out.

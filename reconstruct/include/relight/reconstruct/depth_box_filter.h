@@ -11,7 +11,7 @@
 //
 // Three ways to run it:
 //   - depth_box_filter(depth)                 : the CPU reference (plain, serial; also the fast
-//                                               path on lavapipe machines, see platform.md)
+//                                               path on lavapipe machines, see docs/platform.md)
 //   - DepthBoxFilterVk(context).run(depth)    : Vulkan without the frame graph
 //   - DepthBoxFilterCpuStage / DepthBoxFilterVkStage, or make_depth_box_filter_stage(backend, ...):
 //     frame-graph stages reading a DepthMap buffer ("depth") and writing one ("depth_smoothed").

@@ -1,5 +1,5 @@
 #pragma once
-// Which backend a stage runs on. Measured on this project's machines (shared/design/platform.md):
+// Which backend a stage runs on. Measured on this project's machines (docs/platform.md):
 // lavapipe, the CPU-type Vulkan device, runs a per-pixel compute dispatch slower than relight's
 // plain CPU loop, so per-pixel stages default to the CPU path there and to Vulkan on a real GPU.
 // Rasterisation-heavy work (the renderer) stays on Vulkan whenever a device exists.

@@ -22,7 +22,7 @@ enum class DirOutput { Both, RealVirtualOnly, RealOnly };
 
 /// Where steps 3-5 (ISMs, shading, merge) run. Rasterisation (steps 1-2) is always Vulkan's.
 /// Auto: on the CPU when the Vulkan device is itself a CPU (lavapipe), where relight's CPU code
-/// is several times faster than the same per-pixel work through llvmpipe (platform.md; bench
+/// is several times faster than the same per-pixel work through llvmpipe (docs/platform.md; bench
 /// dir/frame_640x480_*: cpu_mirror_ms), on the GPU otherwise.
 enum class DirBackend { Auto, Gpu, Cpu };
 
