@@ -7,6 +7,7 @@
 
 #include "json_config.h"
 #include "mixed_reality_scene.h"
+#include "render_option_values.h"
 #include "replay.h"
 
 namespace relight::app {
@@ -88,7 +89,7 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--vpl-budget", options.vpl_budget,
                      "How the VPL samples are shared among the lights: equal, power (emitted power), weights "
                      "(--vpl-weights) or flux (the flux each light's VPLs carried last frame)")
-      ->check(CLI::IsMember({"equal", "power", "weights", "flux"}))
+      ->check(CLI::IsMember(names_of(kVplBudgets)))
       ->capture_default_str();
   command.add_option("--vpl-weights", options.vpl_weights,
                      "With --vpl-budget weights: one weight per light, comma-separated (the lights file's order, "
@@ -102,12 +103,12 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--bounce-method", options.bounce_method,
                      "How bounces after the first find their surface: rays (ray traced) or cone (the nearest of "
                      "the surface points within 5 degrees of the sampled direction, no ray tracing)")
-      ->check(CLI::IsMember({"rays", "cone"}))
+      ->check(CLI::IsMember(names_of(kBounceMethods)))
       ->capture_default_str();
   command.add_option("--vpl-source", options.vpl_source,
                      "Where a spot light's first VPLs come from: rays (traced from the light) or rsm (importance-"
                      "sampled texels of its reflective shadow maps, rasterised on the Vulkan device)")
-      ->check(CLI::IsMember({"rays", "rsm"}))
+      ->check(CLI::IsMember(names_of(kVplSources)))
       ->capture_default_str();
   command.add_option("--real-albedo", options.real_albedo,
                      "The k_d that real surfaces are rendered with: pixel (each camera pixel's own estimate, so "
@@ -120,11 +121,11 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--colormap", options.colormap,
                      "Map the rendered colours to the camera's: stats (CIELab statistics), sample (colour samples "
                      "and a fitted 3x4 matrix) or none; composite.mp4 shows the mapped result, frames/ both")
-      ->check(CLI::IsMember({"none", "sample", "stats"}))
+      ->check(CLI::IsMember(names_of(kColorMapMethods)))
       ->capture_default_str();
   command.add_option("--colormap-model", options.colormap_model,
                      "Polynomial model of --colormap sample: per_channel_affine, linear_3x3 or affine_3x4")
-      ->check(CLI::IsMember({"per_channel_affine", "linear_3x3", "affine_3x4"}))
+      ->check(CLI::IsMember(names_of(kColorMapModels)))
       ->capture_default_str();
   command.add_flag("--channel-swap", options.channel_swap,
                    "--colormap sample: also fit channel-permuted colour pairs (helps when the virtual colour is "

@@ -17,6 +17,7 @@
 #include "marker_trajectory_stage.h"
 #include "mixed_reality_scene.h"
 #include "object_placement_stage.h"
+#include "render_option_values.h"
 #include "relight/capture/camera_tracking_stage.h"
 #include "relight/capture/looping_source.h"
 #include "relight/capture/range_source.h"
@@ -128,39 +129,16 @@ std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
   return parse_tag_layout(text, scene.string());
 }
 
-render::VplBudget vpl_budget(const std::string& name) {
-  if (name == "equal") return render::VplBudget::Equal;
-  if (name == "power") return render::VplBudget::ByPower;
-  if (name == "weights") return render::VplBudget::ByWeight;
-  if (name == "flux") return render::VplBudget::ByPreviousFlux;
-  throw Error("--vpl-budget '" + name + "' is not one of equal, power, weights, flux");
-}
-
-colormap::ColorMapMethod color_map_method(const std::string& name) {
-  if (name == "none") return colormap::ColorMapMethod::None;
-  if (name == "sample") return colormap::ColorMapMethod::Sample;
-  if (name == "stats") return colormap::ColorMapMethod::Statistics;
-  throw Error("--colormap '" + name + "' is not one of none, sample, stats");
-}
-
-colormap::PolynomialModel polynomial_model(const std::string& name) {
-  for (const auto model : {colormap::PolynomialModel::PerChannelAffine, colormap::PolynomialModel::Linear3x3,
-                           colormap::PolynomialModel::Affine3x4}) {
-    if (name == colormap::to_string(model)) return model;
-  }
-  throw Error("--colormap-model '" + name + "' is not one of per_channel_affine, linear_3x3, affine_3x4");
-}
-
 /// The colour mapping between DIR's L_rv/L_r and the camera, and its composite; returns the name
 /// of the buffer that holds the final picture ("composite" when there is no mapping).
 std::string add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel,
                               const colormap::ToneMap& tone_map) {
-  const auto method = color_map_method(options.colormap);
+  const auto method = parse_option(kColorMapMethods, "--colormap", options.colormap);
   if (method == colormap::ColorMapMethod::None) return "composite";  // DIR's own composite is unmapped
   colormap::SampleMappingOptions mapping;
   mapping.tone_map = tone_map;
   mapping.channel_swap = options.channel_swap;
-  mapping.model = polynomial_model(options.colormap_model);
+  mapping.model = parse_option(kColorMapModels, "--colormap-model", options.colormap_model);
   pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping));
   pipeline.graph->emplace<render::MappedCompositeStage>();
   pipeline.graph->keep("composite_mapped");
@@ -208,12 +186,11 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
   render::DirStageOptions dir;
   dir.vpls.count = options.vpls;
-  dir.vpls.budget = vpl_budget(options.vpl_budget);
+  dir.vpls.budget = parse_option(kVplBudgets, "--vpl-budget", options.vpl_budget);
   dir.vpls.light_weights = options.vpl_weights;
   dir.vpls.bounces = options.vpl_bounces;
-  dir.vpls.bounce_method = options.bounce_method == "cone" ? render::BounceMethod::PointCone : render::BounceMethod::RayTraced;
-  dir.vpls.source =
-      options.vpl_source == "rsm" ? render::VplSource::ReflectiveShadowMaps : render::VplSource::RayTraced;
+  dir.vpls.bounce_method = parse_option(kBounceMethods, "--bounce-method", options.bounce_method);
+  dir.vpls.source = parse_option(kVplSources, "--vpl-source", options.vpl_source);
   dir.tone_map.exposure = options.exposure;
   dir.materials_buffer = "materials";
   if (pipeline.placement) dir.placements_buffer = "object_placements";

@@ -225,36 +225,37 @@ std::pair<double, std::size_t> pebble_overlap(const std::vector<bool>& a, const 
 
 // Live mixed reality that holds still: `relight live` on the virtual device's orbit, tracked
 // (marker+odometry from the layout the device serves, lit by the probe it serves), draws the
-// pebble where a replay of the same frames with the true poses draws it. Measured: IoU 0.96 to
-// 0.97 per frame (the pebble is ~650 pixels at 320x240; the marker pose that sets the world is
-// good to about a centimetre).
+// pebble where a replay of the same frames with the true poses draws it. Measured at 640x480: IoU
+// 0.966 to 0.969 per frame (the pebble ~2600 pixels; the marker pose that sets the world is good
+// to about a centimetre; at 320x240 the same offset gave 0.945 to 0.966, depending on the frame
+// the marker anchored the world at).
 TEST(ReplayTracking, LiveOrbitDrawsThePebbleWhereAReplayWithTheTruePosesDoes) {
   TempDir dir;
   const std::string pebble = std::string(RELIGHT_TEST_DATA) + "/models/glossy_pebble.gltf";
-  constexpr int kFps = 3;  // slow enough for the pipeline to take every frame, mostly
+  constexpr int kFps = 1;  // slow enough for the pipeline to take every frame, mostly
   const auto live = dir.path() / "live";
-  const auto ran = relight("live --quiet --no-video --buffers --vpls 16 --device \"relight://synthetic?trajectory=orbit&size=320x240&fps=" +
-                           std::to_string(kFps) + "\" --frames 5 --object " + pebble + " --out " + live.string());
+  const auto ran = relight("live --quiet --no-video --buffers --vpls 16 --device \"relight://synthetic?trajectory=orbit&fps=" +
+                           std::to_string(kFps) + "\" --frames 4 --object " + pebble + " --out " + live.string());
   ASSERT_EQ(ran.exit_code, 0) << ran.err;
   EXPECT_EQ(tracking_of(live)["source"], "marker+odometry");
-  const auto sequence = cli_test::synthetic_sequence("--frames 12 --trajectory orbit --noise none --size 320x240 --no-gt");
+  const auto sequence = cli_test::synthetic_sequence("--frames 10 --trajectory orbit --noise none --no-gt");
   const auto replay = dir.path() / "replay";
   ASSERT_EQ(relight("replay --quiet --no-video --buffers --vpls 16 --pose sequence " + sequence.string() + " --object " + pebble +
                     " --out " + replay.string())
                 .exit_code,
             0);
   const auto timestamps = trajectory_timestamps(live / "camera_trajectory.txt");
-  ASSERT_EQ(timestamps.size(), 5u);
+  ASSERT_EQ(timestamps.size(), 4u);
   for (std::size_t i = 0; i < timestamps.size(); ++i) {
     // The device's frame k has timestamp 1 s + k / fps; the replay's frame k is the same view.
     const auto k = static_cast<int>(std::lround((timestamps[i] - 1.0) * kFps));
-    ASSERT_LT(k, 12) << "the device dropped more frames than the replay holds";
+    ASSERT_LT(k, 10) << "the device dropped more frames than the replay holds";
     char live_name[32], replay_name[32];
     std::snprintf(live_name, sizeof live_name, "%06zu", i);
     std::snprintf(replay_name, sizeof replay_name, "%06d", k);
     const auto [iou, either] =
         pebble_overlap(virtual_pixels(live / "frames", live_name), virtual_pixels(replay / "frames", replay_name));
-    ASSERT_GT(either, 100u) << "the pebble is in view in frame " << i;
+    ASSERT_GT(either, 400u) << "the pebble is in view in frame " << i;
     std::printf("live frame %zu (device frame %d): IoU %.3f of %zu pixels\n", i, k, iou, either);
     EXPECT_GE(iou, 0.95) << "frame " << i;
   }
