@@ -17,12 +17,9 @@
 
 #include "commands.h"
 #include "interrupt.h"
-#include "latency_stage.h"
 #include "live_view.h"
 #include "view_stage.h"
-#include "object_placement_stage.h"
 #include "camera_trajectory_stage.h"
-#include "marker_trajectory_stage.h"
 #include "relight/capture/openni_source.h"
 #include "relight/capture/tum_writer.h"
 #include "relight/core/atomic_file.h"
@@ -158,14 +155,7 @@ int run_live(const LiveOptions& options) {
                          : InterruptGuard::interrupted() ? "interrupt"
                          : quit_from_view                ? "view"
                                                          : "end";
-  if (pipeline.view) report["view"] = {{"drawn", pipeline.view->drawn()}, {"skipped", pipeline.view->skipped()}};
-  if (pipeline.markers) {
-    report["marker_pose"] = pipeline.markers->summary();
-    std::cerr << pipeline.markers->no_tag_warning(options.replay.markers);
-  }
-  report["tracking"] = pipeline.trajectory->summary();
-  report["latency_ms"] = pipeline.latency->summary();
-  if (pipeline.placement) report["placements"] = pipeline.placement->summary();
+  add_pipeline_summaries(report, pipeline, replay);
   write_reports(options.replay.out, "relight live: " + description, graph, report, pipeline.report);
   if (!quiet) {
     std::cerr << "relight live: " << graph.frames_run() << " frames in " << seconds << " s ("

@@ -233,14 +233,6 @@ void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
   pipeline.trajectory = &pipeline.graph->emplace<CameraTrajectoryStage>(options.out / "camera_trajectory.txt");
 }
 
-/// The kind of picture a --view-side buffer is.
-BufferPreviews::Kind view_side_kind(const std::string& buffer) {
-  if (buffer.rfind("depth", 0) == 0) return BufferPreviews::Kind::Depth;
-  if (buffer == "normals") return BufferPreviews::Kind::Normals;
-  if (buffer == "virtual_coverage") return BufferPreviews::Kind::Coverage;
-  return BufferPreviews::Kind::Color;
-}
-
 /// --view: the window (opened now, so that a missing display fails before any frame) and the
 /// stage that feeds it the final picture.
 void add_view(ReplayPipeline& pipeline, const ReplayOptions& options, bool method2) {
@@ -251,8 +243,9 @@ void add_view(ReplayPipeline& pipeline, const ReplayOptions& options, bool metho
   pipeline.view = std::make_unique<LiveView>("relight " + (options.live_device.empty() ? std::string("replay")
                                                                                        : "live: " + options.live_device),
                                              options.out / "snapshots");
+  const auto side_kind = side.empty() ? BufferPreviews::Kind::Color : parse_option(kViewSides, "--view-side", side);
   pipeline.view_stage = &pipeline.graph->emplace<ViewStage>(*pipeline.view, pipeline.renders ? pipeline.final_composite : "color",
-                                                            side, view_side_kind(side));
+                                                            side, side_kind);
 }
 
 void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, bool method2) {
@@ -274,6 +267,21 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
 
 
 }  // namespace
+
+void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline& pipeline,
+                            const ReplayOptions& options) {
+  if (pipeline.view) report["view"] = {{"drawn", pipeline.view->drawn()}, {"skipped", pipeline.view->skipped()}};
+  if (pipeline.markers) {
+    report["marker_pose"] = pipeline.markers->summary();
+    std::cerr << pipeline.markers->no_tag_warning(marker_layout_name(options));
+  }
+  report["tracking"] = pipeline.trajectory->summary();
+  report["latency_ms"] = pipeline.latency->summary();
+  if (pipeline.placement) {
+    report["placements"] = pipeline.placement->summary();
+    if (!options.quiet) std::cerr << pipeline.placement->describe();
+  }
+}
 
 ReplayOptions with_main_job_defaults(ReplayOptions options) {
   const bool embedded_sample = options.sequence.empty() && options.live_device.empty();
@@ -390,17 +398,7 @@ int run_replay(const ReplayOptions& options) {
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
   report["stopped_by"] = interrupted ? "interrupt" : quit_from_view ? "view" : "end";
-  if (pipeline.view) report["view"] = {{"drawn", pipeline.view->drawn()}, {"skipped", pipeline.view->skipped()}};
-  if (pipeline.markers) {
-    report["marker_pose"] = pipeline.markers->summary();
-    std::cerr << pipeline.markers->no_tag_warning(marker_layout_name(options));
-  }
-  report["tracking"] = pipeline.trajectory->summary();
-  report["latency_ms"] = pipeline.latency->summary();
-  if (pipeline.placement) {
-    report["placements"] = pipeline.placement->summary();
-    if (!options.quiet) std::cerr << pipeline.placement->describe();
-  }
+  add_pipeline_summaries(report, pipeline, options);
   write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
   if (interrupted) {
     // Not a failure of the input, but the run did not cover it: 128 + SIGINT, as shells report it.

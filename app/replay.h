@@ -1,6 +1,7 @@
 #pragma once
 // `relight replay`: runs the frame graph over a recorded sequence and writes the results.
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -117,6 +118,11 @@ struct ReplayPipeline {
 /// Creates the Vulkan context the options ask for and the replay graph: source, depth filter, writer.
 [[nodiscard]] ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options);
 [[nodiscard]] std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options);
+
+/// The report.json sections every run shares (replay, live): the view's counts, the marker pose
+/// (with its no-tag warning on stderr), tracking, latency, and where each object was placed
+/// (also on stderr unless quiet).
+void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline& pipeline, const ReplayOptions& options);
 
 /// Runs the whole replay; returns the process exit code. Throws relight::Error on bad input.
 int run_replay(const ReplayOptions& options);
