@@ -27,9 +27,6 @@ std::optional<Plane> plane_through(const Eigen::Vector3d& a, const Eigen::Vector
   return plane;
 }
 
-bool inlier(const Plane& plane, const Eigen::Vector3d& p, double tolerance_m) {
-  return std::abs(plane.distance(p)) <= tolerance_m + 0.01 * p.z();
-}
 
 // Least squares through the points `use` accepts (the smallest eigenvector of their scatter),
 // the normal turned to the camera's side; nullopt for fewer than 3 points.
@@ -61,13 +58,13 @@ std::optional<Plane> fit_plane(const std::vector<Eigen::Vector3d>& points, Accep
 }
 
 Plane refit(const Plane& plane, const std::vector<Eigen::Vector3d>& points, double tolerance_m) {
-  const auto fitted = fit_plane(points, [&](const Eigen::Vector3d& p) { return inlier(plane, p, tolerance_m); });
+  const auto fitted = fit_plane(points, [&](const Eigen::Vector3d& p) { return plane.holds(p, tolerance_m); });
   return fitted.value_or(plane);
 }
 
 int count_inliers(const Plane& plane, const std::vector<Eigen::Vector3d>& points, double tolerance_m) {
   int count = 0;
-  for (const auto& p : points) count += inlier(plane, p, tolerance_m);
+  for (const auto& p : points) count += plane.holds(p, tolerance_m);
   return count;
 }
 
@@ -131,7 +128,7 @@ std::vector<Plane> support_planes(const DepthMap& depth, const PinholeIntrinsics
   while (static_cast<int>(planes.size()) < max_planes) {
     auto plane = ransac_plane(points, total, options, true);
     if (!plane) break;
-    std::erase_if(points, [&](const Eigen::Vector3d& p) { return inlier(*plane, p, options.tolerance_m); });
+    std::erase_if(points, [&](const Eigen::Vector3d& p) { return plane->holds(p, options.tolerance_m); });
     planes.push_back(*plane);
   }
   return planes;

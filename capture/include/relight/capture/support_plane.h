@@ -7,6 +7,7 @@
 // It gives the world frame of a run without ground truth or markers (z up along the plane's
 // normal, origin below the first camera) and the surface that objects are placed on. The local
 // plane of one pixel's surface (local_plane_at) is what `--place-at` stands an object on.
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -22,6 +23,11 @@ struct Plane {
   int inliers = 0;                                    ///< depth samples within the tolerance
   double inlier_share = 0;                            ///< of the valid samples
   [[nodiscard]] double distance(const Eigen::Vector3d& p) const { return normal.dot(p) + offset; }
+  /// A camera-frame point within `tolerance_m` of the plane, plus 1 % of its depth (Kinect noise
+  /// grows with distance): what every fit here counts as an inlier.
+  [[nodiscard]] bool holds(const Eigen::Vector3d& p, double tolerance_m) const {
+    return std::abs(distance(p)) <= tolerance_m + 0.01 * p.z();
+  }
   /// Where the camera ray through pixel (u, v) meets the plane (camera frame); nullopt when the
   /// ray runs parallel to it or meets it behind the camera.
   [[nodiscard]] std::optional<Eigen::Vector3d> ray_hit(const PinholeIntrinsics& intrinsics, double u, double v) const;
