@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "number_list.h"
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
 #include "relight/lights/light_output.h"
@@ -25,20 +26,6 @@ bool is_synthetic(const fs::path& sequence) {
 
 namespace {
 
-/// The comma-separated numbers of `option`'s value `text`.
-std::vector<float> parse_numbers(const char* option, const std::string& text) {
-  std::vector<float> v;
-  std::stringstream stream(text);
-  std::string field;
-  while (std::getline(stream, field, ',')) {
-    char* end = nullptr;
-    v.push_back(std::strtof(field.c_str(), &end));
-    if (field.empty() || *end != '\0' || !std::isfinite(v.back()))
-      throw Error(std::string(option) + " '" + text + "': '" + field + "' is not a number");
-  }
-  return v;
-}
-
 /// intensity x (r, g, b) from v[first] and, when present, v[first + 1 .. first + 3].
 Eigen::Vector3f parse_intensity(const char* option, const std::string& text, const std::vector<float>& v,
                                 std::size_t first) {
@@ -52,7 +39,7 @@ Eigen::Vector3f parse_intensity(const char* option, const std::string& text, con
 }  // namespace
 
 render::MrLight parse_virtual_light(const std::string& text) {
-  const std::vector<float> v = parse_numbers("--virtual-light", text);
+  const std::vector<float> v = parse_number_list<float>("--virtual-light", text);
   if (v.size() != 4 && v.size() != 7) throw Error("--virtual-light '" + text + "' needs x,y,z,intensity[,r,g,b]");
   render::MrLight light;
   light.kind = render::LightKind::Point;
@@ -63,7 +50,7 @@ render::MrLight parse_virtual_light(const std::string& text) {
 }
 
 render::MrLight parse_virtual_spot(const std::string& text) {
-  const std::vector<float> v = parse_numbers("--virtual-spot", text);
+  const std::vector<float> v = parse_number_list<float>("--virtual-spot", text);
   if (v.size() != 8 && v.size() != 11)
     throw Error("--virtual-spot '" + text + "' needs x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b]");
   const Eigen::Vector3f position(v[0], v[1], v[2]);

@@ -10,6 +10,7 @@
 #include <numbers>
 #include <sstream>
 
+#include "number_list.h"
 #include "relight/capture/support_plane.h"
 #include "relight/core/error.h"
 #include "relight/core/pixel.h"
@@ -18,21 +19,10 @@ namespace relight::app {
 
 namespace {
 
-/// The comma-separated numbers of `text` (empty: none); throws naming `option`.
+/// The numbers of `text` (empty: none), between `min` and `max` of them; throws naming `option`.
 std::vector<double> numbers(const std::string& option, const std::string& text, std::size_t min, std::size_t max,
                             const char* form) {
-  std::vector<double> values;
-  if (!text.empty()) {
-    std::stringstream stream(text);
-    std::string field;
-    while (std::getline(stream, field, ',')) {
-      char* end = nullptr;
-      const double value = std::strtod(field.c_str(), &end);
-      if (field.empty() || *end != '\0' || !std::isfinite(value))
-        throw Error(option + " '" + text + "': '" + field + "' is not a number (expected " + form + ")");
-      values.push_back(value);
-    }
-  }
+  std::vector<double> values = parse_number_list<double>(option, text, form);
   if (values.size() < min || values.size() > max) throw Error(option + " '" + text + "' needs " + form);
   return values;
 }
@@ -88,8 +78,7 @@ std::optional<FreeSpot> free_spot_nearest_centre(const DepthMap& depth, const Pi
     int row_sum = 0;
     for (int col = 0; col < width; ++col) {
       const float z = depth(row, col);
-      const bool on_plane = is_valid_depth(z) &&
-                            std::abs(plane.distance(intrinsics.unproject(col, row, z))) <= tolerance.tolerance_m + 0.01 * z;
+      const bool on_plane = is_valid_depth(z) && plane.holds(intrinsics.unproject(col, row, z), tolerance.tolerance_m);
       row_sum += on_plane;
       sum[at(row + 1, col + 1)] = sum[at(row, col + 1)] + row_sum;
       if (on_plane) candidates.push_back({(col - cu) * (col - cu) + (row - cv) * (row - cv), row, col});
