@@ -8,6 +8,7 @@
 #include "json_config.h"
 #include "mixed_reality_scene.h"
 #include "render_option_values.h"
+#include "view_stage.h"
 #include "replay.h"
 
 namespace relight::app {
@@ -137,8 +138,7 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                    "Show the final picture in a window as it is made, with fps, tracking state and dropped frames; "
                    "keys: q quit, space pause, s snapshot (to DIR/snapshots/)");
   command.add_option("--view-side", options.view_side, "With --view: a buffer shown beside the picture")
-      ->check(CLI::IsMember({"color", "depth", "depth_smoothed", "depth_filtered", "normals", "composite",
-                             "virtual_coverage"}));
+      ->check(CLI::IsMember(names_of(kViewSides)));
 }
 
 namespace {

@@ -7,6 +7,7 @@
 // Reads: the picture (ColorImage: the final composite, or "color" when nothing renders), the
 //        side buffer when given (BufferPreviews' kinds), "camera_pose" (CameraPose),
 //        "source_frame" (FrameInfo: the frame index).
+#include <array>
 #include <chrono>
 #include <deque>
 #include <functional>
@@ -14,11 +15,22 @@
 
 #include "buffer_previews.h"
 #include "live_view.h"
+#include "option_values.h"
 #include "relight/capture/camera_pose.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
 
 namespace relight::app {
+
+/// The buffers --view-side can show beside the picture, and how each is drawn.
+inline constexpr std::array<OptionValue<BufferPreviews::Kind>, 7> kViewSides{
+    {{"color", BufferPreviews::Kind::Color},
+     {"depth", BufferPreviews::Kind::Depth},
+     {"depth_smoothed", BufferPreviews::Kind::Depth},
+     {"depth_filtered", BufferPreviews::Kind::Depth},
+     {"normals", BufferPreviews::Kind::Normals},
+     {"composite", BufferPreviews::Kind::Color},
+     {"virtual_coverage", BufferPreviews::Kind::Coverage}}};
 
 class ViewStage final : public Stage {
  public:
