@@ -20,7 +20,7 @@
 #include "relight/render/scene/depth_mesh.h"
 #include "relight/render/scene/model_io.h"
 #include "relight/render/scene/procedural_models.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/render/scene/scene_lights.h"
 
 namespace relight::app {
@@ -57,7 +57,7 @@ MrScene real_scene(const RenderReferenceOptions& command, bool synthetic, const 
     // The path tracer gets the synthetic scene's exact lights and sky.
     if (!command.lights.empty())
       throw Error("--lights applies to recorded sequences; a synthetic sequence brings its own lights");
-    return render::scene_from_synth(synth::default_indoor_scene());
+    return truth::scene_from_synth(synth::default_indoor_scene());
   }
   MrScene scene;
   render::add_lights(scene, real_light_set(false, command.sequence, command.lights));

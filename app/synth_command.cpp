@@ -6,6 +6,7 @@
 #include "relight/core/error.h"
 #include "relight/core/progress.h"
 #include "relight/synth/sequence.h"
+#include "relight/truth/sequence_writer.h"
 
 namespace relight::app {
 
@@ -44,7 +45,7 @@ int run_synth(const SynthCommandOptions& command) {
 
   ProgressBar progress("synth", command.frames, command.quiet);
   const auto start = std::chrono::steady_clock::now();
-  synth::write_sequence(options, command.out, [&](int done, int) { progress.update(done); });
+  truth::write_sequence(options, command.out, [&](int done, int) { progress.update(done); });
   progress.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (!command.quiet) {

@@ -4,7 +4,7 @@
 #include "relight/capture/marker_pose.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/scene.h"
-#include "relight/synth/tag_layout.h"
+#include "relight/truth/tag_layout.h"
 #include "relight/synth/trajectory.h"
 
 namespace {
@@ -18,7 +18,7 @@ Json detect_case(const relight::bench::Options& options, float decimate) {
   const relight::Pose truth = relight::synth::look_at(tag + Eigen::Vector3d(-0.9, -0.9, 0.9), tag, {0, 0, 1});
   const auto frame = relight::synth::render_frame(scene, intrinsics, truth);
   const relight::ColorImage color = relight::synth::encode_color(frame.radiance);
-  const relight::TagLayout layout = relight::synth::tag_layout(scene);
+  const relight::TagLayout layout = relight::truth::tag_layout(scene);
 
   relight::TagDetectorOptions detector_options;
   detector_options.decimate = decimate;

@@ -12,7 +12,7 @@
 #include "relight/colormap/sample_mapping.h"
 #include "relight/colormap/statistics_transfer.h"
 #include "relight/colormap/statistics_transfer_vk.h"
-#include "relight/colormap/synthetic_camera.h"
+#include "relight/truth/synthetic_camera.h"
 #include "relight/vk/backend.h"
 #include "relight/vk/buffer.h"
 #include "relight/vk/context.h"
@@ -23,23 +23,23 @@ namespace {
 using namespace relight;
 using namespace relight::colormap;
 
-const SyntheticTriple& frame_640x480() {
-  static const SyntheticTriple triple = make_synthetic_triple({.width = 640, .height = 480});
+const truth::SyntheticTriple& frame_640x480() {
+  static const truth::SyntheticTriple triple = truth::make_synthetic_triple({.width = 640, .height = 480});
   return triple;
 }
 
-double delta_e_of(const SyntheticTriple& triple, const RadianceImage& delta) {
-  return mean_delta_e(composite(triple.camera, delta), triple.truth, virtual_mask(triple.real, triple.real_virtual));
+double delta_e_of(const truth::SyntheticTriple& triple, const RadianceImage& delta) {
+  return truth::mean_delta_e(composite(triple.camera, delta), triple.truth, virtual_mask(triple.real, triple.real_virtual));
 }
 
-double delta_e_before(const SyntheticTriple& triple) {
+double delta_e_before(const truth::SyntheticTriple& triple) {
   RadianceImage identity;
   sample_delta(triple.real, triple.real_virtual, identity_color_matrix(), {}, identity);
   return delta_e_of(triple, identity);
 }
 
 bench::Json stats_cpu(const bench::Options& options) {
-  const SyntheticTriple& triple = frame_640x480();
+  const truth::SyntheticTriple& triple = frame_640x480();
   RadianceImage delta;
   const double ms = bench::median_ms(
       [&] { (void)statistics_color_map(triple.real, triple.real_virtual, triple.camera, {}, delta); },
@@ -51,7 +51,7 @@ bench::Json stats_cpu(const bench::Options& options) {
 }
 
 bench::Json sample_cpu(const bench::Options& options) {
-  const SyntheticTriple& triple = frame_640x480();
+  const truth::SyntheticTriple& triple = frame_640x480();
   RadianceImage delta;
   bench::Json json;
   for (const auto model : {PolynomialModel::PerChannelAffine, PolynomialModel::Linear3x3, PolynomialModel::Affine3x4}) {
@@ -74,7 +74,7 @@ bench::Json sample_cpu(const bench::Options& options) {
 
 bench::Json stats_vulkan(const bench::Options& options) {
   const auto context = relight::bench::timing_vulkan();
-  const SyntheticTriple& triple = frame_640x480();
+  const truth::SyntheticTriple& triple = frame_640x480();
   StatisticsColorMapVk mapper(*context);
   vk::VulkanTransfer& transfer = context->transfer();
   vk::VulkanBuffer real(*context, triple.real.bytes().size()), real_virtual(*context, triple.real.bytes().size());

@@ -29,7 +29,7 @@
 #include "relight/render/dir/gbuffer_vk.h"
 #include "relight/render/reference/path_tracer.h"
 #include "relight/render/scene/procedural_models.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
 
@@ -39,7 +39,7 @@ using namespace relight;
 using Clock = std::chrono::steady_clock;
 
 render::MrScene bench_scene() {
-  render::MrScene scene = render::scene_from_synth(synth::default_indoor_scene());
+  render::MrScene scene = truth::scene_from_synth(synth::default_indoor_scene());
   scene.environment.radiance.setZero();
   render::add_virtual_model(scene, render::make_glossy_pebble(), render::Placement::parse("0.35,-0.2,0.75,30"));
   return scene;

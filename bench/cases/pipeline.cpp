@@ -9,6 +9,7 @@
 
 #include "bench.h"
 #include "relight/synth/sequence.h"
+#include "relight/truth/sequence_writer.h"
 #include "replay.h"
 #include "report.h"
 
@@ -31,7 +32,7 @@ bench::Json replay_640x480(const bench::Options& options) {
   synth::SynthOptions synth;
   synth.frames = std::max(options.repetitions, 3) + 1;
   synth.ground_truth = false;
-  synth::write_sequence(synth, folder.path / "sequence");
+  truth::write_sequence(synth, folder.path / "sequence");
 
   app::ReplayOptions replay;
   replay.sequence = folder.path / "sequence";

@@ -14,7 +14,7 @@
 #include "relight/render/scene/model_io.h"
 #include "relight/render/reference/path_tracer.h"
 #include "relight/render/scene/procedural_models.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
 
 namespace {
@@ -23,7 +23,7 @@ using namespace relight;
 
 render::MrScene scene_with_pebble() {
   const synth::Scene synthetic = synth::default_indoor_scene();
-  render::MrScene scene = render::scene_from_synth(synthetic);
+  render::MrScene scene = truth::scene_from_synth(synthetic);
   render::add_virtual_model(scene, render::make_glossy_pebble(), render::Placement::parse("0.35,-0.2,0.75,30"));
   return scene;
 }

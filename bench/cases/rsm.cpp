@@ -19,7 +19,7 @@
 #include "relight/render/vpl/hierarchical_warp_vk.h"
 #include "relight/render/scene/procedural_models.h"
 #include "relight/render/vpl/reflective_shadow_map_vk.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/vk/buffer.h"
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
@@ -105,7 +105,7 @@ relight::bench::Json warp_vulkan(const relight::bench::Options& options) {
 }
 
 MrScene room_with_spot() {
-  MrScene scene = scene_from_synth(relight::synth::default_indoor_scene());
+  MrScene scene = relight::truth::scene_from_synth(relight::synth::default_indoor_scene());
   add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
   scene.lights = {spot_light({0.3f, -0.25f, 1.6f}, {0.05f, 0.05f, -1.f}, 30.f, 24.f, {4.f, 4.f, 4.f}, true)};
   return scene;

@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
-#include "relight/capture/tum_writer.h"
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
 #include "relight/core/image_io.h"
@@ -15,8 +14,6 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 namespace fs = std::filesystem;
-
-constexpr double kDepthScale = 5000.0;
 
 Json vec(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
@@ -130,38 +127,6 @@ Json intrinsics_json(const PinholeIntrinsics& k) {
   return {{"fx", k.fx}, {"fy", k.fy}, {"cx", k.cx}, {"cy", k.cy}, {"width", k.width}, {"height", k.height}};
 }
 
-void validate(const SynthOptions& options) {
-  if (options.frames < 0) throw Error("synth: number of frames must not be negative");
-  if (options.width < 2 || options.height < 2) throw Error("synth: image size must be at least 2x2");
-  for (double g : options.color.gains) {
-    if (!(g > 0.0)) throw Error("synth: white-balance gains must be positive");
-  }
-  if (!(options.color.exposure > 0.0)) throw Error("synth: exposure must be positive");
-}
-
-RadianceImage as_radiance_image(const NormalMap& normals) {
-  RadianceImage image(normals.width(), normals.height());
-  std::copy(normals.pixels().begin(), normals.pixels().end(), image.pixels().begin());
-  return image;
-}
-
-void write_ground_truth(const fs::path& out, Timestamp timestamp, const RenderedFrame& frame) {
-  const std::string stem = fs::path(TumWriter::file_name(timestamp)).stem().string();
-  write_depth_exr(out / "gt" / "depth" / (stem + ".exr"), frame.depth);
-  write_radiance(out / "gt" / "normals" / (stem + ".exr"), as_radiance_image(frame.normals));
-  write_color(out / "gt" / "albedo" / (stem + ".png"), encode_albedo(frame.albedo));
-  write_label_png(out / "gt" / "material" / (stem + ".png"), frame.material);
-}
-
-void create_folders(const fs::path& out, bool ground_truth) {
-  std::error_code ec;
-  fs::create_directories(out, ec);
-  for (const char* sub : {"depth", "normals", "albedo", "material"}) {
-    if (ground_truth && !ec) fs::create_directories(out / "gt" / sub, ec);
-  }
-  if (ec) throw Error("cannot create " + out.string() + ": " + ec.message());
-}
-
 }  // namespace
 
 PinholeIntrinsics synth_intrinsics(const SynthOptions& options) {
@@ -176,7 +141,7 @@ std::string scene_json(const Scene& scene, const SynthOptions& options) {
                {"units", "metres, seconds, linear RGB radiance"},
                {"world_up", {0, 0, 1}},
                {"intrinsics", intrinsics_json(synth_intrinsics(options))},
-               {"depth_scale", kDepthScale},
+               {"depth_scale", kSynthDepthScale},
                {"registered", "colour and depth share one camera (these intrinsics, same pose)"},
                {"frames", options.frames},
                {"first_timestamp", frame_timestamp(0)},
@@ -199,31 +164,13 @@ std::string scene_json(const Scene& scene, const SynthOptions& options) {
   return json.dump(2) + "\n";
 }
 
-void write_sequence(const SynthOptions& options, const fs::path& out, const SynthProgress& progress) {
-  write_sequence(default_indoor_scene(), options, out, progress);
-}
-
-void write_sequence(const Scene& scene, const SynthOptions& options, const fs::path& out,
-                    const SynthProgress& progress) {
-  validate(options);
-  create_folders(out, options.ground_truth);
-  const PinholeIntrinsics intrinsics = synth_intrinsics(options);
-  const std::vector<Pose> poses = make_trajectory(options.trajectory, options.frames, options.seed, scene);
-  TumWriter writer(out, kDepthScale);
-  for (int i = 0; i < options.frames; ++i) {
-    const RenderedFrame frame = render_frame(scene, intrinsics, poses[static_cast<std::size_t>(i)], options.threads);
-    const DepthMap depth = options.noise == NoiseModel::None
-                               ? frame.depth
-                               : apply_kinect_noise(frame.depth, frame.normals, intrinsics, options.kinect,
-                                                    options.seed, static_cast<std::uint64_t>(i), options.threads);
-    const Timestamp timestamp = frame_timestamp(i);
-    writer.add(timestamp, encode_color(frame.radiance, options.color), depth, poses[static_cast<std::size_t>(i)]);
-    if (options.ground_truth) write_ground_truth(out, timestamp, frame);
-    if (progress) progress(i + 1, options.frames);
+void validate_synth_options(const SynthOptions& options) {
+  if (options.frames < 0) throw Error("synth: number of frames must not be negative");
+  if (options.width < 2 || options.height < 2) throw Error("synth: image size must be at least 2x2");
+  for (double g : options.color.gains) {
+    if (!(g > 0.0)) throw Error("synth: white-balance gains must be positive");
   }
-  writer.finish();
-  if (options.probe) write_radiance(out / "probe.hdr", render_probe(scene, default_probe(scene), options.threads));
-  write_file_atomically(out / "scene.json", scene_json(scene, options));
+  if (!(options.color.exposure > 0.0)) throw Error("synth: exposure must be positive");
 }
 
 }  // namespace relight::synth

@@ -11,7 +11,7 @@
 #include "relight/synth/raycast.h"
 #include "relight/synth/scene.h"
 #include "relight/synth/sequence.h"
-#include "relight/synth/tag_layout.h"
+#include "relight/truth/tag_layout.h"
 #include "relight/synth/trajectory.h"
 
 namespace relight {
@@ -64,7 +64,7 @@ std::vector<Pose> viewpoints(const synth::Scene& scene) {
 TEST(MarkerPose, NoiseFreeSyntheticFramesGivePoseWithinOneCentimetreAndOneDegree) {
   const synth::Scene scene = synth::default_indoor_scene();
   const auto intrinsics = PinholeIntrinsics::kinect_v1();
-  const TagLayout layout = synth::tag_layout(scene);
+  const TagLayout layout = truth::tag_layout(scene);
   TagDetector detector;
   for (const Pose& truth : viewpoints(scene)) {
     const double distance = (truth.translation() - scene.tags.front().centre).norm();
@@ -101,7 +101,7 @@ TEST(MarkerPose, ImageNoiseDegradesThePoseGracefully) {
   };
   for (auto& p : color.pixels()) p = {perturb(p.r), perturb(p.g), perturb(p.b)};
   TagDetector detector;
-  const auto pose = estimate_camera_pose(detector.detect(color), synth::tag_layout(scene), intrinsics);
+  const auto pose = estimate_camera_pose(detector.detect(color), truth::tag_layout(scene), intrinsics);
   ASSERT_TRUE(pose.has_value());
   const PoseError error = pose_error(pose->camera_to_world, truth);
   EXPECT_LE(error.cm, 2.0);
@@ -148,7 +148,7 @@ TEST(MarkerPoseStage, HoldsTheLastPoseWhenTheTagIsLost) {
   const ColorImage blank(640, 480, Rgb8{128, 128, 128});
   FrameGraph graph;
   graph.emplace<PoseFrameSource>(std::vector<ColorImage>{blank, tagged, blank});
-  graph.emplace<MarkerPoseStage>(synth::tag_layout(scene));
+  graph.emplace<MarkerPoseStage>(truth::tag_layout(scene));
   graph.keep("marker_pose");
   std::vector<CameraPose> poses;
   while (graph.run_frame()) poses.push_back(*graph.find<CameraPose>("marker_pose"));

@@ -16,7 +16,7 @@ namespace {
 // Writes a synthetic triple into "L_r", "L_rv" and "color" every frame.
 class TripleSource final : public Stage {
  public:
-  explicit TripleSource(const SyntheticTriple& triple, bool wrong_camera_size = false)
+  explicit TripleSource(const truth::SyntheticTriple& triple, bool wrong_camera_size = false)
       : triple_(triple), wrong_camera_size_(wrong_camera_size) {}
   [[nodiscard]] std::string name() const override { return "triple_source"; }
   [[nodiscard]] bool has_side_effects() const override { return true; }
@@ -32,7 +32,7 @@ class TripleSource final : public Stage {
   }
 
  private:
-  const SyntheticTriple& triple_;
+  const truth::SyntheticTriple& triple_;
   bool wrong_camera_size_;
   Write<RadianceImage> real_, real_virtual_;
   Write<ColorImage> camera_;
@@ -53,7 +53,7 @@ ColorImage run_graph(ColorMapMethod method, Backend backend, vk::VulkanContext* 
 
 double graph_delta_e(const ColorImage& mapped) {
   const auto& triple = test::orange_triple();
-  return mean_delta_e(mapped, triple.truth, virtual_mask(triple.real, triple.real_virtual));
+  return truth::mean_delta_e(mapped, triple.truth, virtual_mask(triple.real, triple.real_virtual));
 }
 
 TEST(ColorMapStages, EveryMethodRunsInAGraphAndMappingBeatsNone) {

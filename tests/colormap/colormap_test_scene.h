@@ -6,29 +6,29 @@
 #include <string>
 
 #include "relight/colormap/statistics_transfer.h"
-#include "relight/colormap/synthetic_camera.h"
+#include "relight/truth/synthetic_camera.h"
 
 namespace relight::colormap::test {
 
 /// Orange sphere: a hue the real scene has (wood, red paint, yellow plastic).
-inline const SyntheticTriple& orange_triple() {
-  static const SyntheticTriple triple = make_synthetic_triple({});
+inline const truth::SyntheticTriple& orange_triple() {
+  static const truth::SyntheticTriple triple = truth::make_synthetic_triple({});
   return triple;
 }
 
 /// Green sphere: a hue absent from the real scene (where the channel-swap heuristic matters).
-inline const SyntheticTriple& green_triple() {
-  static const SyntheticTriple triple = [] {
-    SyntheticTripleOptions options;
+inline const truth::SyntheticTriple& green_triple() {
+  static const truth::SyntheticTriple triple = [] {
+    truth::SyntheticTripleOptions options;
     options.virtual_albedo = {0.15, 0.60, 0.20};
-    return make_synthetic_triple(options);
+    return truth::make_synthetic_triple(options);
   }();
   return triple;
 }
 
 /// Mean CIEDE2000 over the virtual object of composite(L_cam, delta) against the truth.
-inline double virtual_delta_e(const SyntheticTriple& triple, const RadianceImage& delta) {
-  return mean_delta_e(composite(triple.camera, delta), triple.truth, virtual_mask(triple.real, triple.real_virtual));
+inline double virtual_delta_e(const truth::SyntheticTriple& triple, const RadianceImage& delta) {
+  return truth::mean_delta_e(composite(triple.camera, delta), triple.truth, virtual_mask(triple.real, triple.real_virtual));
 }
 
 }  // namespace relight::colormap::test

@@ -91,7 +91,7 @@ TEST(SampleMapping, FindsOnePairPerSampleAndSixWithChannelSwap) {
   EXPECT_THROW((void)find_color_pairs(triple.real, triple.real_virtual, ColorImage(3, 3), options), Error);
 }
 
-double sample_delta_e(const colormap::SyntheticTriple& triple, PolynomialModel model, bool swap) {
+double sample_delta_e(const truth::SyntheticTriple& triple, PolynomialModel model, bool swap) {
   SampleMappingOptions options;
   options.model = model;
   options.channel_swap = swap;
@@ -131,7 +131,7 @@ double coefficient_jitter(double u) {
   SampleMappingOptions options;
   options.smoothing = u;
   SampleColorMapper mapper(options);
-  SyntheticTripleOptions triple_options;
+  truth::SyntheticTripleOptions triple_options;
   const auto& clean = test::orange_triple();
   RadianceImage delta;
   double sum = 0.0;
@@ -139,10 +139,10 @@ double coefficient_jitter(double u) {
   ColorMatrix previous;
   constexpr int kFrames = 24, kWarmUp = 4;
   for (int frame = 0; frame < kFrames; ++frame) {
-    CameraColorTransform camera = triple_options.camera;
+    truth::CameraColorTransform camera = triple_options.camera;
     camera.noise_sigma = 3.0;
     camera.noise_seed = 1000 + static_cast<std::uint64_t>(frame);
-    const ColorImage noisy = apply_camera(clean.real, camera);
+    const ColorImage noisy = truth::apply_camera(clean.real, camera);
     const ColorMatrix current = mapper.map(clean.real, clean.real_virtual, noisy, delta);
     if (frame > kWarmUp) {
       sum += (current - previous).norm();

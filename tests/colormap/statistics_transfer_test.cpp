@@ -137,8 +137,8 @@ TEST(StatisticsTransfer, FastCubeRootMatchesStdCbrt) {
 
 // The synthetic triple with the kinds of pixels the mask must drop mixed in: NaN and infinite
 // radiance, black camera pixels, black renderings.
-SyntheticTriple triple_with_invalid_pixels() {
-  SyntheticTriple triple = test::orange_triple();
+truth::SyntheticTriple triple_with_invalid_pixels() {
+  truth::SyntheticTriple triple = test::orange_triple();
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   for (std::size_t i = 0; i < triple.real.size(); i += 7) {
     switch (i % 4) {
@@ -160,7 +160,7 @@ void expect_statistics_near(const LabStatistics& fast, const LabStatistics& refe
 }
 
 TEST(StatisticsTransfer, FastStatisticsMatchThePlainReference) {
-  for (const SyntheticTriple& triple : {test::orange_triple(), test::green_triple(), triple_with_invalid_pixels()}) {
+  for (const truth::SyntheticTriple& triple : {test::orange_triple(), test::green_triple(), triple_with_invalid_pixels()}) {
     const TransferStatistics reference =
         statistics_from_sums(test::masked_lab_sums_reference(triple.real, triple.real_virtual, triple.camera, {}));
     const TransferStatistics fast = masked_lab_statistics(triple.real, triple.real_virtual, triple.camera, {});
@@ -172,7 +172,7 @@ TEST(StatisticsTransfer, FastStatisticsMatchThePlainReference) {
 }
 
 TEST(StatisticsTransfer, FastMappingMatchesThePlainReference) {
-  for (const SyntheticTriple* triple : {&test::orange_triple(), &test::green_triple()}) {
+  for (const truth::SyntheticTriple* triple : {&test::orange_triple(), &test::green_triple()}) {
     const ReinhardTransfer reference = ReinhardTransfer::from(
         statistics_from_sums(test::masked_lab_sums_reference(triple->real, triple->real_virtual, triple->camera, {})));
     const RadianceImage reference_delta =
@@ -194,7 +194,7 @@ TEST(StatisticsTransfer, FastMappingMatchesThePlainReference) {
 }
 
 TEST(StatisticsTransfer, ResultDoesNotDependOnTheThreadCount) {
-  const SyntheticTriple triple = triple_with_invalid_pixels();
+  const truth::SyntheticTriple triple = triple_with_invalid_pixels();
   const LabSums one = masked_lab_sums(triple.real, triple.real_virtual, triple.camera, {}, 1);
   for (const int threads : {2, 3, 8}) {
     const LabSums many = masked_lab_sums(triple.real, triple.real_virtual, triple.camera, {}, threads);

@@ -18,7 +18,7 @@
 #include "relight/render/scene/virtual_model.h"
 #include "relight/render/vpl/vpl.h"
 #include "relight/render/scene/sampler.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/synth/trajectory.h"
 
 namespace relight::render {
@@ -60,7 +60,7 @@ using ConeSearchVkTest = test::VulkanTest;
 
 TEST_F(ConeSearchVkTest, MatchesTheCpuOnTheSceneSurfacePoints) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
-  const MrScene scene = scene_from_synth(synth::default_indoor_scene());
+  const MrScene scene = truth::scene_from_synth(synth::default_indoor_scene());
   const IsmPointPools pools = sample_ism_points(scene, {.points_per_vpl = 16384, .pool_factor = 1});
   // Queries from points of the scene, in cosine-distributed directions above their surface.
   std::vector<ConeQuery> queries;
@@ -97,7 +97,7 @@ TEST_F(ConeSearchVkTest, MatchesTheCpuOnTheSceneSurfacePoints) {
 // (the same paths resolved in the same order), on the indoor scene with the pebble.
 TEST_F(ConeSearchVkTest, VplsFromTheGpuSearchEqualTheCpuOnes) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
-  MrScene scene = scene_from_synth(synth::default_indoor_scene());
+  MrScene scene = truth::scene_from_synth(synth::default_indoor_scene());
   add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
   const RayTracer tracer(scene, RayTracer::Build::Fast);
   VplOptions options;

@@ -125,7 +125,7 @@ TEST(DirCpu, RealWallBehindAVirtualOccluderBleedsOnlyInLr) {
   // wall; in L_r that part still bleeds red onto the floor, so the difference removes red there.
   MrScene scene = floor_scene(Eigen::Vector3f::Constant(0.8f), {0.f, 0.f, 1.0f}, 4.f);
   const std::uint32_t red = scene.add_material(diffuse({0.9f, 0.05f, 0.05f}, "red wall"));
-  TriangleMesh wall = tessellate(synth::Box{{1.0, -1.0, 0.0}, {1.05, 1.0, 1.2}}, red);
+  TriangleMesh wall = truth::tessellate(synth::Box{{1.0, -1.0, 0.0}, {1.05, 1.0, 1.2}}, red);
   scene.meshes.push_back(wall);
   test::add_virtual_box(scene, synth::Box{{0.5, -0.5, 0.65}, {0.7, 0.5, 1.4}}, diffuse(Eigen::Vector3f::Constant(0.5f)));
   const MrCamera camera = camera_at({-0.6, -1.5, 1.2}, {0.8, 0, 0.2}, 96, 72);
@@ -152,7 +152,7 @@ TEST(DirCpu, RealWallBehindAVirtualOccluderBleedsOnlyInLr) {
 TEST(DirCpu, RealBlockerBehindAVirtualOneDoesNotShadowTwice) {
   MrScene scene = floor_scene(Eigen::Vector3f::Constant(0.8f), {0.f, 0.f, 2.0f}, 4.f);
   const std::uint32_t grey = scene.add_material(diffuse(Eigen::Vector3f::Constant(0.5f)));
-  scene.meshes.push_back(tessellate(synth::Box{{-0.2, -0.2, 0.5}, {0.2, 0.2, 0.6}}, grey));  // real blocker
+  scene.meshes.push_back(truth::tessellate(synth::Box{{-0.2, -0.2, 0.5}, {0.2, 0.2, 0.6}}, grey));  // real blocker
   test::add_virtual_box(scene, synth::Box{{-0.25, -0.25, 1.0}, {0.25, 0.25, 1.1}}, diffuse(Eigen::Vector3f::Constant(0.5f)));
   const MrCamera camera = camera_at({0.0, -1.6, 1.2}, {0, 0, 0}, 64, 48);
   DirOptions direct_only;
@@ -172,7 +172,7 @@ TEST(Vpls, FirstBounceFluxAddsUpToTheLightsPowerAndFollowsTheBudget) {
   // A point light inside a closed box: every light sample ends on a surface.
   MrScene scene;
   const std::uint32_t white = scene.add_material(diffuse(Eigen::Vector3f::Constant(0.5f)));
-  scene.meshes.push_back(tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
+  scene.meshes.push_back(truth::tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
   MrLight strong, weak;
   strong.position = {0.2f, 0.f, 0.f};
   strong.intensity = Eigen::Vector3f::Constant(3.f);
@@ -201,7 +201,7 @@ TEST(Vpls, FirstBounceFluxAddsUpToTheLightsPowerAndFollowsTheBudget) {
 MrScene two_lights_in_a_box() {
   MrScene scene;
   const std::uint32_t white = scene.add_material(diffuse(Eigen::Vector3f::Constant(0.5f)));
-  scene.meshes.push_back(tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
+  scene.meshes.push_back(truth::tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
   MrLight left, right;
   left.position = {-0.2f, 0.f, 0.f};
   right.position = {0.2f, 0.f, 0.f};
@@ -321,7 +321,7 @@ TEST(DirCpu, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions) {
 TEST(Vpls, ConeBounceLandsNearTheRayTracedHit) {
   MrScene scene;
   const std::uint32_t white = scene.add_material(diffuse(Eigen::Vector3f::Constant(0.5f)));
-  scene.meshes.push_back(tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
+  scene.meshes.push_back(truth::tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
   MrLight light;
   light.position = {0.3f, -0.2f, 0.1f};
   light.intensity = Eigen::Vector3f::Constant(1.f);

@@ -9,7 +9,7 @@
 
 #include "support/vulkan_test_env.h"
 #include "relight/render/scene/procedural_models.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
@@ -33,7 +33,7 @@ StageRun run_stage(vk::VulkanContext* context) {
   FrameGraph graph(context ? &context->transfer() : nullptr);
   graph.emplace<test::SyntheticFrameStage>(intrinsics, synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75}));
   DirSceneContent content;
-  content.lights = scene_from_synth(synth::default_indoor_scene()).lights;
+  content.lights = truth::scene_from_synth(synth::default_indoor_scene()).lights;
   content.objects.emplace_back(make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
   DirStageOptions options;
   options.renderer.shadow_tile = 256;

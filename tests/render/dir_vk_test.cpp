@@ -24,7 +24,7 @@ class DirVkTest : public relight::test::VulkanTest {};
 /// A white floor and a back wall, a real point light, and a red virtual cube on the floor.
 MrScene cube_scene() {
   MrScene scene = test::floor_scene(Eigen::Vector3f::Constant(0.8f), {1.0f, 0.f, 1.5f}, 4.f);
-  TriangleMesh wall = tessellate(synth::Rect{{0, 2, 1}, {0, -1, 0}, {1, 0, 0}, {0, 0, 1}, 2, 1},
+  TriangleMesh wall = truth::tessellate(synth::Rect{{0, 2, 1}, {0, -1, 0}, {1, 0, 0}, {0, 0, 1}, 2, 1},
                                  scene.add_material(diffuse({0.3f, 0.6f, 0.3f}, "green wall")));
   scene.meshes.push_back(wall);
   test::add_virtual_box(scene, synth::Box{{-0.2, -0.2, 0.0}, {0.2, 0.2, 0.4}}, diffuse({0.9f, 0.1f, 0.1f}, "red cube"));

@@ -48,8 +48,8 @@ TEST(MappedComposite, StatisticsMappingReachesTheColourGoalOnTheSyntheticCamera)
                                                           colormap::ColorMapping::of_statistics(transfer, {}));
   const ColorImage unmapped = differential_composite(triple.camera, triple.real_virtual, triple.real,
                                                      coverage_of(object), {});
-  const double before = colormap::mean_delta_e(unmapped, triple.truth, object);
-  const double after = colormap::mean_delta_e(mapped, triple.truth, object);
+  const double before = truth::mean_delta_e(unmapped, triple.truth, object);
+  const double after = truth::mean_delta_e(mapped, triple.truth, object);
   EXPECT_GT(before, 5.0);  // 5.41 measured
   EXPECT_LT(after, 3.0) << "before " << before;
 }

@@ -56,7 +56,7 @@ MrScene furnace(float albedo, float emission) {
   MrScene scene;
   PhongMaterial wall = test::diffuse(Eigen::Vector3f::Constant(albedo), "furnace");
   wall.emission = Eigen::Vector3f::Constant(emission);
-  TriangleMesh sphere = tessellate(synth::Sphere{{0, 0, 0}, 1.0}, scene.add_material(wall), {48});
+  TriangleMesh sphere = truth::tessellate(synth::Sphere{{0, 0, 0}, 1.0}, scene.add_material(wall), {48});
   sphere.normals.clear();  // flat facets: no sample is lost to a shading/geometric normal mismatch
   scene.meshes.push_back(sphere);
   return scene;

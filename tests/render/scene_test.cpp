@@ -4,7 +4,7 @@
 
 #include "relight/core/error.h"
 #include "relight/render/reference/ray_tracer.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 
@@ -13,7 +13,7 @@ namespace {
 
 TEST(Tessellation, SphereVerticesLieOnTheSphereAndNormalsPointOut) {
   const synth::Sphere sphere{{1, 2, 3}, 0.5};
-  const TriangleMesh mesh = tessellate(sphere, 0);
+  const TriangleMesh mesh = truth::tessellate(sphere, 0);
   ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     const Eigen::Vector3f offset = mesh.positions[i] - Eigen::Vector3f(1, 2, 3);
@@ -23,7 +23,7 @@ TEST(Tessellation, SphereVerticesLieOnTheSphereAndNormalsPointOut) {
 }
 
 TEST(Tessellation, BoxHasTwelveTrianglesWithOutwardNormals) {
-  const TriangleMesh mesh = tessellate(synth::Box{{0, 0, 0}, {1, 2, 3}}, 4);
+  const TriangleMesh mesh = truth::tessellate(synth::Box{{0, 0, 0}, {1, 2, 3}}, 4);
   ASSERT_EQ(mesh.triangle_count(), 12u);
   const Eigen::Vector3f centre(0.5f, 1.f, 1.5f);
   for (std::size_t i = 0; i < mesh.positions.size(); ++i)
@@ -32,7 +32,7 @@ TEST(Tessellation, BoxHasTwelveTrianglesWithOutwardNormals) {
 }
 
 TEST(Tessellation, RejectsTooFewSegments) {
-  EXPECT_THROW((void)tessellate(synth::Sphere{{0, 0, 0}, 1}, 0, {2}), Error);
+  EXPECT_THROW((void)truth::tessellate(synth::Sphere{{0, 0, 0}, 1}, 0, {2}), Error);
 }
 
 TEST(MrSceneValidation, NamesTheBrokenMesh) {
@@ -54,7 +54,7 @@ TEST(MrSceneValidation, NamesTheBrokenMesh) {
 
 TEST(RayTracer, TessellatedSyntheticSceneMatchesTheAnalyticDepth) {
   const synth::Scene synthetic = synth::default_indoor_scene();
-  const MrScene scene = scene_from_synth(synthetic);
+  const MrScene scene = truth::scene_from_synth(synthetic);
   const RayTracer tracer(scene);
   const Pose pose = synth::look_at({1.6, -1.4, 1.5}, synthetic.look_at);
   const PinholeIntrinsics k{};
@@ -80,8 +80,8 @@ TEST(RayTracer, TessellatedSyntheticSceneMatchesTheAnalyticDepth) {
 TEST(RayTracer, VirtualLayerIsSeparateFromTheRealLayer) {
   MrScene scene;
   scene.add_material({});
-  TriangleMesh floor = tessellate(synth::Rect{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, 1, 1}, 0);
-  TriangleMesh cube = tessellate(synth::Box{{-0.1, -0.1, 0.5}, {0.1, 0.1, 0.7}}, 0);
+  TriangleMesh floor = truth::tessellate(synth::Rect{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, 1, 1}, 0);
+  TriangleMesh cube = truth::tessellate(synth::Box{{-0.1, -0.1, 0.5}, {0.1, 0.1, 0.7}}, 0);
   cube.real = false;
   scene.meshes = {floor, cube};
   const RayTracer tracer(scene);

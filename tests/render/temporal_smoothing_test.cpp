@@ -11,7 +11,7 @@
 #include "relight/reconstruct/normals_raw_depth.h"
 #include "relight/render/dir/dir_stage.h"
 #include "relight/render/scene/procedural_models.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
@@ -121,7 +121,7 @@ double flicker(vk::VulkanContext& context, bool smoothing, Geometry geometry, co
       break;
   }
   DirSceneContent content;
-  content.lights = scene_from_synth(synth::default_indoor_scene()).lights;
+  content.lights = truth::scene_from_synth(synth::default_indoor_scene()).lights;
   content.objects.emplace_back(make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
   DirStageOptions options;
   options.renderer.shadow_tile = 256;

@@ -11,7 +11,7 @@
 #include "relight/render/reference/path_tracer.h"
 #include "relight/render/scene/procedural_models.h"
 #include "relight/render/reference/ray_tracer.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/render/scene/virtual_model.h"
 #include "relight/synth/trajectory.h"
 
@@ -29,7 +29,7 @@ inline PhongMaterial diffuse(const Eigen::Vector3f& kd, const char* name = "diff
 inline MrScene floor_scene(const Eigen::Vector3f& albedo, const Eigen::Vector3f& light, float intensity) {
   MrScene scene;
   const std::uint32_t floor_material = scene.add_material(diffuse(albedo, "floor"));
-  TriangleMesh floor = tessellate(synth::Rect{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, 2, 2}, floor_material);
+  TriangleMesh floor = truth::tessellate(synth::Rect{{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {0, 1, 0}, 2, 2}, floor_material);
   floor.name = "floor";
   scene.meshes.push_back(floor);
   MrLight point;
@@ -42,14 +42,14 @@ inline MrScene floor_scene(const Eigen::Vector3f& albedo, const Eigen::Vector3f&
 /// The synthetic room (objects tessellated with 48 segments, smooth-shaded) with the glossy
 /// pebble standing on its table, and the room's own lights.
 inline MrScene indoor_with_pebble() {
-  MrScene scene = scene_from_synth(synth::default_indoor_scene(), {48});
+  MrScene scene = truth::scene_from_synth(synth::default_indoor_scene(), {48});
   add_virtual_model(scene, make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
   return scene;
 }
 
 /// Adds a virtual box with the given material.
 inline void add_virtual_box(MrScene& scene, const synth::Box& box, const PhongMaterial& material) {
-  TriangleMesh mesh = tessellate(box, scene.add_material(material));
+  TriangleMesh mesh = truth::tessellate(box, scene.add_material(material));
   mesh.name = "virtual box";
   mesh.real = false;
   scene.meshes.push_back(mesh);

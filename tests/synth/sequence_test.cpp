@@ -1,4 +1,5 @@
 #include "relight/synth/sequence.h"
+#include "relight/truth/sequence_writer.h"
 
 #include <gtest/gtest.h>
 
@@ -45,7 +46,7 @@ TEST(Sequence, WritesATumFolderWithGroundTruthThatTheReaderUnderstands) {
   options.trajectory = Trajectory::Handheld;
   options.seed = 5;
   int progress_calls = 0;
-  write_sequence(options, dir.path(), [&](int done, int total) {
+  truth::write_sequence(options, dir.path(), [&](int done, int total) {
     EXPECT_EQ(total, 2);
     EXPECT_EQ(done, ++progress_calls);
   });
@@ -90,7 +91,7 @@ TEST(Sequence, SceneJsonDescribesTheScene) {
   options.frames = 1;
   options.probe = false;
   options.color.gains = {1.1, 1.0, 0.9};
-  write_sequence(options, dir.path());
+  truth::write_sequence(options, dir.path());
   const Json json = Json::parse(read_text_file(dir.path() / "scene.json"));
   EXPECT_EQ(json["intrinsics"]["width"], 160);
   EXPECT_DOUBLE_EQ(json["intrinsics"]["fx"].get<double>(), 525.0 / 4.0);
@@ -123,11 +124,11 @@ TEST(Sequence, SameSeedGivesIdenticalBytesAndAnotherSeedOtherNoise) {
   TempDir a, b, c;
   SynthOptions options = small_options();
   options.seed = 17;
-  write_sequence(options, a.path());
+  truth::write_sequence(options, a.path());
   options.threads = 1;  // the schedule must not matter either
-  write_sequence(options, b.path());
+  truth::write_sequence(options, b.path());
   options.seed = 18;
-  write_sequence(options, c.path());
+  truth::write_sequence(options, c.path());
   const auto files_a = folder_contents(a.path());
   const auto files_b = folder_contents(b.path());
   const auto files_c = folder_contents(c.path());
@@ -149,7 +150,7 @@ TEST(Sequence, TagCornersProjectWhereSceneJsonSays) {
   options.noise = NoiseModel::None;
   options.ground_truth = false;
   options.probe = false;
-  write_sequence(options, dir.path());
+  truth::write_sequence(options, dir.path());
   const Json json = Json::parse(read_text_file(dir.path() / "scene.json"));
   const auto& k = json["intrinsics"];
   const PinholeIntrinsics intrinsics{k["fx"].get<double>(), k["fy"].get<double>(), k["cx"].get<double>(),
@@ -195,10 +196,10 @@ TEST(Sequence, RejectsBadOptions) {
   TempDir dir;
   SynthOptions options = small_options();
   options.frames = -1;
-  EXPECT_THROW(write_sequence(options, dir.path()), Error);
+  EXPECT_THROW(truth::write_sequence(options, dir.path()), Error);
   options = small_options();
   options.color.gains = {1.0, 0.0, 1.0};
-  EXPECT_THROW(write_sequence(options, dir.path()), Error);
+  EXPECT_THROW(truth::write_sequence(options, dir.path()), Error);
 }
 
 }  // namespace

@@ -4,7 +4,7 @@
 #include <numbers>
 
 #include "relight/core/error.h"
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/render/scene/tessellation.h"
 
 namespace relight::render {
 
@@ -67,7 +67,7 @@ VirtualModel make_matte_box() {
   VirtualModel model;
   model.name = "matte_box";
   model.materials.push_back({"matte_blue", {0.20f, 0.35f, 0.60f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
-  TriangleMesh mesh = tessellate(synth::Box{{-0.06, 0.0, -0.06}, {0.06, 0.12, 0.06}}, 0);
+  TriangleMesh mesh = tessellate_box({-0.06f, 0.0f, -0.06f}, {0.06f, 0.12f, 0.06f}, 0);
   mesh.name = "box";
   model.meshes.push_back(std::move(mesh));
   return model;

@@ -1,6 +1,6 @@
 #pragma once
 // Frames from OpenNI2 (Debian's 2.2): a live device (Kinect-class camera, or relight's own virtual
-// device relight://synthetic / relight://tum/<folder>, see capture/openni_driver/) or a recorded
+// device relight://synthetic / relight://tum/<folder>, see openni_driver/) or a recorded
 // .oni file played back through OpenNI2's file device. OpenNI.h stays out of this header.
 //
 // Reading follows docs/platform.md: every wait is OpenNI::waitForAnyStream with a

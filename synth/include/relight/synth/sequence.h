@@ -1,6 +1,7 @@
 #pragma once
-// Writes a complete synthetic RGB-D sequence with ground truth:
-//   rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt  standard TUM RGB-D (relight::TumWriter),
+// The options of a synthetic RGB-D sequence and its scene.json. truth/sequence_writer.h writes
+// the sequence with ground truth:
+//   rgb/, depth/, rgb.txt, depth.txt, groundtruth.txt  standard TUM RGB-D (capture/tum_writer.h),
 //                                                      depth 16-bit PNG, metres * 5000
 //   gt/depth/<t>.exr     exact depth, float32 metres along the optical axis (0 = nothing hit)
 //   gt/normals/<t>.exr   camera-frame unit normals facing the camera (RGB = xyz)
@@ -27,6 +28,9 @@
 
 namespace relight::synth {
 
+/// Depth PNGs hold metres * kSynthDepthScale (TUM's 5000).
+inline constexpr double kSynthDepthScale = 5000.0;
+
 struct SynthOptions {
   int frames = 30;
   Trajectory trajectory = Trajectory::Orbit;
@@ -47,13 +51,11 @@ struct SynthOptions {
 /// The text of scene.json for this scene and these options.
 [[nodiscard]] std::string scene_json(const Scene& scene, const SynthOptions& options);
 
+/// Throws relight::Error for options that cannot make a sequence (negative frames, size < 2x2,
+/// gains or exposure not positive).
+void validate_synth_options(const SynthOptions& options);
+
 /// Called after each frame with (frames done, frames total).
 using SynthProgress = std::function<void(int, int)>;
-
-/// Renders and writes the sequence of default_indoor_scene() into `out` (created if needed).
-/// Throws relight::Error on bad options or when a file cannot be written.
-void write_sequence(const SynthOptions& options, const std::filesystem::path& out, const SynthProgress& progress = {});
-void write_sequence(const Scene& scene, const SynthOptions& options, const std::filesystem::path& out,
-                    const SynthProgress& progress = {});
 
 }  // namespace relight::synth

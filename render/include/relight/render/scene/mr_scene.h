@@ -5,7 +5,7 @@
 // Every mesh and every light carries the real/virtual flag r(x) of differential rendering:
 // L_rv is the light transport of the whole scene, L_r that of the real elements alone (virtual
 // meshes invisible to every ray, virtual lights switched off). Real geometry comes from the
-// synthetic scene's exact shapes (scene_from_synth.h) or from the reconstructed depth of a frame
+// synthetic scene's exact shapes (truth/scene_from_synth.h) or from the reconstructed depth of a frame
 // (depth_mesh.h); virtual objects from OBJ/glTF files (model_io.h).
 #include <Eigen/Core>
 #include <array>

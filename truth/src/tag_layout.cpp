@@ -1,8 +1,8 @@
-#include "relight/synth/tag_layout.h"
+#include "relight/truth/tag_layout.h"
 
-namespace relight::synth {
+namespace relight::truth {
 
-TagLayout tag_layout(const Scene& scene) {
+TagLayout tag_layout(const synth::Scene& scene) {
   TagLayout layout;
   for (const auto& decal : scene.tags) {
     TagLayout::Tag tag;
@@ -15,4 +15,4 @@ TagLayout tag_layout(const Scene& scene) {
   return layout;
 }
 
-}  // namespace relight::synth
+}  // namespace relight::truth

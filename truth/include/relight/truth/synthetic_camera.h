@@ -12,7 +12,7 @@
 
 #include "relight/core/image.h"
 
-namespace relight::colormap {
+namespace relight::truth {
 
 struct CameraColorTransform {
   Eigen::Vector3d gains{1.0, 1.0, 1.0};
@@ -48,4 +48,4 @@ struct SyntheticTriple {
 /// Mean CIEDE2000 (Lab of the decoded 8-bit images, illuminant E) over the pixels of `mask`.
 [[nodiscard]] double mean_delta_e(const ColorImage& first, const ColorImage& second, const Mask& mask);
 
-}  // namespace relight::colormap
+}  // namespace relight::truth

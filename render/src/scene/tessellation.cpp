@@ -1,4 +1,4 @@
-#include "relight/render/scene/scene_from_synth.h"
+#include "relight/render/scene/tessellation.h"
 
 #include <cmath>
 #include <numbers>
@@ -9,6 +9,7 @@ namespace relight::render {
 namespace {
 
 using Vec3 = Eigen::Vector3f;
+
 
 class MeshBuilder {
  public:
@@ -44,13 +45,18 @@ class MeshBuilder {
   TriangleMesh mesh_;
 };
 
-Vec3 to_float(const Eigen::Vector3d& v) { return v.cast<float>(); }
+void check_segments(const TessellationOptions& options) {
+  if (options.segments < 3) throw Error("tessellation needs at least 3 segments");
+}
 
-TriangleMesh sphere(const synth::Sphere& shape, std::uint32_t material, int segments) {
+}  // namespace
+
+TriangleMesh tessellate_sphere(const Vec3& centre, float radius, std::uint32_t material,
+                               const TessellationOptions& options) {
+  check_segments(options);
+  const int segments = options.segments;
   MeshBuilder builder(material);
   const int rings = std::max(2, segments / 2);
-  const Vec3 centre = to_float(shape.centre);
-  const auto radius = static_cast<float>(shape.radius);
   for (int ring = 0; ring <= rings; ++ring) {
     const double theta = std::numbers::pi * ring / rings;
     for (int segment = 0; segment <= segments; ++segment) {
@@ -70,10 +76,8 @@ TriangleMesh sphere(const synth::Sphere& shape, std::uint32_t material, int segm
   return builder.take();
 }
 
-TriangleMesh box(const synth::Box& shape, std::uint32_t material) {
+TriangleMesh tessellate_box(const Vec3& lo, const Vec3& hi, std::uint32_t material) {
   MeshBuilder builder(material);
-  const Vec3 lo = to_float(shape.min);
-  const Vec3 hi = to_float(shape.max);
   const Vec3 centre = 0.5f * (lo + hi);
   const Vec3 half = 0.5f * (hi - lo);
   const Vec3 x(half.x(), 0, 0), y(0, half.y(), 0), z(0, 0, half.z());
@@ -86,21 +90,21 @@ TriangleMesh box(const synth::Box& shape, std::uint32_t material) {
   return builder.take();
 }
 
-TriangleMesh rect(const synth::Rect& shape, std::uint32_t material) {
+TriangleMesh tessellate_rectangle(const Vec3& centre, const Vec3& normal, const Vec3& half_u, const Vec3& half_v,
+                                  std::uint32_t material) {
   MeshBuilder builder(material);
-  Vec3 u = to_float(shape.u) * static_cast<float>(shape.half_u);
-  const Vec3 v = to_float(shape.v) * static_cast<float>(shape.half_v);
   // Orient the winding so that the vertex normals (u x v) equal the rectangle's normal.
-  if (u.cross(v).dot(to_float(shape.normal)) < 0.f) u = -u;
-  builder.flat_rect(to_float(shape.centre), u, v);
+  const Vec3 u = half_u.cross(half_v).dot(normal) < 0.f ? Vec3(-half_u) : half_u;
+  builder.flat_rect(centre, u, half_v);
   return builder.take();
 }
 
-TriangleMesh cylinder(const synth::Cylinder& shape, std::uint32_t material, int segments) {
+TriangleMesh tessellate_z_cylinder(const Vec3& base, float radius, float height, std::uint32_t material,
+                                   const TessellationOptions& options) {
+  check_segments(options);
+  const int segments = options.segments;
   MeshBuilder builder(material);
-  const Vec3 base = to_float(shape.base);
-  const auto radius = static_cast<float>(shape.radius);
-  const Vec3 up(0, 0, static_cast<float>(shape.height));
+  const Vec3 up(0, 0, height);
   std::vector<Vec3> rim;
   for (int segment = 0; segment < segments; ++segment) {
     const double phi = 2.0 * std::numbers::pi * segment / segments;
@@ -132,43 +136,6 @@ TriangleMesh cylinder(const synth::Cylinder& shape, std::uint32_t material, int 
     }
   }
   return builder.take();
-}
-
-}  // namespace
-
-TriangleMesh tessellate(const synth::Shape& shape, std::uint32_t material, const TessellationOptions& options) {
-  if (options.segments < 3) throw Error("tessellation needs at least 3 segments");
-  return std::visit(
-      [&](const auto& s) -> TriangleMesh {
-        using T = std::decay_t<decltype(s)>;
-        if constexpr (std::is_same_v<T, synth::Sphere>) return sphere(s, material, options.segments);
-        if constexpr (std::is_same_v<T, synth::Box>) return box(s, material);
-        if constexpr (std::is_same_v<T, synth::Rect>) return rect(s, material);
-        if constexpr (std::is_same_v<T, synth::Cylinder>) return cylinder(s, material, options.segments);
-      },
-      shape);
-}
-
-MrScene scene_from_synth(const synth::Scene& scene, const TessellationOptions& options) {
-  MrScene out;
-  for (const synth::Material& m : scene.materials)
-    out.add_material({m.name, m.kd.cast<float>(), static_cast<float>(m.ks), static_cast<float>(m.n), Vec3::Zero()});
-  for (const synth::Object& object : scene.objects) {
-    TriangleMesh mesh = tessellate(object.shape, static_cast<std::uint32_t>(object.material), options);
-    mesh.name = object.name;
-    mesh.real = true;
-    out.meshes.push_back(std::move(mesh));
-  }
-  for (const synth::PointLight& light : scene.lights) {
-    MrLight l;
-    l.kind = LightKind::Point;
-    l.position = to_float(light.position);
-    l.intensity = to_float(light.colour * light.intensity);
-    l.real = true;
-    out.lights.push_back(l);
-  }
-  out.environment.radiance = to_float(scene.environment);
-  return out;
 }
 
 }  // namespace relight::render

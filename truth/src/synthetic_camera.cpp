@@ -1,5 +1,5 @@
 // Synthetic camera and L_r / L_rv / L_cam triples (synthetic_camera.h).
-#include "relight/colormap/synthetic_camera.h"
+#include "relight/truth/synthetic_camera.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 #include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 
-namespace relight::colormap {
+namespace relight::truth {
 
 CameraColorTransform CameraColorTransform::typical() {
   CameraColorTransform camera;
@@ -73,12 +73,12 @@ double mean_delta_e(const ColorImage& first, const ColorImage& second, const Mas
   std::int64_t count = 0;
   for (std::size_t i = 0; i < first.size(); ++i) {
     if (mask.pixels()[i] == 0) continue;
-    sum += ciede2000(linear_srgb_to_lab(decode_srgb8(first.pixels()[i])),
-                     linear_srgb_to_lab(decode_srgb8(second.pixels()[i])));
+    sum += colormap::ciede2000(colormap::linear_srgb_to_lab(colormap::decode_srgb8(first.pixels()[i])),
+                               colormap::linear_srgb_to_lab(colormap::decode_srgb8(second.pixels()[i])));
     ++count;
   }
   if (count == 0) throw Error("mean_delta_e: the mask is empty");
   return sum / static_cast<double>(count);
 }
 
-}  // namespace relight::colormap
+}  // namespace relight::truth
