@@ -18,28 +18,34 @@ ColorImage coverage_preview(const render::CoverageImage& coverage) {
   return out;
 }
 
+ColorImage preview(const DepthMap& depth) { return depth_preview(depth); }
+ColorImage preview(const NormalMap& normals) { return normal_preview(normals); }
+ColorImage preview(const render::CoverageImage& coverage) { return coverage_preview(coverage); }
+
 }  // namespace
 
+std::string name_of(const PreviewBuffer& buffer) {
+  return std::visit([](auto name) { return std::string(name.name()); }, buffer);
+}
+
 void BufferPreviews::declare(StageBuilder& builder) {
-  for (Entry& entry : entries_) {
-    switch (entry.kind) {
-      case Kind::Color: entry.color = builder.read<ColorImage>(entry.buffer); break;
-      case Kind::Depth: entry.depth = builder.read<DepthMap>(entry.buffer); break;
-      case Kind::Normals: entry.normals = builder.read<NormalMap>(entry.buffer); break;
-      case Kind::Coverage: entry.coverage = builder.read<render::CoverageImage>(entry.buffer); break;
-    }
-  }
+  for (Entry& entry : entries_) std::visit([&](auto name) { entry.handle = builder.read(name); }, entry.buffer);
 }
 
 void BufferPreviews::for_each(StageContext& context,
                               const std::function<void(const std::string&, const ColorImage&)>& visit) const {
   for (const Entry& entry : entries_) {
-    switch (entry.kind) {
-      case Kind::Color: visit(entry.buffer, context.get(entry.color)); break;
-      case Kind::Depth: visit(entry.buffer, depth_preview(context.get(entry.depth))); break;
-      case Kind::Normals: visit(entry.buffer, normal_preview(context.get(entry.normals))); break;
-      case Kind::Coverage: visit(entry.buffer, coverage_preview(context.get(entry.coverage))); break;
-    }
+    const std::string name = name_of(entry.buffer);
+    std::visit(
+        [&](auto handle) {
+          const auto& image = context.get(handle);
+          if constexpr (std::is_same_v<std::decay_t<decltype(image)>, ColorImage>) {
+            visit(name, image);
+          } else {
+            visit(name, preview(image));
+          }
+        },
+        entry.handle);
   }
 }
 

@@ -1,11 +1,13 @@
 #pragma once
 // 8-bit pictures of named frame-graph buffers, for people to look at: colour images as they are,
 // depth maps in false colour (depth_preview), normal maps colour-coded (normal_preview), the
-// virtual coverage as grey (0 real .. 255 virtual). Shared by
-// the per-frame PNG writer and the report's contact sheet so both show the same pictures.
+// virtual coverage as grey (0 real .. 255 virtual). Shared by the per-frame PNG writer, the
+// report's contact sheet and the view, so all show the same pictures. The buffer's type says how
+// it is drawn.
 // Reads: every buffer registered with add() before the owning stage declares its inputs.
 #include <functional>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "relight/core/frame_graph.h"
@@ -14,11 +16,14 @@
 
 namespace relight::app {
 
+/// A buffer that can be drawn, by its typed name.
+using PreviewBuffer = std::variant<BufferName<ColorImage>, BufferName<DepthMap>, BufferName<NormalMap>,
+                                   BufferName<render::CoverageImage>>;
+[[nodiscard]] std::string name_of(const PreviewBuffer& buffer);
+
 class BufferPreviews {
  public:
-  enum class Kind { Color, Depth, Normals, Coverage };
-
-  void add(std::string buffer, Kind kind) { entries_.push_back({std::move(buffer), kind, {}, {}, {}, {}}); }
+  void add(PreviewBuffer buffer) { entries_.push_back({buffer, {}}); }
   [[nodiscard]] bool empty() const { return entries_.empty(); }
   void declare(StageBuilder& builder);
   /// Calls `visit(buffer name, picture)` for each registered buffer, in registration order.
@@ -26,12 +31,8 @@ class BufferPreviews {
 
  private:
   struct Entry {
-    std::string buffer;
-    Kind kind;
-    Read<ColorImage> color;
-    Read<DepthMap> depth;
-    Read<NormalMap> normals;
-    Read<render::CoverageImage> coverage;
+    PreviewBuffer buffer;
+    std::variant<Read<ColorImage>, Read<DepthMap>, Read<NormalMap>, Read<render::CoverageImage>> handle;
   };
   std::vector<Entry> entries_;
 };

@@ -16,7 +16,7 @@ namespace relight::app {
 
 class CameraTrajectoryStage final : public PoseTrajectoryStage {
  public:
-  explicit CameraTrajectoryStage(std::filesystem::path file) : PoseTrajectoryStage(std::move(file), "camera_pose") {}
+  explicit CameraTrajectoryStage(std::filesystem::path file) : PoseTrajectoryStage(std::move(file), kCameraPose) {}
   [[nodiscard]] std::string name() const override { return "camera_trajectory"; }
 
   [[nodiscard]] nlohmann::ordered_json summary() const;

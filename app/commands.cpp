@@ -7,27 +7,25 @@
 
 #include "json_config.h"
 #include "mixed_reality_scene.h"
-#include "render_option_values.h"
-#include "view_stage.h"
+#include "option_values.h"
 #include "replay.h"
+#include "view_stage.h"
 
 namespace relight::app {
 
 namespace {
 
 void add_compute_options(CLI::App& command, ReplayOptions& options) {
-  command.add_option("--backend", options.backend,
-                     "auto (per-pixel stages on the CPU when the only Vulkan device is a CPU device), cpu, vulkan")
-      ->capture_default_str();
-  command.add_flag_callback("--cpu", [&options] { options.backend = "cpu"; }, "Same as --backend cpu");
+  add_choice_option(command, "--backend", options.backend, vk::kBackendPolicyNames,
+                    "auto (per-pixel stages on the CPU when the only Vulkan device is a CPU device), cpu, vulkan");
+  command.add_flag_callback(
+      "--cpu", [&options] { options.backend = vk::BackendPolicy::ForceCpu; }, "Same as --backend cpu");
   command.add_option("--device", options.device,
                      "Vulkan device: index, type (discrete, integrated, cpu) or part of its name "
                      "(default: $RELIGHT_VK_DEVICE, else the best device)");
-  command.add_option("--geometry", options.geometry,
-                     "normal estimation: method1 (raw depth, temporally filtered normals) or method2 "
-                     "(warped and merged depth, normals from its positions)")
-      ->check(CLI::IsMember({"method1", "method2"}))
-      ->capture_default_str();
+  add_choice_option(command, "--geometry", options.geometry, kGeometryMethodNames,
+                    "normal estimation: method1 (raw depth, temporally filtered normals) or method2 "
+                    "(warped and merged depth, normals from its positions)");
   add_method2_normals_option(command, options);
 }
 
@@ -47,20 +45,16 @@ void add_pose_options(CLI::App& command, ReplayOptions& options) {
 }  // namespace
 
 void add_pose_option(CLI::App& command, ReplayOptions& options) {
-  command.add_option("--pose", options.pose,
-                     "camera pose: auto (the sequence's own poses when it has them, else marker+odometry with a "
-                     "marker layout, else odometry), sequence, marker, odometry, marker+odometry; writes "
-                     "camera_trajectory.txt")
-      ->check(CLI::IsMember({"auto", "sequence", "marker", "odometry", "marker+odometry"}))
-      ->capture_default_str();
+  add_choice_option(command, "--pose", options.pose, kPoseSourceNames,
+                    "camera pose: auto (the sequence's own poses when it has them, else marker+odometry with a "
+                    "marker layout, else odometry), sequence, marker, odometry, marker+odometry; writes "
+                    "camera_trajectory.txt");
 }
 
 void add_method2_normals_option(CLI::App& command, ReplayOptions& options) {
-  command.add_option("--method2-normals", options.method2_normals,
-                     "method2's normals: filtered (method1's temporal filter on the merged depth) or plain "
-                     "(stride-1 cross products of the merged positions)")
-      ->check(CLI::IsMember({"filtered", "plain"}))
-      ->capture_default_str();
+  add_choice_option(command, "--method2-normals", options.method2_normals, kMethod2NormalsNames,
+                    "method2's normals: filtered (method1's temporal filter on the merged depth) or plain "
+                    "(stride-1 cross products of the merged positions)");
 }
 
 void add_render_options(CLI::App& command, ReplayOptions& options) {
@@ -87,11 +81,9 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--vpls", options.vpls, "Light samples for virtual point lights per frame")
       ->check(CLI::Range(0, 4096))
       ->capture_default_str();
-  command.add_option("--vpl-budget", options.vpl_budget,
-                     "How the VPL samples are shared among the lights: equal, power (emitted power), weights "
-                     "(--vpl-weights) or flux (the flux each light's VPLs carried last frame)")
-      ->check(CLI::IsMember(names_of(kVplBudgets)))
-      ->capture_default_str();
+  add_choice_option(command, "--vpl-budget", options.vpl_budget, render::kVplBudgetNames,
+                    "How the VPL samples are shared among the lights: equal, power (emitted power), weights "
+                    "(--vpl-weights) or flux (the flux each light's VPLs carried last frame)");
   command.add_option("--vpl-weights", options.vpl_weights,
                      "With --vpl-budget weights: one weight per light, comma-separated (the lights file's order, "
                      "then the --virtual-light ones, then the --virtual-spot ones; missing weights are 1)")
@@ -101,33 +93,23 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                      "Indirect bounces the VPLs carry: 1 = light reflected once, 2 adds VPLs lit by VPLs")
       ->check(CLI::Range(1, 4))
       ->capture_default_str();
-  command.add_option("--bounce-method", options.bounce_method,
-                     "How bounces after the first find their surface: rays (ray traced) or cone (the nearest of "
-                     "the surface points within 5 degrees of the sampled direction, no ray tracing)")
-      ->check(CLI::IsMember(names_of(kBounceMethods)))
-      ->capture_default_str();
-  command.add_option("--vpl-source", options.vpl_source,
-                     "Where a spot light's first VPLs come from: rays (traced from the light) or rsm (importance-"
-                     "sampled texels of its reflective shadow maps, rasterised on the Vulkan device)")
-      ->check(CLI::IsMember(names_of(kVplSources)))
-      ->capture_default_str();
-  command.add_option("--real-albedo", options.real_albedo,
-                     "The k_d that real surfaces are rendered with: pixel (each camera pixel's own estimate, so "
-                     "that the real-only render matches the camera's colours) or cluster (its material cluster's)")
-      ->check(CLI::IsMember({"pixel", "cluster"}))
-      ->capture_default_str();
+  add_choice_option(command, "--bounce-method", options.bounce_method, render::kBounceMethodNames,
+                    "How bounces after the first find their surface: rays (ray traced) or cone (the nearest of "
+                    "the surface points within 5 degrees of the sampled direction, no ray tracing)");
+  add_choice_option(command, "--vpl-source", options.vpl_source, render::kVplSourceNames,
+                    "Where a spot light's first VPLs come from: rays (traced from the light) or rsm (importance-"
+                    "sampled texels of its reflective shadow maps, rasterised on the Vulkan device)");
+  add_choice_option(command, "--real-albedo", options.real_albedo, kRealAlbedoNames,
+                    "The k_d that real surfaces are rendered with: pixel (each camera pixel's own estimate, so "
+                    "that the real-only render matches the camera's colours) or cluster (its material cluster's)");
   command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  command.add_option("--colormap", options.colormap,
-                     "Map the rendered colours to the camera's: stats (CIELab statistics), sample (colour samples "
-                     "and a fitted 3x4 matrix) or none; composite.mp4 shows the mapped result, frames/ both")
-      ->check(CLI::IsMember(names_of(kColorMapMethods)))
-      ->capture_default_str();
-  command.add_option("--colormap-model", options.colormap_model,
-                     "Polynomial model of --colormap sample: per_channel_affine, linear_3x3 or affine_3x4")
-      ->check(CLI::IsMember(names_of(kColorMapModels)))
-      ->capture_default_str();
+  add_choice_option(command, "--colormap", options.colormap, colormap::kColorMapMethodNames,
+                    "Map the rendered colours to the camera's: stats (CIELab statistics), sample (colour samples "
+                    "and a fitted 3x4 matrix) or none; composite.mp4 shows the mapped result, frames/ both");
+  add_choice_option(command, "--colormap-model", options.colormap_model, colormap::kPolynomialModelNames,
+                    "Polynomial model of --colormap sample: per_channel_affine, linear_3x3 or affine_3x4");
   command.add_flag("--channel-swap", options.channel_swap,
                    "--colormap sample: also fit channel-permuted colour pairs (helps when the virtual colour is "
                    "absent from the real scene and the camera treats R, G, B alike)");
@@ -167,7 +149,8 @@ void register_replay(CLI::App& app) {
   replay->add_option("--loop", options->loops, "Play the sequence (after --frames) this many times, e.g. for soak runs")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  replay->add_option("--intrinsics", options->intrinsics, "Override intrinsics: kinect, fr1, fr2, fr3");
+  add_choice_option(*replay, "--intrinsics", options->intrinsics, kIntrinsicsPresets,
+                    "Override the sequence's intrinsics: the Kinect v1 defaults or a TUM calibration");
   replay->add_flag("--quiet", options->quiet, "No progress or summary on stderr");
   replay->add_flag("!--no-frames", options->write_frames, "Do not write per-frame images");
   replay->add_flag("--skip-bad-frames", options->skip_bad_frames,

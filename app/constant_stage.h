@@ -11,13 +11,13 @@ namespace relight::app {
 template <class T>
 class ConstantStage final : public Stage {
  public:
-  ConstantStage(std::string buffer, T value) : buffer_name_(std::move(buffer)), value_(std::move(value)) {}
-  [[nodiscard]] std::string name() const override { return "constant_" + buffer_name_; }
-  void declare(StageBuilder& builder) override { buffer_ = builder.write<T>(buffer_name_); }
+  ConstantStage(BufferName<T> buffer, T value) : buffer_name_(buffer), value_(std::move(value)) {}
+  [[nodiscard]] std::string name() const override { return "constant_" + std::string(buffer_name_.name()); }
+  void declare(StageBuilder& builder) override { buffer_ = builder.write(buffer_name_); }
   void run(StageContext& context) override { context.get(buffer_) = value_; }
 
  private:
-  std::string buffer_name_;
+  BufferName<T> buffer_name_;
   T value_;
   Write<T> buffer_;
 };

@@ -9,7 +9,7 @@ namespace relight::app {
 
 void FrameWriterStage::declare(StageBuilder& builder) {
   previews_.declare(builder);
-  for (const auto& name : radiance_names_) radiances_.push_back(builder.read<RadianceImage>(name));
+  for (const auto name : radiance_names_) radiances_.push_back(builder.read(name));
 }
 
 std::filesystem::path FrameWriterStage::file_for(std::int64_t frame, const std::string& buffer,
@@ -29,7 +29,8 @@ void FrameWriterStage::run(StageContext& context) {
     write_color(file_for(context.frame_index(), buffer), picture);
   });
   for (std::size_t i = 0; i < radiances_.size(); ++i) {
-    write_radiance(file_for(context.frame_index(), radiance_names_[i], ".exr"), context.get(radiances_[i]));
+    write_radiance(file_for(context.frame_index(), std::string(radiance_names_[i].name()), ".exr"),
+                   context.get(radiances_[i]));
   }
 }
 

@@ -7,11 +7,11 @@
 namespace relight::app {
 
 void LatencyStage::declare(StageBuilder& builder) {
-  frame_ = builder.read<FrameInfo>("source_frame");
-  if (composite_.empty()) {
-    normals_ = builder.read<NormalMap>("normals");
+  frame_ = builder.read(kSourceFrame);
+  if (composite_) {
+    picture_ = builder.read(*composite_);
   } else {
-    picture_ = builder.read<ColorImage>(composite_);
+    normals_ = builder.read(kNormals);
   }
 }
 
@@ -24,7 +24,7 @@ void LatencyStage::run(StageContext& context) {
 
 nlohmann::ordered_json LatencyStage::summary() const {
   nlohmann::ordered_json out;
-  out["to"] = composite_.empty() ? "normals" : composite_;
+  out["to"] = composite_ ? composite_->name() : kNormals.name();
   out["frames"] = latencies_ms_.size();
   if (latencies_ms_.empty()) return out;
   std::vector<double> sorted = latencies_ms_;

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
 #include "relight/core/rgbd_frame.h"
@@ -19,8 +20,8 @@ namespace relight::app {
 
 class LatencyStage final : public Stage {
  public:
-  /// `composite`: the ColorImage whose readiness ends the latency; empty: "normals".
-  explicit LatencyStage(std::string composite) : composite_(std::move(composite)) {}
+  /// `composite`: the ColorImage whose readiness ends the latency; none: the normals.
+  explicit LatencyStage(std::optional<BufferName<ColorImage>> composite) : composite_(composite) {}
   [[nodiscard]] std::string name() const override { return "latency"; }
   [[nodiscard]] bool has_side_effects() const override { return true; }
   void declare(StageBuilder& builder) override;
@@ -32,7 +33,7 @@ class LatencyStage final : public Stage {
   [[nodiscard]] double last_ms() const { return latencies_ms_.empty() ? 0.0 : latencies_ms_.back(); }
 
  private:
-  std::string composite_;
+  std::optional<BufferName<ColorImage>> composite_;
   std::vector<double> latencies_ms_;
   Read<FrameInfo> frame_;
   Read<ColorImage> picture_;

@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "commands.h"
+#include "option_values.h"
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
 #include "relight/core/image_io.h"
@@ -16,14 +17,21 @@ namespace relight::app {
 
 namespace {
 
+/// --projection: the probe's, or auto (equirectangular when width = 2 x height, else fisheye).
+enum class ProjectionChoice { Auto, Fisheye, Equirect };
+constexpr std::array<NamedValue<ProjectionChoice>, 3> kProjectionChoiceNames{
+    {{"auto", ProjectionChoice::Auto},
+     {"fisheye", ProjectionChoice::Fisheye},
+     {"equirect", ProjectionChoice::Equirect}}};
+
 struct LightsCommandOptions {
   std::filesystem::path probe;
   int lights = 64;
-  std::string method = "importance";
+  LightMethod method = LightMethod::Importance;
   std::uint64_t seed = 0;
   std::filesystem::path out;
   std::filesystem::path preview;
-  std::string projection = "auto";
+  ProjectionChoice projection = ProjectionChoice::Auto;
   std::vector<double> centre;
   double radius = 0.0;
   double fov = 180.0;
@@ -70,11 +78,10 @@ void check_not_over_exposed(const RadianceImage& probe, const ProbeGeometry& geo
 }
 
 ProbeCalibration calibration_for(const LightsCommandOptions& command, const RadianceImage& probe) {
-  std::string projection = command.projection;
-  if (projection == "auto") projection = probe.width() == 2 * probe.height() ? "equirect" : "fisheye";
-  ProbeCalibration calibration = projection == "equirect"
-                                     ? ProbeCalibration::equirectangular()
-                                     : ProbeCalibration::centred_fisheye(probe.width(), probe.height());
+  const bool equirect = command.projection == ProjectionChoice::Auto ? probe.width() == 2 * probe.height()
+                                                                     : command.projection == ProjectionChoice::Equirect;
+  ProbeCalibration calibration =
+      equirect ? ProbeCalibration::equirectangular() : ProbeCalibration::centred_fisheye(probe.width(), probe.height());
   if (!command.centre.empty()) {
     calibration.fisheye.cx = command.centre[0];
     calibration.fisheye.cy = command.centre[1];
@@ -95,7 +102,7 @@ ProbeCalibration calibration_for(const LightsCommandOptions& command, const Radi
 int run_lights(const LightsCommandOptions& command) {
   const RadianceImage probe = read_probe(command.probe, command.gamma);
   LightExtractionOptions options;
-  options.method = parse_light_method(command.method);
+  options.method = command.method;
   options.lights = command.lights;
   options.seed = command.seed;
   options.calibration = calibration_for(command, probe);
@@ -111,9 +118,9 @@ int run_lights(const LightsCommandOptions& command) {
   if (!command.preview.empty()) write_color(command.preview, light_preview(probe, geometry, lights));
   if (!command.quiet) {
     const Eigen::Vector3d e = irradiance(lights, Eigen::Vector3d::UnitZ());
-    std::cerr << "relight lights: " << lights.lights.size() << " lights (" << command.method << ") from "
-              << command.probe.string() << ", irradiance on +z " << e.x() << " " << e.y() << " " << e.z() << " -> "
-              << command.out.string() << "\n";
+    std::cerr << "relight lights: " << lights.lights.size() << " lights (" << name_of(kLightMethodNames, command.method)
+              << ") from " << command.probe.string() << ", irradiance on +z " << e.x() << " " << e.y() << " " << e.z()
+              << " -> " << command.out.string() << "\n";
   }
   return 0;
 }
@@ -126,16 +133,13 @@ void register_lights(CLI::App& app, Runners& runners) {
   lights->add_option("probe", options->probe, "Probe image: .hdr/.exr (linear), or 8-bit (linearised with --gamma)")
       ->required();
   lights->add_option("--n", options->lights, "Number of lights")->check(CLI::Range(1, 1 << 20))->capture_default_str();
-  lights->add_option("--method", options->method, "importance (hierarchical warping VPLs) or median-cut")
-      ->check(CLI::IsMember({"importance", "median-cut"}))
-      ->capture_default_str();
+  add_choice_option(*lights, "--method", options->method, kLightMethodNames,
+                    "importance (hierarchical warping VPLs) or median-cut");
   lights->add_option("--seed", options->seed, "Rotation of the sample set (importance)")->capture_default_str();
   lights->add_option("--out", options->out, "Output JSON (lights/light_output.h)")->required();
   lights->add_option("--preview", options->preview, "Picture of the probe with the lights marked (.png)");
-  lights->add_option("--projection", options->projection,
-                     "fisheye, equirect, or auto (equirect when width = 2 x height)")
-      ->check(CLI::IsMember({"auto", "fisheye", "equirect"}))
-      ->capture_default_str();
+  add_choice_option(*lights, "--projection", options->projection, kProjectionChoiceNames,
+                    "fisheye, equirect, or auto (equirect when width = 2 x height)");
   lights->add_option("--centre", options->centre, "Fisheye image-circle centre cx,cy in pixels (default: image centre)")
       ->expected(2)
       ->delimiter(',');

@@ -15,17 +15,18 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 
+#include "camera_trajectory_stage.h"
 #include "commands.h"
 #include "interrupt.h"
 #include "live_view.h"
-#include "view_stage.h"
-#include "camera_trajectory_stage.h"
+#include "option_values.h"
 #include "relight/capture/openni_source.h"
 #include "relight/capture/tum_writer.h"
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
 #include "replay.h"
 #include "report.h"
+#include "view_stage.h"
 
 namespace relight::app {
 
@@ -279,12 +280,11 @@ int run_record(const RecordOptions& options) {
 }
 
 void add_live_compute_options(CLI::App& command, ReplayOptions& options) {
-  command.add_option("--backend", options.backend, "auto, cpu or vulkan (as in replay)")->capture_default_str();
-  command.add_flag_callback("--cpu", [&options] { options.backend = "cpu"; }, "Same as --backend cpu");
+  add_choice_option(command, "--backend", options.backend, vk::kBackendPolicyNames, "As in replay");
+  command.add_flag_callback(
+      "--cpu", [&options] { options.backend = vk::BackendPolicy::ForceCpu; }, "Same as --backend cpu");
   command.add_option("--vk-device", options.device, "Vulkan device (replay's --device)");
-  command.add_option("--geometry", options.geometry, "normal estimation: method1 or method2 (as in replay)")
-      ->check(CLI::IsMember({"method1", "method2"}))
-      ->capture_default_str();
+  add_choice_option(command, "--geometry", options.geometry, kGeometryMethodNames, "Normal estimation (as in replay)");
   add_method2_normals_option(command, options);
 }
 

@@ -11,9 +11,12 @@
 #include <sstream>
 
 #include "number_list.h"
+#include "relight/capture/buffers.h"
 #include "relight/capture/support_plane.h"
+#include "relight/core/buffers.h"
 #include "relight/core/error.h"
 #include "relight/core/pixel.h"
+#include "relight/render/buffers.h"
 
 namespace relight::app {
 
@@ -152,10 +155,10 @@ ObjectPlacementStage::ObjectPlacementStage(std::vector<PlacementRequest> request
 }
 
 void ObjectPlacementStage::declare(StageBuilder& builder) {
-  frame_ = builder.read<FrameInfo>("frame");
-  depth_ = builder.read<DepthMap>("depth");
-  pose_ = builder.read<CameraPose>("camera_pose");
-  placements_ = builder.write<render::ObjectPlacements>("object_placements");
+  frame_ = builder.read(kFrame);
+  depth_ = builder.read(kDepth);
+  pose_ = builder.read(kCameraPose);
+  placements_ = builder.write(render::kObjectPlacements);
 }
 
 void ObjectPlacementStage::run(StageContext& context) {

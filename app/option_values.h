@@ -1,38 +1,36 @@
 #pragma once
-// The values of a CLI option with a fixed set of them, written once: a table of (name, value)
-// that serves CLI11's check (names_of), the parser that turns the text into its enum
-// (parse_option: the one place an unknown name becomes an error) and the error message.
+// CLI options whose values are an enum's names (core/named_values.h): the option stores the enum
+// directly, CLI11 checks the text against the table (its error lists the names, --help shows them
+// and the default), and the JSON config, which goes through CLI11, gets the same check. The text
+// becomes the enum here, at the CLI boundary, and nowhere else.
+#include <CLI/CLI.hpp>
 #include <array>
 #include <cstddef>
+#include <optional>
 #include <string>
-#include <string_view>
-#include <vector>
 
-#include "relight/core/error.h"
+#include "relight/core/named_values.h"
 
 namespace relight::app {
 
-template <class E>
-struct OptionValue {
-  std::string_view name;
-  E value;
-};
-
 template <class E, std::size_t N>
-[[nodiscard]] std::vector<std::string> names_of(const std::array<OptionValue<E>, N>& table) {
-  std::vector<std::string> names;
-  for (const auto& entry : table) names.emplace_back(entry.name);
-  return names;
+CLI::Option* add_choice_option(CLI::App& command, const std::string& flag, E& value,
+                               const std::array<NamedValue<E>, N>& table, const std::string& description) {
+  CLI::Option* option = command.add_option_function<std::string>(
+      flag, [&value, &table, flag](const std::string& text) { value = parse_named(table, flag, text); }, description);
+  option->check(CLI::IsMember(names_of(table)));
+  option->default_str(name_of(table, value));
+  return option;
 }
 
-/// The value named `text`; throws relight::Error("OPTION 'text' is not one of a, b, c").
+/// The same for an optional value without a default (absent: the option was not given).
 template <class E, std::size_t N>
-[[nodiscard]] E parse_option(const std::array<OptionValue<E>, N>& table, std::string_view option, std::string_view text) {
-  for (const auto& entry : table)
-    if (entry.name == text) return entry.value;
-  std::string list;
-  for (const auto& entry : table) list += (list.empty() ? "" : ", ") + std::string(entry.name);
-  throw Error(std::string(option) + " '" + std::string(text) + "' is not one of " + list);
+CLI::Option* add_choice_option(CLI::App& command, const std::string& flag, std::optional<E>& value,
+                               const std::array<NamedValue<E>, N>& table, const std::string& description) {
+  CLI::Option* option = command.add_option_function<std::string>(
+      flag, [&value, &table, flag](const std::string& text) { value = parse_named(table, flag, text); }, description);
+  option->check(CLI::IsMember(names_of(table)));
+  return option;
 }
 
 }  // namespace relight::app

@@ -3,12 +3,13 @@
 #include <cstdio>
 
 #include "relight/core/atomic_file.h"
+#include "relight/core/buffers.h"
 
 namespace relight::app {
 
 void PoseTrajectoryStage::declare(StageBuilder& builder) {
-  pose_ = builder.read<CameraPose>(pose_buffer_);
-  frame_ = builder.read<FrameInfo>("source_frame");
+  pose_ = builder.read(pose_buffer_);
+  frame_ = builder.read(kSourceFrame);
 }
 
 void PoseTrajectoryStage::run(StageContext& context) {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "relight/capture/buffers.h"
 #include "relight/capture/camera_pose.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
@@ -23,8 +24,8 @@ class PoseTrajectoryStage : public Stage {
   void finish() override;
 
  protected:
-  PoseTrajectoryStage(std::filesystem::path file, std::string pose_buffer)
-      : file_(std::move(file)), pose_buffer_(std::move(pose_buffer)) {}
+  PoseTrajectoryStage(std::filesystem::path file, BufferName<CameraPose> pose_buffer)
+      : file_(std::move(file)), pose_buffer_(pose_buffer) {}
   struct Entry {
     std::int64_t index;
     Timestamp timestamp;
@@ -37,7 +38,7 @@ class PoseTrajectoryStage : public Stage {
 
  private:
   std::filesystem::path file_;
-  std::string pose_buffer_;
+  BufferName<CameraPose> pose_buffer_;
   std::vector<Entry> entries_;
   Read<CameraPose> pose_;
   Read<FrameInfo> frame_;

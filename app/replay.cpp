@@ -7,27 +7,33 @@
 #include <functional>
 #include <iostream>
 
+#include "camera_trajectory_stage.h"
 #include "constant_stage.h"
 #include "frame_range.h"
 #include "frame_writer_stage.h"
 #include "interrupt.h"
 #include "latency_stage.h"
 #include "live_view.h"
-#include "camera_trajectory_stage.h"
 #include "marker_trajectory_stage.h"
 #include "mixed_reality_scene.h"
 #include "object_placement_stage.h"
-#include "render_option_values.h"
+#include "relight/brdf/brdf_preview.h"
+#include "relight/brdf/brdf_stages.h"
+#include "relight/brdf/buffers.h"
+#include "relight/capture/buffers.h"
 #include "relight/capture/camera_tracking_stage.h"
 #include "relight/capture/looping_source.h"
-#include "relight/capture/range_source.h"
 #include "relight/capture/marker_pose.h"
 #include "relight/capture/openni_source.h"
+#include "relight/capture/range_source.h"
 #include "relight/capture/source_stage.h"
 #include "relight/capture/tum_sequence.h"
+#include "relight/colormap/colormap_stages.h"
 #include "relight/core/atomic_file.h"
+#include "relight/core/buffers.h"
 #include "relight/core/error.h"
 #include "relight/core/progress.h"
+#include "relight/lights/buffers.h"
 #include "relight/reconstruct/cross_normals_vk.h"
 #include "relight/reconstruct/depth_box_filter.h"
 #include "relight/reconstruct/depth_warp_merge.h"
@@ -35,16 +41,14 @@
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
 #include "relight/reconstruct/normals_raw_depth_vk.h"
-#include "relight/vk/backend.h"
-#include "relight/vk/context.h"
-#include "relight/vk/transfer.h"
-#include "relight/brdf/brdf_preview.h"
-#include "relight/brdf/brdf_stages.h"
-#include "relight/colormap/colormap_stages.h"
+#include "relight/render/buffers.h"
 #include "relight/render/dir/dir_stage.h"
 #include "relight/render/dir/mapped_composite_stage.h"
 #include "relight/render/scene/model_io.h"
 #include "relight/render/scene/scene_lights.h"
+#include "relight/vk/backend.h"
+#include "relight/vk/context.h"
+#include "relight/vk/transfer.h"
 #include "report.h"
 #include "report_collector_stage.h"
 #include "video_writer_stage.h"
@@ -63,10 +67,7 @@ namespace {
 
 std::unique_ptr<FrameSource> open_source_once(const ReplayOptions& options) {
   TumOptions tum;
-  if (!options.intrinsics.empty()) {
-    tum.intrinsics = PinholeIntrinsics::preset(options.intrinsics);
-    if (!tum.intrinsics) throw Error("--intrinsics '" + options.intrinsics + "' is not one of kinect, fr1, fr2, fr3");
-  }
+  tum.intrinsics = options.intrinsics;
   const FrameRange range = options.frames.empty() ? FrameRange{} : parse_frame_range(options.frames);
   const auto folder = options.sequence.empty() ? default_sequence() : options.sequence;
   if (folder.extension() == ".oni") {  // OpenNI2 recording, played back through its file device
@@ -129,20 +130,20 @@ std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
   return parse_tag_layout(text, scene.string());
 }
 
-/// The colour mapping between DIR's L_rv/L_r and the camera, and its composite; returns the name
-/// of the buffer that holds the final picture ("composite" when there is no mapping).
-std::string add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel,
-                              const colormap::ToneMap& tone_map) {
-  const auto method = parse_option(kColorMapMethods, "--colormap", options.colormap);
-  if (method == colormap::ColorMapMethod::None) return "composite";  // DIR's own composite is unmapped
+/// The colour mapping between DIR's L_rv/L_r and the camera, and its composite; returns the
+/// buffer that holds the final picture (DIR's own composite when there is no mapping).
+BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel,
+                                         const colormap::ToneMap& tone_map) {
+  const auto method = options.colormap;
+  if (method == colormap::ColorMapMethod::None) return kComposite;  // DIR's own composite is unmapped
   colormap::SampleMappingOptions mapping;
   mapping.tone_map = tone_map;
   mapping.channel_swap = options.channel_swap;
-  mapping.model = parse_option(kColorMapModels, "--colormap-model", options.colormap_model);
+  mapping.model = options.colormap_model;
   pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping));
   pipeline.graph->emplace<render::MappedCompositeStage>();
-  pipeline.graph->keep("composite_mapped");
-  return "composite_mapped";
+  pipeline.graph->keep(kCompositeMapped);
+  return kCompositeMapped;
 }
 
 /// The lights, the BRDF stages (real materials) and the DIR stage with its outputs, when the
@@ -181,25 +182,25 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   FrameGraph& graph = *pipeline.graph;
   if (!content.objects.empty())
     pipeline.placement = &graph.emplace<ObjectPlacementStage>(std::move(requests), std::move(names));
-  graph.emplace<ConstantStage<LightSet>>("lights", measured);
+  graph.emplace<ConstantStage<LightSet>>(kLights, measured);
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
   graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
   render::DirStageOptions dir;
   dir.vpls.count = options.vpls;
-  dir.vpls.budget = parse_option(kVplBudgets, "--vpl-budget", options.vpl_budget);
+  dir.vpls.budget = options.vpl_budget;
   dir.vpls.light_weights = options.vpl_weights;
   dir.vpls.bounces = options.vpl_bounces;
-  dir.vpls.bounce_method = parse_option(kBounceMethods, "--bounce-method", options.bounce_method);
-  dir.vpls.source = parse_option(kVplSources, "--vpl-source", options.vpl_source);
+  dir.vpls.bounce_method = options.bounce_method;
+  dir.vpls.source = options.vpl_source;
   dir.tone_map.exposure = options.exposure;
-  dir.materials_buffer = "materials";
-  if (pipeline.placement) dir.placements_buffer = "object_placements";
-  if (options.real_albedo == "pixel") dir.albedo_buffer = "kd";
+  dir.materials_buffer = brdf::kMaterials;
+  if (pipeline.placement) dir.placements_buffer = render::kObjectPlacements;
+  if (options.real_albedo == RealAlbedo::Pixel) dir.albedo_buffers = render::RealAlbedoBuffers{};
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view
   // keep their shadows, at a quarter of the rasterisation and memory of 512.
   dir.renderer.shadow_tile = 256;
   render::add_dir_stages(graph, pipeline.vulkan.get(), std::move(content), dir);
-  graph.keep("composite");
+  graph.keep(kComposite);
   pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, dir.tone_map);
   if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", pipeline.final_composite);
   pipeline.renders = true;
@@ -216,16 +217,11 @@ std::string marker_layout_name(const ReplayOptions& options) {
 /// source's frame into the tracked "frame" every pose reader uses.
 void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
   CameraTrackingOptions tracking;
-  if (options.pose != "auto") {
-    tracking.source = parse_pose_source(options.pose);
-    if (!tracking.source) {
-      throw Error("--pose '" + options.pose + "' is not one of auto, sequence, marker, odometry, marker+odometry");
-    }
-  }
+  tracking.source = options.pose;
   auto layout = marker_layout(options);
   tracking.has_marker_layout = layout.has_value();
   if (layout) {
-    pipeline.graph->emplace<MarkerPoseStage>(std::move(*layout), TagDetectorOptions{}, "source_frame");
+    pipeline.graph->emplace<MarkerPoseStage>(std::move(*layout), TagDetectorOptions{}, kSourceFrame);
     pipeline.markers =
         &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt", marker_layout_name(options));
   }
@@ -237,34 +233,33 @@ void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
 /// stage that feeds it the final picture.
 void add_view(ReplayPipeline& pipeline, const ReplayOptions& options, bool method2) {
   const std::string& side = options.view_side;
-  const bool needs_render = side == "composite" || side == "virtual_coverage";
+  const bool needs_render = side == kComposite.name() || side == render::kVirtualCoverage.name();
   if (needs_render && !pipeline.renders) throw Error("--view-side " + side + " needs something to render (--object)");
-  if (side == "depth_filtered" && !method2) throw Error("--view-side depth_filtered needs --geometry method2");
+  if (side == kDepthFiltered.name() && !method2) throw Error("--view-side depth_filtered needs --geometry method2");
   pipeline.view = std::make_unique<LiveView>("relight " + (options.live_device.empty() ? std::string("replay")
                                                                                        : "live: " + options.live_device),
                                              options.out / "snapshots");
-  const auto side_kind = side.empty() ? BufferPreviews::Kind::Color : parse_option(kViewSides, "--view-side", side);
-  pipeline.view_stage = &pipeline.graph->emplace<ViewStage>(*pipeline.view, pipeline.renders ? pipeline.final_composite : "color",
-                                                            side, side_kind);
+  const auto side_buffer =
+      side.empty() ? std::nullopt : std::optional<PreviewBuffer>(parse_named(kViewSides, "--view-side", side));
+  pipeline.view_stage = &pipeline.graph->emplace<ViewStage>(
+      *pipeline.view, pipeline.renders ? pipeline.final_composite : kColor, side_buffer);
 }
 
 void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, bool method2) {
-  using Kind = BufferPreviews::Kind;
   auto collector = std::make_unique<ReportCollectorStage>(total_frames);
-  collector->add_picture("color", Kind::Color);
-  collector->add_picture(method2 ? "depth_filtered" : "depth_smoothed", Kind::Depth);
-  collector->add_picture("normals", Kind::Normals);
+  collector->add_picture(kColor);
+  collector->add_picture(method2 ? kDepthFiltered : kDepthSmoothed);
+  collector->add_picture(kNormals);
   if (pipeline.renders) {
-    collector->add_picture("composite", Kind::Color);
-    if (pipeline.final_composite != "composite") collector->add_picture(pipeline.final_composite, Kind::Color);
-    collector->add_picture("brdf_preview", Kind::Color);  // a wide mosaic: last, so it wraps alone
-    collector->collect_materials("materials");
-    collector->collect_lights("lights");
+    collector->add_picture(kComposite);
+    if (pipeline.final_composite != kComposite) collector->add_picture(pipeline.final_composite);
+    collector->add_picture(kBrdfPreview);  // a wide mosaic: last, so it wraps alone
+    collector->collect_materials(brdf::kMaterials);
+    collector->collect_lights(kLights);
   }
   pipeline.report = collector.get();
   pipeline.graph->add(std::move(collector));
 }
-
 
 }  // namespace
 
@@ -297,29 +292,22 @@ ReplayOptions with_main_job_defaults(ReplayOptions options) {
 
 ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& given) {
   const ReplayOptions options = with_main_job_defaults(given);
-  if (options.geometry != "method1" && options.geometry != "method2") {
-    throw Error("--geometry '" + options.geometry + "' is not one of method1, method2");
-  }
-  if (options.method2_normals != "filtered" && options.method2_normals != "plain") {
-    throw Error("--method2-normals '" + options.method2_normals + "' is not one of filtered, plain");
-  }
-  const auto policy = vk::parse_backend_policy(options.backend);
-  if (!policy) throw Error("--backend '" + options.backend + "' is not one of auto, cpu, vulkan");
+  const vk::BackendPolicy policy = options.backend;
   ReplayPipeline pipeline;
-  pipeline.vulkan = make_vulkan(options, *policy);
+  pipeline.vulkan = make_vulkan(options, policy);
   pipeline.graph = std::make_unique<FrameGraph>(pipeline.vulkan ? &pipeline.vulkan->transfer() : nullptr);
-  const Backend per_pixel = vk::choose_backend(vk::StageKind::PerPixel, pipeline.vulkan.get(), *policy);
+  const Backend per_pixel = vk::choose_backend(vk::StageKind::PerPixel, pipeline.vulkan.get(), policy);
   pipeline.compute = std::string("per-pixel stages on ") + to_string(per_pixel) +
                      (pipeline.vulkan ? " (Vulkan device: " + pipeline.vulkan->device_info().name + ")"
                                       : " (no Vulkan device in use)");
 
   FrameGraph& graph = *pipeline.graph;
   const std::int64_t total_frames = source->size_hint();
-  graph.emplace<SourceStage>(std::move(source), "source_frame");
+  graph.emplace<SourceStage>(std::move(source), kSourceFrame);
   graph.add(make_depth_box_filter_stage(per_pixel, pipeline.vulkan.get()));
   // Geometry (positions + normals) follows the per-pixel backend; method 1's
   // pass-1 pyramid stays on the CPU either way (normals_raw_depth_vk.h).
-  const bool method2 = options.geometry == "method2";
+  const bool method2 = options.geometry == GeometryMethod::Method2;
   const bool geometry_on_gpu = per_pixel == Backend::Vulkan && pipeline.vulkan;
   if (method2 && geometry_on_gpu) {
     graph.emplace<DepthWarpMergeVkStage>(*pipeline.vulkan);
@@ -327,7 +315,7 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
     graph.emplace<DepthWarpMergeCpuStage>();
   }
   const auto input = method2 ? NormalsDepthInput::Filtered : NormalsDepthInput::Raw;
-  if (method2 && options.method2_normals == "plain") {
+  if (method2 && options.method2_normals == Method2Normals::Plain) {
     if (geometry_on_gpu) {
       graph.emplace<NormalsFromPositionsVkStage>(*pipeline.vulkan);
     } else {
@@ -338,29 +326,30 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   } else {
     graph.emplace<NormalsRawDepthCpuStage>(NormalsRawDepthOptions{}, input);
   }
-  graph.keep("normals");
-  graph.keep("positions");
+  graph.keep(kNormals);
+  graph.keep(kPositions);
   add_camera_pose(pipeline, options);
   add_differential_rendering(pipeline, options, per_pixel);
-  pipeline.latency = &graph.emplace<LatencyStage>(pipeline.renders ? pipeline.final_composite : "");
+  pipeline.latency =
+      &graph.emplace<LatencyStage>(pipeline.renders ? std::optional(pipeline.final_composite) : std::nullopt);
   if (options.view) add_view(pipeline, options, method2);
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
-    writer->add_color("color");
-    writer->add_depth("depth");
-    writer->add_depth("depth_smoothed");
-    if (method2) writer->add_depth("depth_filtered");
-    writer->add_normals("normals");
+    writer->add(kColor);
+    writer->add(kDepth);
+    writer->add(kDepthSmoothed);
+    if (method2) writer->add(kDepthFiltered);
+    writer->add(kNormals);
     if (pipeline.renders) {
-      writer->add_color("composite");
-      if (pipeline.final_composite != "composite") writer->add_color(pipeline.final_composite);
-      writer->add_color("brdf_preview");
+      writer->add(kComposite);
+      if (pipeline.final_composite != kComposite) writer->add(pipeline.final_composite);
+      writer->add(kBrdfPreview);
     }
     if (pipeline.renders && options.write_buffers) {
-      writer->add_radiance("L_rv");
-      writer->add_radiance("L_r");
-      writer->add_coverage("virtual_coverage");
-      if (pipeline.final_composite != "composite") writer->add_radiance("delta_L");  // the colour-mapped difference
+      writer->add(kRealVirtualRadiance);
+      writer->add(kRealRadiance);
+      writer->add(render::kVirtualCoverage);
+      if (pipeline.final_composite != kComposite) writer->add(kDeltaRadiance);  // the colour-mapped difference
     }
     graph.add(std::move(writer));
   }

@@ -1,17 +1,21 @@
 #pragma once
 // `relight replay`: runs the frame graph over a recorded sequence and writes the results.
+#include <array>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "relight/capture/camera_pose.h"
 #include "relight/capture/frame_source.h"
+#include "relight/colormap/colormap_stages.h"
+#include "relight/colormap/sample_mapping.h"
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
-
-namespace relight::vk {
-class VulkanContext;
-}
+#include "relight/core/named_values.h"
+#include "relight/render/vpl/vpl.h"
+#include "relight/vk/backend.h"
 
 namespace relight::app {
 
@@ -23,27 +27,40 @@ class ObjectPlacementStage;
 class ViewStage;
 class ReportCollectorStage;
 
+/// --geometry: method 1 (NormalsRawDepth on the raw depth) or method 2 (DepthWarpMerge, then
+/// the normals of `Method2Normals`).
+enum class GeometryMethod { Method1, Method2 };
+inline constexpr std::array<NamedValue<GeometryMethod>, 2> kGeometryMethodNames{
+    {{"method1", GeometryMethod::Method1}, {"method2", GeometryMethod::Method2}}};
+/// Method 2's normals: method 1's estimator on the merged depth (§4.3.3's filtered normal), or
+/// stride-1 cross products of the merged positions (NormalsFromPositions).
+enum class Method2Normals { Filtered, Plain };
+inline constexpr std::array<NamedValue<Method2Normals>, 2> kMethod2NormalsNames{
+    {{"filtered", Method2Normals::Filtered}, {"plain", Method2Normals::Plain}}};
+/// The k_d real surfaces are rendered with: each camera pixel's own estimate (render/dir/camera_albedo.h)
+/// or its material cluster's.
+enum class RealAlbedo { Pixel, Cluster };
+inline constexpr std::array<NamedValue<RealAlbedo>, 2> kRealAlbedoNames{
+    {{"pixel", RealAlbedo::Pixel}, {"cluster", RealAlbedo::Cluster}}};
+
 struct ReplayOptions {
   std::filesystem::path sequence;  ///< empty: the embedded sample (data/tum_fr1_rpy)
   std::filesystem::path out = "relight-out";
   std::string frames;              ///< "A:B" range, empty = all
   int loops = 1;                   ///< play the (ranged) sequence this many times
-  std::string intrinsics;          ///< TUM preset name overriding the sequence's own
+  std::optional<PinholeIntrinsics> intrinsics;  ///< a preset (kIntrinsicsPresets) overriding the sequence's own
   bool quiet = false;
   bool write_frames = true;        ///< per-frame PNGs under out/frames
-  std::string backend = "auto";    ///< auto | cpu | vulkan (see vk/backend.h)
+  vk::BackendPolicy backend = vk::BackendPolicy::Auto;  ///< see vk/backend.h
   std::string device;              ///< Vulkan device selector (index, type or name part)
   /// AprilTag layout for the marker pose: "auto" (the sequence's scene.json when it has a tag),
   /// "none", or a layout/scene JSON file.
   std::string markers = "auto";
-  /// Camera pose source (capture/camera_tracking_stage.h): auto | sequence | marker | odometry |
-  /// marker+odometry.
-  std::string pose = "auto";
+  /// Camera pose source (capture/camera_tracking_stage.h); none: auto.
+  std::optional<PoseSource> pose;
   bool skip_bad_frames = false;  ///< TUM frames that cannot be read: warn and skip instead of failing
-  std::string geometry = "method1";  ///< normals: method1 (NormalsRawDepth) | method2 (DepthWarpMerge + normals below)
-  /// Method 2's normals: "filtered" (method 1's estimator on the merged depth, §4.3.3's filtered
-  /// normal) | "plain" (stride-1 cross products of the merged positions, NormalsFromPositions).
-  std::string method2_normals = "filtered";
+  GeometryMethod geometry = GeometryMethod::Method1;
+  Method2Normals method2_normals = Method2Normals::Filtered;
   /// Differential rendering (render/dir_stage.h) runs when there is an object or a virtual light.
   std::vector<std::filesystem::path> objects;  ///< .obj / .gltf / .glb
   std::vector<std::string> places;             ///< x,y,z[,yaw[,scale]] (world), see object_placement_stage.h
@@ -59,18 +76,17 @@ struct ReplayOptions {
   std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]
   std::vector<std::string> virtual_spots;      ///< x,y,z,tx,ty,tz,angle,intensity[,r,g,b]
   int vpls = 64;                               ///< first-bounce light samples per frame
-  std::string vpl_budget = "power";            ///< equal | power | weights | flux (render/vpl.h)
+  render::VplBudget vpl_budget = render::VplBudget::ByPower;  ///< render/vpl/vpl.h
   std::vector<float> vpl_weights;              ///< per light (lights file order, then virtual lights)
   int vpl_bounces = 1;                         ///< indirect bounces carried by VPLs (render/vpl.h)
-  std::string bounce_method = "rays";          ///< rays | cone: how bounces >= 2 find surfaces
-  std::string vpl_source = "rays";             ///< rays | rsm: where spot lights' first VPLs come from
-  /// pixel | cluster: the k_d real surfaces are shaded with (render/camera_albedo.h)
-  std::string real_albedo = "pixel";
+  render::BounceMethod bounce_method = render::BounceMethod::RayTraced;  ///< how bounces >= 2 find surfaces
+  render::VplSource vpl_source = render::VplSource::RayTraced;           ///< where spot lights' first VPLs come from
+  RealAlbedo real_albedo = RealAlbedo::Pixel;
   float exposure = 1.f;                        ///< tone mapping of the rendered light
   bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
-  /// Colour mapping of the rendered light to the camera (colormap/): none | sample | stats.
-  std::string colormap = "stats";
-  std::string colormap_model = "affine_3x4";  ///< sample mapping: per_channel_affine | linear_3x3 | affine_3x4
+  /// Colour mapping of the rendered light to the camera (colormap/).
+  colormap::ColorMapMethod colormap = colormap::ColorMapMethod::Statistics;
+  colormap::PolynomialModel colormap_model = colormap::PolynomialModel::Affine3x4;  ///< sample mapping
   bool channel_swap = false;                  ///< sample mapping: add channel-permuted pairs
   bool video = true;                           ///< composite.mp4
   /// A window showing the final picture as it is made (live_view.h), with `view_side` (a buffer:
@@ -99,7 +115,7 @@ struct ReplayPipeline {
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".
-  std::string final_composite = "composite";
+  BufferName<ColorImage> final_composite = kComposite;
   app::ReportCollectorStage* report = nullptr;    ///< gathers report.html's pictures, materials, lights
   ReplayPipeline();
   ~ReplayPipeline();

@@ -28,8 +28,8 @@ ReportCollectorStage::ReportCollectorStage(std::int64_t total_frames, int rows, 
 
 void ReportCollectorStage::declare(StageBuilder& builder) {
   previews_.declare(builder);
-  if (!materials_name_.empty()) materials_ = builder.read<brdf::Materials>(materials_name_);
-  if (!lights_name_.empty()) lights_ = builder.read<LightSet>(lights_name_);
+  if (materials_name_) materials_ = builder.read(*materials_name_);
+  if (lights_name_) lights_ = builder.read(*lights_name_);
 }
 
 std::optional<std::size_t> ReportCollectorStage::row_for(std::int64_t frame) const {
@@ -47,8 +47,8 @@ std::optional<std::size_t> ReportCollectorStage::row_for(std::int64_t frame) con
 }
 
 void ReportCollectorStage::run(StageContext& context) {
-  if (!materials_name_.empty()) content_.materials = context.get(materials_).clusters;
-  if (!lights_name_.empty()) content_.lights = context.get(lights_);
+  if (materials_name_) content_.materials = context.get(materials_).clusters;
+  if (lights_name_) content_.lights = context.get(lights_);
   const auto row = row_for(context.frame_index());
   if (!row || previews_.empty()) return;
   ContactSheetRow pictures{context.frame_index(), {}};

@@ -22,9 +22,9 @@ class ReportCollectorStage final : public Stage {
   /// pictures are scaled to thumbnail_height (wide mosaics such as brdf_preview stay readable).
   ReportCollectorStage(std::int64_t total_frames, int rows = 4, int thumbnail_height = 110);
 
-  void add_picture(std::string buffer, BufferPreviews::Kind kind) { previews_.add(std::move(buffer), kind); }
-  void collect_materials(std::string buffer) { materials_name_ = std::move(buffer); }
-  void collect_lights(std::string buffer) { lights_name_ = std::move(buffer); }
+  void add_picture(PreviewBuffer buffer) { previews_.add(buffer); }
+  void collect_materials(BufferName<brdf::Materials> buffer) { materials_name_ = buffer; }
+  void collect_lights(BufferName<LightSet> buffer) { lights_name_ = buffer; }
 
   [[nodiscard]] std::string name() const override { return "report"; }
   [[nodiscard]] bool has_side_effects() const override { return true; }
@@ -42,8 +42,8 @@ class ReportCollectorStage final : public Stage {
   int rows_;
   int thumbnail_height_;
   BufferPreviews previews_;
-  std::string materials_name_;
-  std::string lights_name_;
+  std::optional<BufferName<brdf::Materials>> materials_name_;
+  std::optional<BufferName<LightSet>> lights_name_;
   Read<brdf::Materials> materials_;
   Read<LightSet> lights_;
   ReportContent content_;

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "option_values.h"
 #include "relight/core/error.h"
 #include "relight/core/progress.h"
 #include "relight/synth/sequence.h"
@@ -12,16 +13,21 @@ namespace relight::app {
 
 namespace {
 
+/// The Kinect v1's two sizes.
+enum class ImageSize { Vga, Qvga };
+constexpr std::array<NamedValue<ImageSize>, 2> kImageSizeNames{
+    {{"640x480", ImageSize::Vga}, {"320x240", ImageSize::Qvga}}};
+
 struct SynthCommandOptions {
   std::filesystem::path out;
   int frames = 30;
-  std::string trajectory = "orbit";
+  synth::Trajectory trajectory = synth::Trajectory::Orbit;
   std::uint64_t seed = 0;
-  std::string noise = "kinect1";
+  synth::NoiseModel noise = synth::NoiseModel::Kinect1;
   std::vector<double> white_balance{1.0, 1.0, 1.0};
   double exposure = 1.0;
   int threads = 0;
-  std::string size = "640x480";
+  ImageSize size = ImageSize::Vga;
   bool no_ground_truth = false;
   bool quiet = false;
 };
@@ -29,17 +35,15 @@ struct SynthCommandOptions {
 int run_synth(const SynthCommandOptions& command) {
   synth::SynthOptions options;
   options.frames = command.frames;
-  options.trajectory = synth::parse_trajectory(command.trajectory);
-  options.noise = synth::parse_noise(command.noise);
+  options.trajectory = command.trajectory;
+  options.noise = command.noise;
   options.seed = command.seed;
   options.color.gains = {command.white_balance[0], command.white_balance[1], command.white_balance[2]};
   options.color.exposure = command.exposure;
   options.threads = command.threads;
-  if (command.size == "320x240") {
+  if (command.size == ImageSize::Qvga) {
     options.width = 320;
     options.height = 240;
-  } else if (command.size != "640x480") {
-    throw Error("--size '" + command.size + "' is not 640x480 or 320x240");
   }
   options.ground_truth = !command.no_ground_truth;
 
@@ -63,14 +67,10 @@ void register_synth(CLI::App& app, Runners& runners) {
   synth->add_option("--out", options->out, "Output folder (TUM RGB-D layout + gt/, probe.hdr, scene.json)")
       ->required();
   synth->add_option("--frames", options->frames, "Number of frames")->check(CLI::Range(1, 100000))->capture_default_str();
-  synth->add_option("--trajectory", options->trajectory, "Camera path: static, orbit or handheld")
-      ->check(CLI::IsMember({"static", "orbit", "handheld"}))
-      ->capture_default_str();
+  add_choice_option(*synth, "--trajectory", options->trajectory, synth::kTrajectoryNames, "Camera path");
   synth->add_option("--seed", options->seed, "Random seed (noise, handheld path); same seed, same bytes")
       ->capture_default_str();
-  synth->add_option("--noise", options->noise, "Depth noise: kinect1 or none")
-      ->check(CLI::IsMember({"kinect1", "none"}))
-      ->capture_default_str();
+  add_choice_option(*synth, "--noise", options->noise, synth::kNoiseModelNames, "Depth noise");
   synth->add_option("--white-balance", options->white_balance, "Colour camera gains R,G,B")
       ->expected(3)
       ->delimiter(',')
@@ -78,10 +78,8 @@ void register_synth(CLI::App& app, Runners& runners) {
   synth->add_option("--exposure", options->exposure, "Colour camera exposure multiplier")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  synth->add_option("--size", options->size,
-                    "Image size: 640x480 (Kinect v1) or 320x240 (its QVGA mode, the intrinsics halved)")
-      ->check(CLI::IsMember({"640x480", "320x240"}))
-      ->capture_default_str();
+  add_choice_option(*synth, "--size", options->size, kImageSizeNames,
+                    "Image size: 640x480 (Kinect v1) or 320x240 (its QVGA mode, the intrinsics halved)");
   synth->add_option("--threads", options->threads, "Render threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   synth->add_flag("--no-gt", options->no_ground_truth, "Skip the gt/ folder");
   synth->add_flag("--quiet", options->quiet, "No progress or summary on stderr");

@@ -7,8 +7,8 @@
 
 namespace relight::app {
 
-VideoWriterStage::VideoWriterStage(std::filesystem::path path, std::string buffer, double fps)
-    : path_(std::move(path)), buffer_name_(std::move(buffer)), fps_(fps) {
+VideoWriterStage::VideoWriterStage(std::filesystem::path path, BufferName<ColorImage> buffer, double fps)
+    : path_(std::move(path)), buffer_name_(buffer), fps_(fps) {
   // The container comes from the extension, so the temporary name keeps ".mp4".
   partial_ = path_;
   partial_.replace_filename(path_.stem().string() + ".partial" + path_.extension().string());
@@ -22,7 +22,7 @@ VideoWriterStage::~VideoWriterStage() {
   }
 }
 
-void VideoWriterStage::declare(StageBuilder& builder) { buffer_ = builder.read<ColorImage>(buffer_name_); }
+void VideoWriterStage::declare(StageBuilder& builder) { buffer_ = builder.read(buffer_name_); }
 
 void VideoWriterStage::run(StageContext& context) {
   const ColorImage& image = context.get(buffer_);

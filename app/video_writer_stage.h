@@ -19,7 +19,7 @@ namespace relight::app {
 
 class VideoWriterStage final : public Stage {
  public:
-  VideoWriterStage(std::filesystem::path path, std::string buffer, double fps = 30.0);
+  VideoWriterStage(std::filesystem::path path, BufferName<ColorImage> buffer, double fps = 30.0);
   ~VideoWriterStage() override;
 
   [[nodiscard]] std::string name() const override { return "video_writer"; }
@@ -30,7 +30,7 @@ class VideoWriterStage final : public Stage {
 
  private:
   std::filesystem::path path_, partial_;
-  std::string buffer_name_;
+  BufferName<ColorImage> buffer_name_;
   double fps_;
   Read<ColorImage> buffer_;
   std::unique_ptr<cv::VideoWriter> writer_;

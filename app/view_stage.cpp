@@ -18,15 +18,15 @@ ColorImage side_by_side(const ColorImage& left, const ColorImage& right) {
 
 }  // namespace
 
-ViewStage::ViewStage(LiveView& view, std::string picture, std::string side, BufferPreviews::Kind side_kind)
-    : view_(view), picture_name_(std::move(picture)) {
-  if (!side.empty()) side_.add(std::move(side), side_kind);
+ViewStage::ViewStage(LiveView& view, BufferName<ColorImage> picture, std::optional<PreviewBuffer> side)
+    : view_(view), picture_name_(picture) {
+  if (side) side_.add(*side);
 }
 
 void ViewStage::declare(StageBuilder& builder) {
-  picture_ = builder.read<ColorImage>(picture_name_);
-  pose_ = builder.read<CameraPose>("camera_pose");
-  frame_ = builder.read<FrameInfo>("source_frame");
+  picture_ = builder.read(picture_name_);
+  pose_ = builder.read(kCameraPose);
+  frame_ = builder.read(kSourceFrame);
   side_.declare(builder);
 }
 

@@ -11,32 +11,35 @@
 #include <chrono>
 #include <deque>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "buffer_previews.h"
 #include "live_view.h"
 #include "option_values.h"
+#include "relight/capture/buffers.h"
 #include "relight/capture/camera_pose.h"
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/render/buffers.h"
 
 namespace relight::app {
 
 /// The buffers --view-side can show beside the picture, and how each is drawn.
-inline constexpr std::array<OptionValue<BufferPreviews::Kind>, 7> kViewSides{
-    {{"color", BufferPreviews::Kind::Color},
-     {"depth", BufferPreviews::Kind::Depth},
-     {"depth_smoothed", BufferPreviews::Kind::Depth},
-     {"depth_filtered", BufferPreviews::Kind::Depth},
-     {"normals", BufferPreviews::Kind::Normals},
-     {"composite", BufferPreviews::Kind::Color},
-     {"virtual_coverage", BufferPreviews::Kind::Coverage}}};
+inline constexpr std::array<NamedValue<PreviewBuffer>, 7> kViewSides{
+    {{kColor.name(), kColor},
+     {kDepth.name(), kDepth},
+     {kDepthSmoothed.name(), kDepthSmoothed},
+     {kDepthFiltered.name(), kDepthFiltered},
+     {kNormals.name(), kNormals},
+     {kComposite.name(), kComposite},
+     {render::kVirtualCoverage.name(), render::kVirtualCoverage}}};
 
 class ViewStage final : public Stage {
  public:
   /// `side`: empty, or a buffer and its kind shown right of the picture.
-  ViewStage(LiveView& view, std::string picture, std::string side = {},
-            BufferPreviews::Kind side_kind = BufferPreviews::Kind::Color);
+  ViewStage(LiveView& view, BufferName<ColorImage> picture, std::optional<PreviewBuffer> side = std::nullopt);
   [[nodiscard]] std::string name() const override { return "view"; }
   [[nodiscard]] bool has_side_effects() const override { return true; }
   void declare(StageBuilder& builder) override;
@@ -46,7 +49,7 @@ class ViewStage final : public Stage {
 
  private:
   LiveView& view_;
-  std::string picture_name_;
+  BufferName<ColorImage> picture_name_;
   BufferPreviews side_;
   std::function<std::int64_t()> dropped_;
   std::deque<std::chrono::steady_clock::time_point> recent_;  ///< the last frames' times, for fps

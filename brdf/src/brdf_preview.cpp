@@ -53,15 +53,15 @@ ColorImage brdf_preview(const ColorImage& color, const Mask& highlights, const R
 }
 
 void BrdfPreviewStage::declare(StageBuilder& builder) {
-  color_ = builder.read<ColorImage>(buffers_.color);
-  highlights_ = builder.read<Mask>(buffers_.highlight_mask);
-  kd_ = builder.read<RadianceImage>(buffers_.kd);
-  materials_ = builder.read<Materials>(buffers_.materials);
-  positions_ = builder.read<PositionMap>(buffers_.positions);
-  normals_ = builder.read<NormalMap>(buffers_.normals);
-  lights_ = builder.read<LightSet>(buffers_.lights);
-  frame_ = builder.read<FrameInfo>(buffers_.frame);
-  preview_ = builder.write<ColorImage>(output_name_);
+  color_ = builder.read(buffers_.color);
+  highlights_ = builder.read(buffers_.highlight_mask);
+  kd_ = builder.read(buffers_.kd);
+  materials_ = builder.read(buffers_.materials);
+  positions_ = builder.read(buffers_.positions);
+  normals_ = builder.read(buffers_.normals);
+  lights_ = builder.read(buffers_.lights);
+  frame_ = builder.read(buffers_.frame);
+  preview_ = builder.write(output_name_);
 }
 
 void BrdfPreviewStage::run(StageContext& context) {

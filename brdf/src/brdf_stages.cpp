@@ -123,9 +123,9 @@ RadianceImage render_materials(const Materials& materials, const PositionMap& po
 }
 
 void HighlightRemovalStage::declare(StageBuilder& builder) {
-  color_ = builder.read<ColorImage>(buffers_.color);
-  cleaned_ = builder.write<ColorImage>(buffers_.color_diffuse);
-  mask_ = builder.write<Mask>(buffers_.highlight_mask);
+  color_ = builder.read(buffers_.color);
+  cleaned_ = builder.write(buffers_.color_diffuse);
+  mask_ = builder.write(buffers_.highlight_mask);
 }
 
 void HighlightRemovalStage::run(StageContext& context) {
@@ -133,13 +133,13 @@ void HighlightRemovalStage::run(StageContext& context) {
 }
 
 void DiffuseStage::declare(StageBuilder& builder) {
-  color_ = builder.read<ColorImage>(buffers_.color_diffuse);
-  positions_ = builder.read<PositionMap>(buffers_.positions);
-  normals_ = builder.read<NormalMap>(buffers_.normals);
-  lights_ = builder.read<LightSet>(buffers_.lights);
-  frame_ = builder.read<FrameInfo>(buffers_.frame);
-  kd_ = builder.write<RadianceImage>(buffers_.kd);
-  valid_ = builder.write<Mask>(buffers_.kd_valid);
+  color_ = builder.read(buffers_.color_diffuse);
+  positions_ = builder.read(buffers_.positions);
+  normals_ = builder.read(buffers_.normals);
+  lights_ = builder.read(buffers_.lights);
+  frame_ = builder.read(buffers_.frame);
+  kd_ = builder.write(buffers_.kd);
+  valid_ = builder.write(buffers_.kd_valid);
 }
 
 void DiffuseStage::run(StageContext& context) {
@@ -159,9 +159,9 @@ KMeansStage::KMeansStage(vk::VulkanContext& context, KMeansOptions options, std:
 KMeansStage::~KMeansStage() = default;
 
 void KMeansStage::declare(StageBuilder& builder) {
-  kd_ = builder.read<RadianceImage>(buffers_.kd);
-  valid_ = builder.read<Mask>(buffers_.kd_valid);
-  clusters_ = builder.write<Materials>(buffers_.clusters);
+  kd_ = builder.read(buffers_.kd);
+  valid_ = builder.read(buffers_.kd_valid);
+  clusters_ = builder.write(buffers_.clusters);
 }
 
 void KMeansStage::run(StageContext& context) {
@@ -184,14 +184,14 @@ SpecularFitStage::SpecularFitStage(vk::VulkanContext& context, BrdfOptions optio
 SpecularFitStage::~SpecularFitStage() = default;
 
 void SpecularFitStage::declare(StageBuilder& builder) {
-  clusters_ = builder.read<Materials>(buffers_.clusters);
-  color_ = builder.read<ColorImage>(buffers_.color);
-  highlights_ = builder.read<Mask>(buffers_.highlight_mask);
-  positions_ = builder.read<PositionMap>(buffers_.positions);
-  normals_ = builder.read<NormalMap>(buffers_.normals);
-  lights_ = builder.read<LightSet>(buffers_.lights);
-  frame_ = builder.read<FrameInfo>(buffers_.frame);
-  materials_ = builder.write<Materials>(buffers_.materials);
+  clusters_ = builder.read(buffers_.clusters);
+  color_ = builder.read(buffers_.color);
+  highlights_ = builder.read(buffers_.highlight_mask);
+  positions_ = builder.read(buffers_.positions);
+  normals_ = builder.read(buffers_.normals);
+  lights_ = builder.read(buffers_.lights);
+  frame_ = builder.read(buffers_.frame);
+  materials_ = builder.write(buffers_.materials);
 }
 
 void SpecularFitStage::run(StageContext& context) {

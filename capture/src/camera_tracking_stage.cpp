@@ -2,28 +2,12 @@
 
 #include <algorithm>
 
+#include "relight/capture/buffers.h"
 #include "relight/capture/support_plane.h"
+#include "relight/core/buffers.h"
 #include "relight/core/error.h"
 
 namespace relight {
-
-const char* to_string(PoseSource source) {
-  switch (source) {
-    case PoseSource::Sequence: return "sequence";
-    case PoseSource::Marker: return "marker";
-    case PoseSource::Odometry: return "odometry";
-    case PoseSource::MarkerOdometry: return "marker+odometry";
-  }
-  return "?";
-}
-
-std::optional<PoseSource> parse_pose_source(const std::string& text) {
-  for (const PoseSource source :
-       {PoseSource::Sequence, PoseSource::Marker, PoseSource::Odometry, PoseSource::MarkerOdometry}) {
-    if (text == to_string(source)) return source;
-  }
-  return std::nullopt;
-}
 
 namespace {
 
@@ -56,16 +40,16 @@ PoseSource CameraTrackingStage::resolve(const FrameInfo& first) const {
 }
 
 void CameraTrackingStage::declare(StageBuilder& builder) {
-  source_frame_ = builder.read<FrameInfo>("source_frame");
+  source_frame_ = builder.read(kSourceFrame);
   if (!options_.source || *options_.source == PoseSource::Odometry || *options_.source == PoseSource::MarkerOdometry) {
-    depth_ = builder.read<DepthMap>("depth");
-    color_ = builder.read<ColorImage>("color");
+    depth_ = builder.read(kDepth);
+    color_ = builder.read(kColor);
   }
   if (options_.has_marker_layout && (!options_.source || uses_marker(*options_.source))) {
-    marker_ = builder.read<CameraPose>("marker_pose");
+    marker_ = builder.read(kMarkerPose);
   }
-  frame_ = builder.write<FrameInfo>("frame");
-  pose_ = builder.write<CameraPose>("camera_pose");
+  frame_ = builder.write(kFrame);
+  pose_ = builder.write(kCameraPose);
 }
 
 CameraPose CameraTrackingStage::track_odometry(const FrameInfo& frame, const DepthMap& depth, const ColorImage& color,

@@ -1,4 +1,6 @@
 #include "relight/capture/marker_pose.h"
+#include "relight/capture/buffers.h"
+#include "relight/core/buffers.h"
 
 #include <algorithm>
 #include <cmath>
@@ -131,10 +133,10 @@ MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetect
 }
 
 void MarkerPoseStage::declare(StageBuilder& builder) {
-  color_ = builder.read<ColorImage>("color");
-  depth_ = builder.read<DepthMap>("depth");
-  frame_ = builder.read<FrameInfo>(frame_buffer_);
-  pose_ = builder.write<CameraPose>("marker_pose");
+  color_ = builder.read(kColor);
+  depth_ = builder.read(kDepth);
+  frame_ = builder.read(frame_buffer_);
+  pose_ = builder.write(kMarkerPose);
 }
 
 void MarkerPoseStage::run(StageContext& context) {

@@ -1,13 +1,14 @@
 #include "relight/capture/source_stage.h"
+#include "relight/core/buffers.h"
 
 #include <chrono>
 
 namespace relight {
 
 void SourceStage::declare(StageBuilder& builder) {
-  color_ = builder.write<ColorImage>("color");
-  depth_ = builder.write<DepthMap>("depth");
-  frame_ = builder.write<FrameInfo>(frame_buffer_);
+  color_ = builder.write(kColor);
+  depth_ = builder.write(kDepth);
+  frame_ = builder.write(frame_buffer_);
 }
 
 void SourceStage::run(StageContext& context) {

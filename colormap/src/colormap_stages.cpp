@@ -14,8 +14,7 @@ struct Inputs {
 };
 
 Inputs declare_inputs(StageBuilder& builder, const ColorMapBuffers& buffers) {
-  return {builder.read<RadianceImage>(buffers.real), builder.read<RadianceImage>(buffers.real_virtual),
-          builder.read<ColorImage>(buffers.camera)};
+  return {builder.read(buffers.real), builder.read(buffers.real_virtual), builder.read(buffers.camera)};
 }
 
 }  // namespace
@@ -28,8 +27,8 @@ void StatisticsColorMapCpuStage::declare(StageBuilder& builder) {
   real_ = inputs.real;
   real_virtual_ = inputs.real_virtual;
   camera_ = inputs.camera;
-  delta_ = builder.write<RadianceImage>(buffers_.delta);
-  mapping_ = builder.write<ColorMapping>(buffers_.mapping);
+  delta_ = builder.write(buffers_.delta);
+  mapping_ = builder.write(buffers_.mapping);
 }
 
 void StatisticsColorMapCpuStage::run(StageContext& context) {
@@ -48,8 +47,8 @@ void StatisticsColorMapVkStage::declare(StageBuilder& builder) {
   real_ = inputs.real;
   real_virtual_ = inputs.real_virtual;
   camera_ = inputs.camera;
-  delta_ = builder.write<RadianceImage>(buffers_.delta);
-  mapping_ = builder.write<ColorMapping>(buffers_.mapping);
+  delta_ = builder.write(buffers_.delta);
+  mapping_ = builder.write(buffers_.mapping);
 }
 
 void StatisticsColorMapVkStage::run(StageContext& context) {
@@ -75,8 +74,8 @@ void SampleColorMapStage::declare(StageBuilder& builder) {
   real_ = inputs.real;
   real_virtual_ = inputs.real_virtual;
   camera_ = inputs.camera;
-  delta_ = builder.write<RadianceImage>(buffers_.delta);
-  mapping_ = builder.write<ColorMapping>(buffers_.mapping);
+  delta_ = builder.write(buffers_.delta);
+  mapping_ = builder.write(buffers_.mapping);
 }
 
 void SampleColorMapStage::run(StageContext& context) {
@@ -89,10 +88,10 @@ IdentityColorMapStage::IdentityColorMapStage(ToneMap tm, ColorMapBuffers buffers
     : tm_(tm), buffers_(std::move(buffers)) {}
 
 void IdentityColorMapStage::declare(StageBuilder& builder) {
-  real_ = builder.read<RadianceImage>(buffers_.real);
-  real_virtual_ = builder.read<RadianceImage>(buffers_.real_virtual);
-  delta_ = builder.write<RadianceImage>(buffers_.delta);
-  mapping_ = builder.write<ColorMapping>(buffers_.mapping);
+  real_ = builder.read(buffers_.real);
+  real_virtual_ = builder.read(buffers_.real_virtual);
+  delta_ = builder.write(buffers_.delta);
+  mapping_ = builder.write(buffers_.mapping);
 }
 
 void IdentityColorMapStage::run(StageContext& context) {
@@ -101,9 +100,9 @@ void IdentityColorMapStage::run(StageContext& context) {
 }
 
 void ColorMapCompositeStage::declare(StageBuilder& builder) {
-  camera_ = builder.read<ColorImage>(buffers_.camera);
-  delta_ = builder.read<RadianceImage>(buffers_.delta);
-  mapped_ = builder.write<ColorImage>(buffers_.mapped);
+  camera_ = builder.read(buffers_.camera);
+  delta_ = builder.read(buffers_.delta);
+  mapped_ = builder.write(buffers_.mapped);
 }
 
 void ColorMapCompositeStage::run(StageContext& context) {

@@ -96,15 +96,6 @@ void store_row(ColorMatrix& a, const Eigen::VectorXd& w, PolynomialModel model, 
 
 }  // namespace
 
-const char* to_string(PolynomialModel model) {
-  switch (model) {
-    case PolynomialModel::PerChannelAffine: return "per_channel_affine";
-    case PolynomialModel::Linear3x3: return "linear_3x3";
-    case PolynomialModel::Affine3x4: return "affine_3x4";
-  }
-  return "?";
-}
-
 ColorMatrix identity_color_matrix() {
   ColorMatrix a = ColorMatrix::Zero();
   a.leftCols<3>().setIdentity();

@@ -6,11 +6,8 @@
 namespace relight {
 
 std::optional<PinholeIntrinsics> PinholeIntrinsics::preset(std::string_view name) {
-  // TUM RGB-D colour camera calibrations (cvg.cit.tum.de, "file formats" page).
-  if (name == "kinect" || name == "default") return kinect_v1();
-  if (name == "fr1" || name == "freiburg1") return PinholeIntrinsics{517.3, 516.5, 318.6, 255.3, 640, 480};
-  if (name == "fr2" || name == "freiburg2") return PinholeIntrinsics{520.9, 521.0, 325.1, 249.7, 640, 480};
-  if (name == "fr3" || name == "freiburg3") return PinholeIntrinsics{535.4, 539.2, 320.1, 247.6, 640, 480};
+  for (const auto& entry : kIntrinsicsPresets)
+    if (entry.name == name) return entry.value;
   return std::nullopt;
 }
 

@@ -27,9 +27,9 @@ LightSet smooth_lights(const LightSet& current, const LightSet* previous, const 
 }
 
 void LightSmoothingStage::declare(StageBuilder& builder) {
-  input_ = builder.read<LightSet>(buffers_.input);
-  previous_ = builder.read_previous<LightSet>(buffers_.output);
-  output_ = builder.write<LightSet>(buffers_.output);
+  input_ = builder.read(buffers_.input);
+  previous_ = builder.read_previous(buffers_.output);
+  output_ = builder.write(buffers_.output);
 }
 
 void LightSmoothingStage::run(StageContext& context) {

@@ -4,12 +4,6 @@
 
 namespace relight {
 
-LightMethod parse_light_method(const std::string& text) {
-  if (text == "importance") return LightMethod::Importance;
-  if (text == "median-cut") return LightMethod::MedianCut;
-  throw Error("unknown light extraction method '" + text + "' (expected importance or median-cut)");
-}
-
 LightExtractionStage::LightExtractionStage(LightExtractionOptions options, LightExtractionBuffers buffers,
                                            vk::VulkanContext* context)
     : options_(std::move(options)), buffers_(std::move(buffers)), context_(context) {
@@ -21,8 +15,8 @@ LightExtractionStage::LightExtractionStage(LightExtractionOptions options, Light
 LightExtractionStage::~LightExtractionStage() = default;
 
 void LightExtractionStage::declare(StageBuilder& builder) {
-  probe_ = builder.read<RadianceImage>(buffers_.probe);
-  lights_ = builder.write<LightSet>(buffers_.lights);
+  probe_ = builder.read(buffers_.probe);
+  lights_ = builder.write(buffers_.lights);
 }
 
 void LightExtractionStage::run(StageContext& context) {

@@ -1,10 +1,11 @@
 // Vulkan implementation of positions + cross-product normals (definition in
 // normals_from_positions.h, API in cross_normals_vk.h): one invocation per pixel,
 // shaders/cross_normals.comp, embedded at build time.
+#include "relight/reconstruct/cross_normals_vk.h"
+#include "relight/core/buffers.h"
 #include "relight/core/error.h"
 #include "relight/core/pixel.h"
 #include "relight/reconstruct/cross_normals_shared.h"
-#include "relight/reconstruct/cross_normals_vk.h"
 #include "relight/shaders/cross_normals_comp.h"
 #include "relight/vk/buffer.h"
 #include "relight/vk/compute_pipeline.h"
@@ -82,10 +83,10 @@ void CrossNormalsVk::run(const DepthMap& depth, const PinholeIntrinsics& intrins
 }
 
 void NormalsFromPositionsVkStage::declare(StageBuilder& builder) {
-  depth_ = builder.read<DepthMap>("depth_filtered");
-  frame_ = builder.read<FrameInfo>("frame");
-  positions_ = builder.write<PositionMap>("positions");
-  normals_ = builder.write<NormalMap>("normals");
+  depth_ = builder.read(kDepthFiltered);
+  frame_ = builder.read(kFrame);
+  positions_ = builder.write(kPositions);
+  normals_ = builder.write(kNormals);
 }
 
 void NormalsFromPositionsVkStage::run(StageContext& context) {

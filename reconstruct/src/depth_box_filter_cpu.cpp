@@ -45,8 +45,8 @@ DepthMap depth_box_filter(const DepthMap& depth) {
 }
 
 void DepthBoxFilterCpuStage::declare(StageBuilder& builder) {
-  input_ = builder.read<DepthMap>(buffers_.input);
-  output_ = builder.write<DepthMap>(buffers_.output);
+  input_ = builder.read(buffers_.input);
+  output_ = builder.write(buffers_.output);
 }
 
 void DepthBoxFilterCpuStage::run(StageContext& context) {

@@ -65,8 +65,8 @@ DepthBoxFilterVkStage::DepthBoxFilterVkStage(vk::VulkanContext& context, DepthBo
     : filter_(context), buffers_(std::move(buffers)) {}
 
 void DepthBoxFilterVkStage::declare(StageBuilder& builder) {
-  input_ = builder.read<DepthMap>(buffers_.input);
-  output_ = builder.write<DepthMap>(buffers_.output);
+  input_ = builder.read(buffers_.input);
+  output_ = builder.write(buffers_.output);
 }
 
 void DepthBoxFilterVkStage::run(StageContext& context) {

@@ -11,7 +11,9 @@
 #include <immintrin.h>
 #endif
 
+#include "relight/core/buffers.h"
 #include "relight/core/parallel.h"
+#include "relight/reconstruct/buffers.h"
 #include "relight/reconstruct/depth_warp_merge.h"
 
 namespace relight {
@@ -541,13 +543,13 @@ void merge_depth(const DepthMap& depth, const DepthMap& warped, const DepthWeigh
 }
 
 void DepthWarpMergeStageBase::declare(StageBuilder& builder) {
-  depth_ = builder.read<DepthMap>("depth");
-  frame_ = builder.read<FrameInfo>("frame");
-  previous_depth_ = builder.read_previous<DepthMap>("depth_filtered");
-  previous_weight_ = builder.read_previous<DepthWeightMap>("depth_weight");
-  previous_frame_ = builder.read_previous<FrameInfo>("frame");
-  filtered_ = builder.write<DepthMap>("depth_filtered");
-  weight_ = builder.write<DepthWeightMap>("depth_weight");
+  depth_ = builder.read(kDepth);
+  frame_ = builder.read(kFrame);
+  previous_depth_ = builder.read_previous(kDepthFiltered);
+  previous_weight_ = builder.read_previous(kDepthWeight);
+  previous_frame_ = builder.read_previous(kFrame);
+  filtered_ = builder.write(kDepthFiltered);
+  weight_ = builder.write(kDepthWeight);
 }
 
 void DepthWarpMergeStageBase::run(StageContext& context) {

@@ -181,10 +181,10 @@ void normals_from_positions(const PositionMap& positions, NormalMap& normals, co
 }
 
 void NormalsFromPositionsCpuStage::declare(StageBuilder& builder) {
-  depth_ = builder.read<DepthMap>(buffers_.depth);
-  frame_ = builder.read<FrameInfo>(buffers_.frame);
-  positions_ = builder.write<PositionMap>(buffers_.positions);
-  normals_ = builder.write<NormalMap>(buffers_.normals);
+  depth_ = builder.read(buffers_.depth);
+  frame_ = builder.read(buffers_.frame);
+  positions_ = builder.write(buffers_.positions);
+  normals_ = builder.write(buffers_.normals);
 }
 
 void NormalsFromPositionsCpuStage::run(StageContext& context) {

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "normals_raw_depth_kernels.h"
+#include "relight/core/buffers.h"
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
 #include "relight/reconstruct/normals_raw_depth.h"
@@ -329,13 +330,13 @@ std::string NormalsRawDepthStageBase::name() const {
 }
 
 void NormalsRawDepthStageBase::declare(StageBuilder& builder) {
-  depth_ = builder.read<DepthMap>(input_ == NormalsDepthInput::Raw ? "depth" : "depth_filtered");
-  frame_ = builder.read<FrameInfo>("frame");
-  previous_normals_ = builder.read_previous<NormalMap>("normals");
-  previous_positions_ = builder.read_previous<PositionMap>("positions");
-  previous_frame_ = builder.read_previous<FrameInfo>("frame");
-  positions_ = builder.write<PositionMap>("positions");
-  normals_ = builder.write<NormalMap>("normals");
+  depth_ = builder.read(input_ == NormalsDepthInput::Raw ? kDepth : kDepthFiltered);
+  frame_ = builder.read(kFrame);
+  previous_normals_ = builder.read_previous(kNormals);
+  previous_positions_ = builder.read_previous(kPositions);
+  previous_frame_ = builder.read_previous(kFrame);
+  positions_ = builder.write(kPositions);
+  normals_ = builder.write(kNormals);
 }
 
 void NormalsRawDepthStageBase::run(StageContext& context) {

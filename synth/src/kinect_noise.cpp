@@ -74,14 +74,6 @@ float noisy_pixel(const DepthMap& depth, const NormalMap& normals, const Pinhole
 
 }  // namespace
 
-NoiseModel parse_noise(const std::string& name) {
-  if (name == "none") return NoiseModel::None;
-  if (name == "kinect1") return NoiseModel::Kinect1;
-  throw Error("unknown noise model '" + name + "' (expected none or kinect1)");
-}
-
-const char* to_string(NoiseModel model) { return model == NoiseModel::None ? "none" : "kinect1"; }
-
 double kinect_axial_sigma(double z) { return 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4); }
 
 double quantise_depth(double z, const KinectNoiseOptions& options) {

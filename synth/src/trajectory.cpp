@@ -67,22 +67,6 @@ std::vector<Pose> handheld(int frames, std::uint64_t seed, const Scene& scene) {
 
 }  // namespace
 
-Trajectory parse_trajectory(const std::string& name) {
-  if (name == "static") return Trajectory::Static;
-  if (name == "orbit") return Trajectory::Orbit;
-  if (name == "handheld") return Trajectory::Handheld;
-  throw Error("unknown trajectory '" + name + "' (expected static, orbit or handheld)");
-}
-
-const char* to_string(Trajectory trajectory) {
-  switch (trajectory) {
-    case Trajectory::Static: return "static";
-    case Trajectory::Orbit: return "orbit";
-    case Trajectory::Handheld: return "handheld";
-  }
-  return "unknown";
-}
-
 Timestamp frame_timestamp(int index) { return 1.0 + index / kFps; }
 
 Pose look_at(const Vector3d& eye, const Vector3d& target, const Vector3d& up) {

@@ -99,6 +99,8 @@ TEST(Cli, LoopPlaysTheRangeAgainAndReportsPeakMemory) {
   EXPECT_NE(report["sequence"].get<std::string>().find("played 3 times"), std::string::npos);
   EXPECT_GT(report["peak_rss_mb"].get<double>(), 1.0);
   expect_one_line_error(relight("replay --quiet --loop 0 --out " + dir.path().string()), 2);
+  // A value outside an option's choices is a usage error, like every other bad choice.
+  expect_one_line_error(relight("replay --intrinsics fr9 --out " + dir.path().string()), 2);
 }
 
 TEST(Cli, BadInputGivesOneLineAndExitCodeOne) {
@@ -106,7 +108,6 @@ TEST(Cli, BadInputGivesOneLineAndExitCodeOne) {
   expect_one_line_error(relight("replay /no/such/folder --out " + dir.path().string()), 1);
   expect_one_line_error(relight("replay --frames 3:1 --out " + dir.path().string()), 1);
   expect_one_line_error(relight("replay --frames x --out " + dir.path().string()), 1);
-  expect_one_line_error(relight("replay --intrinsics fr9 --out " + dir.path().string()), 1);
 }
 
 TEST(Cli, CorruptFrameMidSequenceFailsCleanlyWithoutPartialFiles) {
@@ -140,7 +141,8 @@ TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
     EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0);
   }
   EXPECT_TRUE(found);
-  expect_one_line_error(relight("replay --backend quantum --out " + dir.path().string()), 1);
+  // Outside the option's choices: a usage error, as for every option with a fixed set of values.
+  expect_one_line_error(relight("replay --backend quantum --out " + dir.path().string()), 2);
 }
 
 // The geometry stages follow the per-pixel backend: with --backend vulkan both methods (and

@@ -6,6 +6,8 @@
 
 #include "constant_stage.h"
 #include "html_report.h"
+#include "relight/core/buffers.h"
+#include "relight/lights/buffers.h"
 #include "report_collector_stage.h"
 
 namespace relight::app {
@@ -72,10 +74,10 @@ ReportContent collect(std::int64_t frames, std::int64_t announced_total) {
   graph.emplace<CountingPictureStage>(frames);
   LightSet lights;
   lights.lights.push_back(directional_light(Eigen::Vector3d::UnitZ(), {1, 0.5, 0.25}));
-  graph.emplace<ConstantStage<LightSet>>("lights", lights);
+  graph.emplace<ConstantStage<LightSet>>(kLights, lights);
   auto stage = std::make_unique<ReportCollectorStage>(announced_total, 4, 16);
-  stage->add_picture("color", BufferPreviews::Kind::Color);  // before the stage joins the graph
-  stage->collect_lights("lights");
+  stage->add_picture(kColor);  // before the stage joins the graph
+  stage->collect_lights(kLights);
   const ReportCollectorStage& collector = *stage;
   graph.add(std::move(stage));
   graph.compile();

@@ -337,8 +337,10 @@ TEST(CameraTrackingStage, SequenceWithoutPosesAndMarkerWithoutLayoutAreErrors) {
   CameraTrackingOptions marker;
   marker.source = PoseSource::Marker;
   EXPECT_THROW(CameraTrackingStage{marker}, Error);
-  EXPECT_EQ(parse_pose_source("marker+odometry"), PoseSource::MarkerOdometry);
-  EXPECT_FALSE(parse_pose_source("gps").has_value());
+  EXPECT_EQ(parse_named(kPoseSourceNames, "--pose", "marker+odometry"), PoseSource::MarkerOdometry);
+  EXPECT_EQ(parse_named(kPoseSourceNames, "--pose", "auto"), std::nullopt);
+  EXPECT_THROW((void)parse_named(kPoseSourceNames, "--pose", "gps"), Error);
+  EXPECT_STREQ(to_string(PoseSource::MarkerOdometry), "marker+odometry");
 }
 
 }  // namespace

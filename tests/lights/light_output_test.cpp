@@ -8,9 +8,12 @@ namespace relight {
 namespace {
 
 TEST(LightOutput, JsonRoundTripKeepsEveryLight) {
+  // Every vector spelled out: `{}` would value-initialise an Eigen vector to garbage (Eigen's
+  // default constructor leaves it uninitialised), not to the member's default.
   LightSet set;
-  set.lights.push_back({LightKind::Directional, Eigen::Vector3d(0, 0.6, 0.8), {}, {1.5, 1.2, 0.9}, true});
-  set.lights.push_back({LightKind::Point, {}, {0.5, -0.2, 2.0}, {3, 3, 3}, false});
+  set.lights.push_back(
+      {LightKind::Directional, Eigen::Vector3d(0, 0.6, 0.8), Eigen::Vector3d::Zero(), {1.5, 1.2, 0.9}, true});
+  set.lights.push_back({LightKind::Point, Eigen::Vector3d::UnitZ(), {0.5, -0.2, 2.0}, {3, 3, 3}, false});
   const LightSet back = lights_from_json(lights_to_json(set), "test");
   ASSERT_EQ(back.lights.size(), 2u);
   EXPECT_EQ(back.lights[0].kind, LightKind::Directional);

@@ -18,20 +18,4 @@ Backend choose_backend(StageKind kind, const VulkanContext* context, BackendPoli
   return Backend::Vulkan;
 }
 
-std::optional<BackendPolicy> parse_backend_policy(std::string_view text) {
-  if (text == "auto") return BackendPolicy::Auto;
-  if (text == "cpu") return BackendPolicy::ForceCpu;
-  if (text == "vulkan") return BackendPolicy::ForceVulkan;
-  return std::nullopt;
-}
-
-const char* to_string(BackendPolicy policy) {
-  switch (policy) {
-    case BackendPolicy::Auto: return "auto";
-    case BackendPolicy::ForceCpu: return "cpu";
-    case BackendPolicy::ForceVulkan: return "vulkan";
-  }
-  return "auto";
-}
-
 }  // namespace relight::vk

@@ -44,7 +44,7 @@ void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneConte
                     const DirStageOptions& options) {
   graph.emplace<MrSceneStage>(std::move(content), options);
   graph.emplace<VplStage>(options.vpls, context);
-  graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffer);
+  graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffers);
   graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
   graph.emplace<DifferentialCompositeStage>(options.tone_map);
 }
@@ -59,17 +59,17 @@ MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& optio
       placements_buffer_(options.placements_buffer) {}
 
 void MrSceneStage::declare(StageBuilder& builder) {
-  frame_ = builder.read<FrameInfo>("frame");
-  positions_ = builder.read<PositionMap>("positions");
-  normals_ = builder.read<NormalMap>("normals");
-  if (!materials_buffer_.empty()) materials_ = builder.read<brdf::Materials>(materials_buffer_);
-  if (!placements_buffer_.empty()) placements_ = builder.read<ObjectPlacements>(placements_buffer_);
-  scene_ = builder.write<MrScene>("mr_scene");
+  frame_ = builder.read(kFrame);
+  positions_ = builder.read(kPositions);
+  normals_ = builder.read(kNormals);
+  if (materials_buffer_) materials_ = builder.read(*materials_buffer_);
+  if (placements_buffer_) placements_ = builder.read(*placements_buffer_);
+  scene_ = builder.write(kMrScene);
 }
 
 void MrSceneStage::run(StageContext& context) {
   const PositionMap& positions = context.get(positions_);
-  const brdf::Materials* cluster_materials = materials_buffer_.empty() ? nullptr : &context.get(materials_);
+  const brdf::Materials* cluster_materials = materials_buffer_ ? &context.get(materials_) : nullptr;
   MrScene& scene = context.get(scene_);
   scene = MrScene{};
   DepthMeshMaterials materials;
@@ -83,7 +83,7 @@ void MrSceneStage::run(StageContext& context) {
   mesh.name = "reconstruction";
   scene.meshes.push_back(std::move(mesh));
   scene.lights = content_.lights;
-  if (placements_buffer_.empty()) {
+  if (!placements_buffer_) {
     for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
     return;
   }
@@ -108,9 +108,9 @@ VplStage::VplStage(VplOptions options, vk::VulkanContext* context) : options_(st
 VplStage::~VplStage() = default;
 
 void VplStage::declare(StageBuilder& builder) {
-  scene_ = builder.read<MrScene>("mr_scene");
-  if (options_.budget == VplBudget::ByPreviousFlux) previous_ = builder.read_previous<VplSet>("vpls");
-  vpls_ = builder.write<VplSet>("vpls");
+  scene_ = builder.read(kMrScene);
+  if (options_.budget == VplBudget::ByPreviousFlux) previous_ = builder.read_previous(kVpls);
+  vpls_ = builder.write(kVpls);
 }
 
 void VplStage::run(StageContext& context) {
@@ -127,23 +127,24 @@ void VplStage::run(StageContext& context) {
 
 // ---- dir ---------------------------------------------------------------------------------------
 
-DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirRenderOptions options, std::string albedo_buffer)
-    : context_(context), options_(std::move(options)), albedo_buffer_(std::move(albedo_buffer)) {}
+DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirRenderOptions options,
+                               std::optional<RealAlbedoBuffers> albedo_buffers)
+    : context_(context), options_(options), albedo_buffers_(albedo_buffers) {}
 
 DirRenderStage::~DirRenderStage() = default;
 
 void DirRenderStage::declare(StageBuilder& builder) {
-  frame_ = builder.read<FrameInfo>("frame");
-  color_ = builder.read<ColorImage>("color");
-  positions_ = builder.read<PositionMap>("positions");
-  scene_ = builder.read<MrScene>("mr_scene");
-  vpls_ = builder.read<VplSet>("vpls");
-  if (!albedo_buffer_.empty()) {
-    albedo_ = builder.read<RadianceImage>(albedo_buffer_);
-    albedo_valid_ = builder.read<Mask>(albedo_buffer_ + "_valid");
+  frame_ = builder.read(kFrame);
+  color_ = builder.read(kColor);
+  positions_ = builder.read(kPositions);
+  scene_ = builder.read(kMrScene);
+  vpls_ = builder.read(kVpls);
+  if (albedo_buffers_) {
+    albedo_ = builder.read(albedo_buffers_->albedo);
+    albedo_valid_ = builder.read(albedo_buffers_->valid);
   }
-  images_ = builder.write<DifferentialImages>("dir_images");
-  gbuffer_ = builder.write<GBuffer>("dir_gbuffer");
+  images_ = builder.write(kDirImages);
+  gbuffer_ = builder.write(kDirGBuffer);
 }
 
 void DirRenderStage::run(StageContext& context) {
@@ -170,7 +171,7 @@ void DirRenderStage::run(StageContext& context) {
     images = renderer_->render(camera, vpls, options_);
     gbuffer = renderer_->last_gbuffer();
   }
-  if (!albedo_buffer_.empty()) {
+  if (albedo_buffers_) {
     modulate_camera_albedo(images, gbuffer, scene, context.get(albedo_), context.get(albedo_valid_));
   }
 }
@@ -178,13 +179,13 @@ void DirRenderStage::run(StageContext& context) {
 // ---- indirect_smoothing ------------------------------------------------------------------------
 
 void IndirectSmoothingStage::declare(StageBuilder& builder) {
-  images_ = builder.read<DifferentialImages>("dir_images");
-  gbuffer_ = builder.read<GBuffer>("dir_gbuffer");
-  frame_ = builder.read<FrameInfo>("frame");
-  real_virtual_ = builder.write<RadianceImage>("L_rv");
-  real_ = builder.write<RadianceImage>("L_r");
-  indirect_ = builder.write<RadianceImage>("L_rv_indirect");
-  coverage_ = builder.write<CoverageImage>("virtual_coverage");
+  images_ = builder.read(kDirImages);
+  gbuffer_ = builder.read(kDirGBuffer);
+  frame_ = builder.read(kFrame);
+  real_virtual_ = builder.write(kRealVirtualRadiance);
+  real_ = builder.write(kRealRadiance);
+  indirect_ = builder.write(kRealVirtualIndirect);
+  coverage_ = builder.write(kVirtualCoverage);
 }
 
 void IndirectSmoothingStage::run(StageContext& context) {
@@ -202,11 +203,11 @@ void IndirectSmoothingStage::run(StageContext& context) {
 // ---- differential_composite --------------------------------------------------------------------
 
 void DifferentialCompositeStage::declare(StageBuilder& builder) {
-  color_ = builder.read<ColorImage>("color");
-  real_virtual_ = builder.read<RadianceImage>("L_rv");
-  real_ = builder.read<RadianceImage>("L_r");
-  coverage_ = builder.read<CoverageImage>("virtual_coverage");
-  composite_ = builder.write<ColorImage>("composite");
+  color_ = builder.read(kColor);
+  real_virtual_ = builder.read(kRealVirtualRadiance);
+  real_ = builder.read(kRealRadiance);
+  coverage_ = builder.read(kVirtualCoverage);
+  composite_ = builder.write(kComposite);
 }
 
 void DifferentialCompositeStage::run(StageContext& context) {

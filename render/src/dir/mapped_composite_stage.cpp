@@ -1,16 +1,19 @@
 #include "relight/render/dir/mapped_composite_stage.h"
 
+#include "relight/colormap/buffers.h"
+#include "relight/core/buffers.h"
+#include "relight/render/buffers.h"
 #include "relight/render/dir/composite.h"
 
 namespace relight::render {
 
 void MappedCompositeStage::declare(StageBuilder& builder) {
-  camera_ = builder.read<ColorImage>("color");
-  delta_ = builder.read<RadianceImage>("delta_L");
-  real_virtual_ = builder.read<RadianceImage>("L_rv");
-  coverage_ = builder.read<CoverageImage>("virtual_coverage");
-  mapping_ = builder.read<colormap::ColorMapping>("color_mapping");
-  composite_ = builder.write<ColorImage>("composite_mapped");
+  camera_ = builder.read(kColor);
+  delta_ = builder.read(kDeltaRadiance);
+  real_virtual_ = builder.read(kRealVirtualRadiance);
+  coverage_ = builder.read(kVirtualCoverage);
+  mapping_ = builder.read(colormap::kColorMapping);
+  composite_ = builder.write(kCompositeMapped);
 }
 
 void MappedCompositeStage::run(StageContext& context) {

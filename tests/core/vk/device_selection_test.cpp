@@ -68,10 +68,10 @@ TEST(BackendPolicy, WithoutDeviceEverythingRunsOnCpuUnlessVulkanIsForced) {
 }
 
 TEST(BackendPolicy, ParsesCommandLineSpellings) {
-  EXPECT_EQ(parse_backend_policy("auto"), BackendPolicy::Auto);
-  EXPECT_EQ(parse_backend_policy("cpu"), BackendPolicy::ForceCpu);
-  EXPECT_EQ(parse_backend_policy("vulkan"), BackendPolicy::ForceVulkan);
-  EXPECT_EQ(parse_backend_policy("gpu"), std::nullopt);
+  EXPECT_EQ(parse_named(kBackendPolicyNames, "--backend", "auto"), BackendPolicy::Auto);
+  EXPECT_EQ(parse_named(kBackendPolicyNames, "--backend", "cpu"), BackendPolicy::ForceCpu);
+  EXPECT_EQ(parse_named(kBackendPolicyNames, "--backend", "vulkan"), BackendPolicy::ForceVulkan);
+  EXPECT_THROW((void)parse_named(kBackendPolicyNames, "--backend", "gpu"), Error);
   EXPECT_STREQ(to_string(BackendPolicy::ForceVulkan), "vulkan");
 }
 

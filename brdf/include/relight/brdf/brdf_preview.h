@@ -19,15 +19,15 @@ namespace relight::brdf {
 
 class BrdfPreviewStage final : public Stage {
  public:
-  explicit BrdfPreviewStage(BrdfBuffers buffers = {}, std::string output = "brdf_preview")
-      : buffers_(std::move(buffers)), output_name_(std::move(output)) {}
+  explicit BrdfPreviewStage(BrdfBuffers buffers = {}, BufferName<ColorImage> output = kBrdfPreview)
+      : buffers_(buffers), output_name_(output) {}
   [[nodiscard]] std::string name() const override { return "brdf_preview"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
  private:
   BrdfBuffers buffers_;
-  std::string output_name_;
+  BufferName<ColorImage> output_name_;
   Read<ColorImage> color_;
   Read<Mask> highlights_;
   Read<RadianceImage> kd_;

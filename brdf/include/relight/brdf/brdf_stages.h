@@ -17,13 +17,16 @@
 #include <memory>
 #include <string>
 
+#include "relight/brdf/buffers.h"
 #include "relight/brdf/diffuse.h"
 #include "relight/brdf/highlight.h"
 #include "relight/brdf/kmeans.h"
 #include "relight/brdf/materials.h"
 #include "relight/brdf/specular_fit.h"
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/lights/buffers.h"
 #include "relight/lights/light_set.h"
 
 namespace relight {
@@ -36,17 +39,17 @@ namespace brdf {
 class SpecularObjectiveVk;
 
 struct BrdfBuffers {
-  std::string color = "color";
-  std::string positions = "positions";
-  std::string normals = "normals";
-  std::string lights = "lights";
-  std::string frame = "frame";
-  std::string color_diffuse = "color_diffuse";
-  std::string highlight_mask = "highlight_mask";
-  std::string kd = "kd";
-  std::string kd_valid = "kd_valid";
-  std::string clusters = "clusters";
-  std::string materials = "materials";
+  BufferName<ColorImage> color = kColor;
+  BufferName<PositionMap> positions = kPositions;
+  BufferName<NormalMap> normals = kNormals;
+  BufferName<LightSet> lights = kLights;
+  BufferName<FrameInfo> frame = kFrame;
+  BufferName<ColorImage> color_diffuse = kColorDiffuse;
+  BufferName<Mask> highlight_mask = kHighlightMask;
+  BufferName<RadianceImage> kd = kKd;
+  BufferName<Mask> kd_valid = kKdValid;
+  BufferName<Materials> clusters = kMaterialClusters;
+  BufferName<Materials> materials = kMaterials;
 };
 
 enum class SpecularMethod { NelderMead, Ceres };

@@ -1,8 +1,11 @@
 #pragma once
 // The camera pose of one frame as the graph carries it ("camera_pose", and the marker stage's
 // "marker_pose"): where the camera is, where that came from, and whether it can be trusted.
+#include <array>
+#include <optional>
 #include <string>
 
+#include "relight/core/named_values.h"
 #include "relight/core/pose.h"
 
 namespace relight {
@@ -14,7 +17,17 @@ enum class PoseSource {
   Odometry,        ///< markerless RGB-D tracking; the world is the first frame's, z up
   MarkerOdometry,  ///< odometry, corrected towards the marker pose whenever a tag is seen
 };
-[[nodiscard]] const char* to_string(PoseSource source);
+/// `--pose`'s values: "auto" (nullopt: decided at the first frame, camera_tracking_stage.h) and
+/// every source.
+inline constexpr std::array<NamedValue<std::optional<PoseSource>>, 5> kPoseSourceNames{
+    {{"auto", std::nullopt},
+     {"sequence", PoseSource::Sequence},
+     {"marker", PoseSource::Marker},
+     {"odometry", PoseSource::Odometry},
+     {"marker+odometry", PoseSource::MarkerOdometry}}};
+[[nodiscard]] inline const char* to_string(PoseSource source) {
+  return name_of(kPoseSourceNames, std::optional<PoseSource>(source));
+}
 
 struct CameraPose {
   Pose camera_to_world = Pose::Identity();

@@ -33,9 +33,6 @@
 
 namespace relight {
 
-/// "sequence", "marker", "odometry", "marker+odometry"; nullopt otherwise.
-[[nodiscard]] std::optional<PoseSource> parse_pose_source(const std::string& text);
-
 struct CameraTrackingOptions {
   /// nullopt: auto, decided at the first frame: the sequence's own poses when it has them, else
   /// marker+odometry when there is a marker layout (has_marker_layout), else odometry.

@@ -20,6 +20,7 @@
 #include "relight/capture/camera_pose.h"
 #include "relight/capture/tag_detector.h"
 #include "relight/capture/tag_layout.h"
+#include "relight/core/buffers.h"
 #include "relight/core/camera.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/pose.h"
@@ -46,8 +47,8 @@ struct MarkerPose {
 
 class MarkerPoseStage final : public Stage {
  public:
-  MarkerPoseStage(TagLayout layout, const TagDetectorOptions& options = {}, std::string frame_buffer = "frame")
-      : layout_(std::move(layout)), detector_(options), frame_buffer_(std::move(frame_buffer)) {}
+  MarkerPoseStage(TagLayout layout, const TagDetectorOptions& options = {}, BufferName<FrameInfo> frame_buffer = kFrame)
+      : layout_(std::move(layout)), detector_(options), frame_buffer_(frame_buffer) {}
   [[nodiscard]] std::string name() const override { return "marker_pose"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
@@ -55,7 +56,7 @@ class MarkerPoseStage final : public Stage {
  private:
   TagLayout layout_;
   TagDetector detector_;
-  std::string frame_buffer_;
+  BufferName<FrameInfo> frame_buffer_;
   std::optional<MarkerPose> last_;
   Read<ColorImage> color_;
   Read<DepthMap> depth_;

@@ -8,14 +8,15 @@
 #include <string>
 
 #include "relight/capture/frame_source.h"
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 
 namespace relight {
 
 class SourceStage final : public Stage {
  public:
-  explicit SourceStage(std::unique_ptr<FrameSource> source, std::string frame_buffer = "frame")
-      : source_(std::move(source)), frame_buffer_(std::move(frame_buffer)) {}
+  explicit SourceStage(std::unique_ptr<FrameSource> source, BufferName<FrameInfo> frame_buffer = kFrame)
+      : source_(std::move(source)), frame_buffer_(frame_buffer) {}
   [[nodiscard]] std::string name() const override { return "source"; }
   [[nodiscard]] bool has_side_effects() const override { return true; }
   void declare(StageBuilder& builder) override;
@@ -24,7 +25,7 @@ class SourceStage final : public Stage {
 
  private:
   std::unique_ptr<FrameSource> source_;
-  std::string frame_buffer_;
+  BufferName<FrameInfo> frame_buffer_;
   Write<ColorImage> color_;
   Write<DepthMap> depth_;
   Write<FrameInfo> frame_;

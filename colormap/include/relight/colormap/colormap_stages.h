@@ -13,23 +13,28 @@
 #include <memory>
 #include <string>
 
+#include "relight/colormap/buffers.h"
 #include "relight/colormap/color_mapping.h"
 #include "relight/colormap/sample_mapping.h"
 #include "relight/colormap/statistics_transfer.h"
 #include "relight/colormap/statistics_transfer_vk.h"
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
+#include "relight/core/named_values.h"
 
 namespace relight::colormap {
 
 enum class ColorMapMethod { None, Sample, Statistics };
+inline constexpr std::array<NamedValue<ColorMapMethod>, 3> kColorMapMethodNames{
+    {{"none", ColorMapMethod::None}, {"sample", ColorMapMethod::Sample}, {"stats", ColorMapMethod::Statistics}}};
 
 struct ColorMapBuffers {
-  std::string real = "L_r";
-  std::string real_virtual = "L_rv";
-  std::string camera = "color";
-  std::string delta = "delta_L";
-  std::string mapping = "color_mapping";
-  std::string mapped = "color_mapped";
+  BufferName<RadianceImage> real = kRealRadiance;
+  BufferName<RadianceImage> real_virtual = kRealVirtualRadiance;
+  BufferName<ColorImage> camera = kColor;
+  BufferName<RadianceImage> delta = kDeltaRadiance;
+  BufferName<ColorMapping> mapping = kColorMapping;
+  BufferName<ColorImage> mapped = kColorMapped;
 };
 
 /// Statistics-based, CPU (statistics_transfer.h).

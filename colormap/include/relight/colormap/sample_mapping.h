@@ -26,11 +26,16 @@
 
 #include "relight/colormap/tone_map.h"
 #include "relight/core/image.h"
+#include "relight/core/named_values.h"
 
 namespace relight::colormap {
 
 enum class PolynomialModel { PerChannelAffine, Linear3x3, Affine3x4 };
-[[nodiscard]] const char* to_string(PolynomialModel model);
+inline constexpr std::array<NamedValue<PolynomialModel>, 3> kPolynomialModelNames{
+    {{"per_channel_affine", PolynomialModel::PerChannelAffine},
+     {"linear_3x3", PolynomialModel::Linear3x3},
+     {"affine_3x4", PolynomialModel::Affine3x4}}};
+[[nodiscard]] inline const char* to_string(PolynomialModel model) { return name_of(kPolynomialModelNames, model); }
 
 struct SampleMappingOptions {
   int samples = 64;    ///< N virtual-object samples per frame

@@ -1,8 +1,11 @@
 #pragma once
 // Camera models. Camera frame convention (OpenCV/TUM): x right, y down, z forward (optical axis).
 #include <Eigen/Core>
+#include <array>
 #include <optional>
 #include <string_view>
+
+#include "relight/core/named_values.h"
 
 namespace relight {
 
@@ -17,7 +20,8 @@ struct PinholeIntrinsics {
 
   /// Kinect v1 / ROS defaults (fx = fy = 525, cx = 319.5, cy = 239.5, 640x480).
   static PinholeIntrinsics kinect_v1() { return {}; }
-  /// TUM RGB-D calibrated colour cameras: "fr1", "fr2", "fr3", or "kinect" for the defaults.
+  /// TUM RGB-D calibrated colour cameras: "fr1", "fr2", "fr3", or "kinect" for the defaults
+  /// (kIntrinsicsPresets).
   static std::optional<PinholeIntrinsics> preset(std::string_view name);
 
   /// Pixel (u, v) of a camera-frame point; z must be > 0.
@@ -33,6 +37,14 @@ struct PinholeIntrinsics {
 
   friend bool operator==(const PinholeIntrinsics&, const PinholeIntrinsics&) = default;
 };
+
+/// The intrinsics presets by name (--intrinsics): the Kinect v1 / ROS defaults and the TUM RGB-D
+/// calibrated colour cameras (cvg.cit.tum.de, "file formats" page).
+inline constexpr std::array<NamedValue<PinholeIntrinsics>, 4> kIntrinsicsPresets{
+    {{"kinect", PinholeIntrinsics{}},
+     {"fr1", PinholeIntrinsics{517.3, 516.5, 318.6, 255.3, 640, 480}},
+     {"fr2", PinholeIntrinsics{520.9, 521.0, 325.1, 249.7, 640, 480}},
+     {"fr3", PinholeIntrinsics{535.4, 539.2, 320.1, 247.6, 640, 480}}}};
 
 /// Equidistant fisheye (r = f * theta) as used for the light probe: centre (cx, cy) and the
 /// pixel radius at which theta reaches max_theta (pi/2 for a 180 degree lens). Directions are

@@ -22,6 +22,7 @@
 #include <typeindex>
 #include <vector>
 
+#include "relight/core/buffer_name.h"
 #include "relight/core/device_transfer.h"
 #include "relight/core/error.h"
 
@@ -119,6 +120,19 @@ class StageBuilder {
   template <GraphBuffer T>
   [[nodiscard]] Write<T> write(std::string_view buffer) {
     return {declare(buffer, detail::Access::Write, detail::buffer_type<T>())};
+  }
+  /// The same with a typed name (buffer_name.h): the handle's type is the name's.
+  template <GraphBuffer T>
+  [[nodiscard]] Read<T> read(BufferName<T> buffer) {
+    return read<T>(buffer.name());
+  }
+  template <GraphBuffer T>
+  [[nodiscard]] ReadPrevious<T> read_previous(BufferName<T> buffer) {
+    return read_previous<T>(buffer.name());
+  }
+  template <GraphBuffer T>
+  [[nodiscard]] Write<T> write(BufferName<T> buffer) {
+    return write<T>(buffer.name());
   }
 
  private:
@@ -246,6 +260,10 @@ class FrameGraph {
   /// Marks a buffer as a result of the graph (read by the caller through find()), so that its
   /// writer is not culled even though no stage reads it.
   void keep(std::string_view buffer);
+  template <class T>
+  void keep(BufferName<T> buffer) {
+    keep(buffer.name());
+  }
 
   /// Validates and orders the graph; throws GraphError naming the offending stage and buffer.
   void compile();
@@ -269,6 +287,10 @@ class FrameGraph {
   [[nodiscard]] const T* find(std::string_view buffer) {
     detail::AnyBuffer* any = find_host(buffer, typeid(T));
     return any ? &static_cast<detail::TypedBuffer<T>*>(any)->value : nullptr;
+  }
+  template <class T>
+  [[nodiscard]] const T* find(BufferName<T> buffer) {
+    return find<T>(buffer.name());
   }
 
  private:

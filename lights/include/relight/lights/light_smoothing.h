@@ -13,6 +13,7 @@
 #include <string>
 
 #include "relight/core/frame_graph.h"
+#include "relight/lights/buffers.h"
 #include "relight/lights/light_set.h"
 
 namespace relight {
@@ -28,15 +29,15 @@ struct LightSmoothingOptions {
                                      const LightSmoothingOptions& options = {});
 
 struct LightSmoothingBuffers {
-  std::string input = "lights_raw";  ///< this frame's extracted lights
-  std::string output = "lights";     ///< smoothed; its previous version is the history
+  BufferName<LightSet> input = kLightsRaw;  ///< this frame's extracted lights
+  BufferName<LightSet> output = kLights;    ///< smoothed; its previous version is the history
 };
 
 /// Reads LightSet `input` and the previous frame's LightSet `output`; writes LightSet `output`.
 class LightSmoothingStage final : public Stage {
  public:
   explicit LightSmoothingStage(LightSmoothingOptions options = {}, LightSmoothingBuffers buffers = {})
-      : options_(options), buffers_(std::move(buffers)) {}
+      : options_(options), buffers_(buffers) {}
   [[nodiscard]] std::string name() const override { return "light_smoothing"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;

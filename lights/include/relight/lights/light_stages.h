@@ -8,15 +8,18 @@
 #include <memory>
 #include <string>
 
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
+#include "relight/core/named_values.h"
+#include "relight/lights/buffers.h"
 #include "relight/lights/importance_sampling.h"
 #include "relight/lights/median_cut.h"
 
 namespace relight {
 
 enum class LightMethod { Importance, MedianCut };
-/// "importance" or "median-cut"; throws relight::Error naming the value otherwise.
-[[nodiscard]] LightMethod parse_light_method(const std::string& text);
+inline constexpr std::array<NamedValue<LightMethod>, 2> kLightMethodNames{
+    {{"importance", LightMethod::Importance}, {"median-cut", LightMethod::MedianCut}}};
 
 struct LightExtractionOptions {
   LightMethod method = LightMethod::Importance;
@@ -26,8 +29,8 @@ struct LightExtractionOptions {
 };
 
 struct LightExtractionBuffers {
-  std::string probe = "probe";
-  std::string lights = "lights_raw";
+  BufferName<RadianceImage> probe = kProbe;
+  BufferName<LightSet> lights = kLightsRaw;
 };
 
 /// Either method on the CPU, or importance sampling on Vulkan when `context` is given.

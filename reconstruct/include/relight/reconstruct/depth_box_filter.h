@@ -21,6 +21,7 @@
 #include <string>
 #include <utility>
 
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
 
@@ -60,14 +61,14 @@ class DepthBoxFilterVk {
 
 /// Buffer names of the box-filter stages.
 struct DepthBoxFilterBuffers {
-  std::string input = "depth";
-  std::string output = "depth_smoothed";
+  BufferName<DepthMap> input = kDepth;
+  BufferName<DepthMap> output = kDepthSmoothed;
 };
 
 /// CPU stage: reads DepthMap `input`, writes DepthMap `output`.
 class DepthBoxFilterCpuStage final : public Stage {
  public:
-  explicit DepthBoxFilterCpuStage(DepthBoxFilterBuffers buffers = {}) : buffers_(std::move(buffers)) {}
+  explicit DepthBoxFilterCpuStage(DepthBoxFilterBuffers buffers = {}) : buffers_(buffers) {}
   [[nodiscard]] std::string name() const override { return "depth_box_filter"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;

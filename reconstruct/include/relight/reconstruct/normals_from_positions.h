@@ -21,6 +21,7 @@
 // (intrinsics) and writes PositionMap "positions" and NormalMap "normals".
 #include <string>
 
+#include "relight/core/buffers.h"
 #include "relight/core/camera.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
@@ -43,10 +44,10 @@ void normals_from_positions(const PositionMap& positions, NormalMap& normals, co
 
 /// Buffer names of NormalsFromPositionsCpuStage.
 struct NormalsFromPositionsBuffers {
-  std::string depth = "depth_filtered";
-  std::string frame = "frame";
-  std::string positions = "positions";
-  std::string normals = "normals";
+  BufferName<DepthMap> depth = kDepthFiltered;
+  BufferName<FrameInfo> frame = kFrame;
+  BufferName<PositionMap> positions = kPositions;
+  BufferName<NormalMap> normals = kNormals;
 };
 
 /// Method 2's normal stage (see the header comment for its buffers).
@@ -54,7 +55,7 @@ class NormalsFromPositionsCpuStage final : public Stage {
  public:
   using Buffers = NormalsFromPositionsBuffers;
   explicit NormalsFromPositionsCpuStage(CrossNormalOptions options = {}, Buffers buffers = {})
-      : options_(options), buffers_(std::move(buffers)) {}
+      : options_(options), buffers_(buffers) {}
   [[nodiscard]] std::string name() const override { return "normals_from_positions"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;

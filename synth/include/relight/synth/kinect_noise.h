@@ -22,14 +22,19 @@
 
 #include "relight/core/camera.h"
 #include "relight/core/image.h"
+#include "relight/core/named_values.h"
 
 namespace relight::synth {
 
 enum class NoiseModel { None, Kinect1 };
+inline constexpr std::array<NamedValue<NoiseModel>, 2> kNoiseModelNames{
+    {{"kinect1", NoiseModel::Kinect1}, {"none", NoiseModel::None}}};
 
-/// "none" or "kinect1"; throws relight::Error otherwise.
-[[nodiscard]] NoiseModel parse_noise(const std::string& name);
-[[nodiscard]] const char* to_string(NoiseModel model);
+/// One of kNoiseModelNames; throws relight::Error naming the choices otherwise.
+[[nodiscard]] inline NoiseModel parse_noise(const std::string& name) {
+  return parse_named(kNoiseModelNames, "noise model", name);
+}
+[[nodiscard]] inline const char* to_string(NoiseModel model) { return name_of(kNoiseModelNames, model); }
 
 struct KinectNoiseOptions {
   bool axial = true;

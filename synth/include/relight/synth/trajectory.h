@@ -12,16 +12,21 @@
 #include <string>
 #include <vector>
 
+#include "relight/core/named_values.h"
 #include "relight/core/pose.h"
 #include "relight/synth/scene.h"
 
 namespace relight::synth {
 
 enum class Trajectory { Static, Orbit, Handheld };
+inline constexpr std::array<NamedValue<Trajectory>, 3> kTrajectoryNames{
+    {{"static", Trajectory::Static}, {"orbit", Trajectory::Orbit}, {"handheld", Trajectory::Handheld}}};
 
-/// "static", "orbit" or "handheld"; throws relight::Error otherwise.
-[[nodiscard]] Trajectory parse_trajectory(const std::string& name);
-[[nodiscard]] const char* to_string(Trajectory trajectory);
+/// One of kTrajectoryNames; throws relight::Error naming the choices otherwise.
+[[nodiscard]] inline Trajectory parse_trajectory(const std::string& name) {
+  return parse_named(kTrajectoryNames, "trajectory", name);
+}
+[[nodiscard]] inline const char* to_string(Trajectory trajectory) { return name_of(kTrajectoryNames, trajectory); }
 
 [[nodiscard]] Timestamp frame_timestamp(int index);
 

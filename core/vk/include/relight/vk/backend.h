@@ -4,10 +4,12 @@
 // plain CPU loop, so per-pixel stages default to the CPU path there and to Vulkan on a real GPU.
 // Rasterisation-heavy work (the renderer) stays on Vulkan whenever a device exists.
 // Deliberately free of Vulkan headers: the app's option parsing includes it.
+#include <array>
 #include <optional>
 #include <string_view>
 
 #include "relight/core/frame_graph.h"  // relight::Backend
+#include "relight/core/named_values.h"
 
 namespace relight::vk {
 
@@ -26,8 +28,9 @@ enum class StageKind {
 [[nodiscard]] Backend choose_backend(StageKind kind, const VulkanContext* context,
                                      BackendPolicy policy = BackendPolicy::Auto);
 
-/// "auto", "cpu", "vulkan" (case-sensitive; for command-line flags and RELIGHT_BACKEND).
-[[nodiscard]] std::optional<BackendPolicy> parse_backend_policy(std::string_view text);
-[[nodiscard]] const char* to_string(BackendPolicy policy);
+/// `--backend`'s values (case-sensitive).
+inline constexpr std::array<NamedValue<BackendPolicy>, 3> kBackendPolicyNames{
+    {{"auto", BackendPolicy::Auto}, {"cpu", BackendPolicy::ForceCpu}, {"vulkan", BackendPolicy::ForceVulkan}}};
+[[nodiscard]] inline const char* to_string(BackendPolicy policy) { return name_of(kBackendPolicyNames, policy); }
 
 }  // namespace relight::vk

@@ -15,9 +15,9 @@
 //                            writes VplSet "vpls" (vpl.h)
 //   dir                      reads  FrameInfo "frame", ColorImage "color" and PositionMap
 //                                   "positions" (the image size, which they must share),
-//                                   MrScene "mr_scene", VplSet "vpls"; when `albedo_buffer` is
-//                                   set, that RadianceImage (per-pixel k_d) and Mask
-//                                   "<albedo_buffer>_valid" (camera_albedo.h)
+//                                   MrScene "mr_scene", VplSet "vpls"; when `albedo_buffers` is
+//                                   set, its RadianceImage (per-pixel k_d, "kd") and Mask
+//                                   ("kd_valid", camera_albedo.h)
 //                            writes DifferentialImages "dir_images" (L_rv, L_r, coverage and
 //                                   their indirect parts, one shading pass) and GBuffer
 //                                   "dir_gbuffer"
@@ -47,17 +47,25 @@
 
 #include "relight/brdf/materials.h"
 #include "relight/colormap/tone_map.h"
+#include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
-#include "relight/render/vpl/cone_search_vk.h"
-#include "relight/render/scene/depth_mesh.h"
+#include "relight/render/buffers.h"
 #include "relight/render/dir/dir_vk.h"
-#include "relight/render/vpl/reflective_shadow_map_vk.h"
 #include "relight/render/dir/temporal_smoothing.h"
+#include "relight/render/scene/depth_mesh.h"
 #include "relight/render/scene/virtual_model.h"
+#include "relight/render/vpl/cone_search_vk.h"
+#include "relight/render/vpl/reflective_shadow_map_vk.h"
 #include "relight/render/vpl/vpl.h"
 
 namespace relight::render {
+
+/// A per-pixel k_d of the real surfaces and where it is valid (brdf/'s diffuse estimate).
+struct RealAlbedoBuffers {
+  BufferName<RadianceImage> albedo = kKd;
+  BufferName<Mask> valid = kKdValid;
+};
 
 struct DirStageOptions {
   DirRenderOptions renderer{};
@@ -65,13 +73,13 @@ struct DirStageOptions {
   DepthMeshOptions mesh{.stride = 2};
   PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
   colormap::ToneMap tone_map{};
-  std::string materials_buffer;  ///< empty: no Materials input
+  std::optional<BufferName<brdf::Materials>> materials_buffer;  ///< none: no Materials input
   /// ObjectPlacements of the objects (virtual_model.h), e.g. resolved on a real surface at the
-  /// first frame; empty: the placements in DirSceneContent.
-  std::string placements_buffer;
-  /// Per-pixel k_d of the camera's real surfaces (brdf/'s "kd"), modulating the cluster k_d of
-  /// diffuse real surfaces (camera_albedo.h); empty: the clusters' k_d alone.
-  std::string albedo_buffer;
+  /// first frame; none: the placements in DirSceneContent.
+  std::optional<BufferName<ObjectPlacements>> placements_buffer;
+  /// Per-pixel k_d of the camera's real surfaces, modulating the cluster k_d of diffuse real
+  /// surfaces (camera_albedo.h); none: the clusters' k_d alone.
+  std::optional<RealAlbedoBuffers> albedo_buffers;
   bool temporal_smoothing = true;
   TemporalOptions temporal{};
 };
@@ -98,8 +106,8 @@ class MrSceneStage final : public Stage {
   DirSceneContent content_;
   DepthMeshOptions mesh_;
   PhongMaterial reconstruction_material_;
-  std::string materials_buffer_;
-  std::string placements_buffer_;
+  std::optional<BufferName<brdf::Materials>> materials_buffer_;
+  std::optional<BufferName<ObjectPlacements>> placements_buffer_;
   Read<FrameInfo> frame_;
   Read<PositionMap> positions_;
   Read<NormalMap> normals_;
@@ -131,8 +139,9 @@ class VplStage final : public Stage {
 /// Steps 3-4 (G-buffer, shadow maps, ISMs, one-pass shading of L_rv and L_r).
 class DirRenderStage final : public Stage {
  public:
-  /// `albedo_buffer`: DirStageOptions::albedo_buffer.
-  DirRenderStage(vk::VulkanContext* context, DirRenderOptions options, std::string albedo_buffer = {});
+  /// `albedo_buffers`: DirStageOptions::albedo_buffers.
+  DirRenderStage(vk::VulkanContext* context, DirRenderOptions options,
+                 std::optional<RealAlbedoBuffers> albedo_buffers = std::nullopt);
   ~DirRenderStage() override;
   [[nodiscard]] std::string name() const override { return "dir"; }
   void declare(StageBuilder& builder) override;
@@ -141,7 +150,7 @@ class DirRenderStage final : public Stage {
  private:
   vk::VulkanContext* context_;
   DirRenderOptions options_;
-  std::string albedo_buffer_;
+  std::optional<RealAlbedoBuffers> albedo_buffers_;
   std::unique_ptr<DirRendererVk> renderer_;
   std::pair<int, int> renderer_size_{0, 0};
   Read<FrameInfo> frame_;
@@ -158,7 +167,7 @@ class DirRenderStage final : public Stage {
 /// Step 6 (temporal smoothing of the indirect light).
 class IndirectSmoothingStage final : public Stage {
  public:
-  IndirectSmoothingStage(bool enabled, TemporalOptions options) : enabled_(enabled), options_(options) {}
+  IndirectSmoothingStage(bool enabled, TemporalOptions options) : enabled_(enabled), options_(std::move(options)) {}
   [[nodiscard]] std::string name() const override { return "indirect_smoothing"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;

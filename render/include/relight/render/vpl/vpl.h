@@ -43,8 +43,9 @@
 #include <cstdint>
 #include <vector>
 
-#include "relight/render/scene/mr_scene.h"
+#include "relight/core/named_values.h"
 #include "relight/render/reference/ray_tracer.h"
+#include "relight/render/scene/mr_scene.h"
 
 namespace relight::render {
 
@@ -77,6 +78,10 @@ struct Vpl {
 ///                   light keeps at least 1/16 of the mean share so that one that found nothing
 ///                   last frame can recover.
 enum class VplBudget { Equal, ByPower, ByWeight, ByPreviousFlux };
+inline constexpr std::array<NamedValue<VplBudget>, 4> kVplBudgetNames{{{"equal", VplBudget::Equal},
+                                                                       {"power", VplBudget::ByPower},
+                                                                       {"weights", VplBudget::ByWeight},
+                                                                       {"flux", VplBudget::ByPreviousFlux}}};
 
 /// Where a spot light's first-bounce VPLs come from.
 ///   RayTraced             light samples traced against both layers (above), for every light;
@@ -89,9 +94,13 @@ enum class VplBudget { Equal, ByPower, ByWeight, ByPreviousFlux };
 ///                         focus), and lights without RSMs (point, directional, spots wider than
 ///                         75 degrees) stay ray traced. Further bounces are traced as above.
 enum class VplSource { RayTraced, ReflectiveShadowMaps };
+inline constexpr std::array<NamedValue<VplSource>, 2> kVplSourceNames{
+    {{"rays", VplSource::RayTraced}, {"rsm", VplSource::ReflectiveShadowMaps}}};
 
 /// How a VPL's continued light path finds its next surface (bounces ≥ 2; see the header comment).
 enum class BounceMethod { RayTraced, PointCone };
+inline constexpr std::array<NamedValue<BounceMethod>, 2> kBounceMethodNames{
+    {{"rays", BounceMethod::RayTraced}, {"cone", BounceMethod::PointCone}}};
 
 struct VplOptions {
   int count = 256;      ///< first-bounce light samples (each may yield two VPLs, see above)

@@ -1,0 +1,12 @@
+#pragma once
+// The names of the BRDF estimation's own frame-graph buffers (buffer_name.h); core/buffers.h has
+// its images (color_diffuse, highlight_mask, kd, kd_valid, brdf_preview).
+#include "relight/brdf/materials.h"
+#include "relight/core/buffer_name.h"
+
+namespace relight::brdf {
+
+inline constexpr BufferName<Materials> kMaterialClusters{"clusters"};  ///< K-means, k_d only
+inline constexpr BufferName<Materials> kMaterials{"materials"};        ///< with the specular fit
+
+}  // namespace relight::brdf
