@@ -118,7 +118,7 @@ class RelightDevice final : public oni::driver::DeviceBase {
     }
     sensors_[0] = {ONI_SENSOR_DEPTH, static_cast<int>(depth_modes_.size()), depth_modes_.data()};
     sensors_[1] = {ONI_SENSOR_COLOR, static_cast<int>(color_modes_.size()), color_modes_.data()};
-    thread_ = std::jthread([this](std::stop_token stop) { run(stop); });
+    thread_ = std::jthread([this](const std::stop_token& stop) { run(stop); });
   }
 
   // The frame thread goes first (the jthread is the last member but is stopped explicitly so that
@@ -209,8 +209,8 @@ class RelightDevice final : public oni::driver::DeviceBase {
   }
 
  private:
-  void run(std::stop_token stop);
-  bool wait_for_streams(std::stop_token stop, std::vector<RelightStream*>& targets);
+  void run(const std::stop_token& stop);
+  bool wait_for_streams(const std::stop_token& stop, std::vector<RelightStream*>& targets);
 
   RelightDriver& driver_;
   OniDeviceInfo info_;
@@ -467,14 +467,14 @@ void RelightStream::emit(const ProducedFrame& produced) {
 
 // ---- RelightDevice frame thread ----
 
-bool RelightDevice::wait_for_streams(std::stop_token stop, std::vector<RelightStream*>& targets) {
+bool RelightDevice::wait_for_streams(const std::stop_token& stop, std::vector<RelightStream*>& targets) {
   std::unique_lock lock(state_mutex_);
   if (!wake_.wait(lock, stop, [this] { return !started_.empty(); })) return false;
   targets = started_;
   return true;
 }
 
-void RelightDevice::run(std::stop_token stop) {
+void RelightDevice::run(const std::stop_token& stop) {
   std::int64_t index = 0;
   std::int64_t anchor_index = -1;  // -1: streaming (re)starts, anchor the clock at the next frame
   Clock::time_point anchor_time;

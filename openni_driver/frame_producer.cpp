@@ -181,8 +181,9 @@ class TumProducer final : public FrameProducer {
 
   std::uint64_t timestamp_us(std::int64_t index) const override {
     const auto n = static_cast<std::int64_t>(sequence_.size());
+    const std::int64_t loops_done = index / n;  // whole loops before this frame
     const double t = sequence_.frame(static_cast<std::size_t>(index % n)).depth_timestamp +
-                     static_cast<double>(index / n) * loop_seconds_;
+                     static_cast<double>(loops_done) * loop_seconds_;
     return static_cast<std::uint64_t>(std::llround(t * 1e6));
   }
 

@@ -1,20 +1,38 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds (optimised, with assertions) and runs every test CI runs, then
-# the unit tests of six labels under AddressSanitizer + UndefinedBehaviorSanitizer and a short run
-# of every fuzz target.
+# Installs what is missing, checks the format and clang-tidy of the last commit's changes, builds
+# (optimised, with assertions) and runs every test CI runs, then compiles the Release+tests
+# combination, runs the unit tests of six labels under AddressSanitizer + UndefinedBehaviorSanitizer
+# and a short run of every fuzz target.
 # Usage: scripts/test.sh [extra ctest arguments for the main suite, e.g. -L core]
-# RELIGHT_ASAN=0 skips the sanitizer stage, RELIGHT_FUZZ_SECONDS=0 the fuzzing stage.
+# RELIGHT_ASAN=0 skips the sanitizer stage, RELIGHT_FUZZ_SECONDS=0 the fuzzing stage,
+# RELIGHT_RELEASE_BUILD=0 the Release+tests build, RELIGHT_LINT=0 the format and tidy checks.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/install-deps.sh"
 source "$root/scripts/common.sh"
+if [ "${RELIGHT_LINT:-1}" != 0 ]; then
+  "$root/scripts/format-check.sh"
+fi
 relight_build debug
+if [ "${RELIGHT_LINT:-1}" != 0 ]; then
+  start=$SECONDS
+  "$root/scripts/tidy-check.sh"
+  echo "tidy stage: $((SECONDS - start)) s"
+fi
 # The Vulkan tests run on whatever device the loader finds (lavapipe on machines without a GPU);
 # RELIGHT_REQUIRE_VULKAN turns "no Vulkan device" into a failure instead of a skip.
 export RELIGHT_REQUIRE_VULKAN="${RELIGHT_REQUIRE_VULKAN:-1}"
 # RELIGHT_REQUIRE_VALIDATION does the same for the Vulkan validation layer (vulkan-validationlayers).
 export RELIGHT_REQUIRE_VALIDATION="${RELIGHT_REQUIRE_VALIDATION:-1}"
 ctest --test-dir "$root/build/debug" --output-on-failure --parallel "$(nproc)" --timeout 600 -LE soak "$@"
+
+# The Release (-O3) build with the tests, as packagers build it: only compiled, since -O3 brings
+# warnings (GCC's flow analysis) that -O2 does not.
+if [ "${RELIGHT_RELEASE_BUILD:-1}" != 0 ]; then
+  start=$SECONDS
+  (relight_build release-tests)
+  echo "release build stage: $((SECONDS - start)) s"
+fi
 
 # Sanitizers (the asan preset, build/asan; suppressions and options in sanitizers/ and the
 # preset). Only these labels: with ASan + UBSan our numeric code runs 8-30 times slower, and

@@ -149,11 +149,15 @@ void DiffuseStage::run(StageContext& context) {
 }
 
 KMeansStage::KMeansStage(KMeansOptions options, std::uint64_t seed, BrdfBuffers buffers)
-    : backend_(Backend::Cpu), engine_(std::make_unique<KMeansCpu>(options.threads)), tracker_(options, seed),
+    : backend_(Backend::Cpu),
+      engine_(std::make_unique<KMeansCpu>(options.threads)),
+      first_tracker_(options, seed),
       buffers_(std::move(buffers)) {}
 
 KMeansStage::KMeansStage(vk::VulkanContext& context, KMeansOptions options, std::uint64_t seed, BrdfBuffers buffers)
-    : backend_(Backend::Vulkan), engine_(std::make_unique<KMeansVk>(context)), tracker_(options, seed),
+    : backend_(Backend::Vulkan),
+      engine_(std::make_unique<KMeansVk>(context)),
+      first_tracker_(options, seed),
       buffers_(std::move(buffers)) {}
 
 KMeansStage::~KMeansStage() = default;
@@ -161,6 +165,8 @@ KMeansStage::~KMeansStage() = default;
 void KMeansStage::declare(StageBuilder& builder) {
   kd_ = builder.read(buffers_.kd);
   valid_ = builder.read(buffers_.kd_valid);
+  previous_tracker_ = builder.read_previous(buffers_.kmeans_history);
+  tracker_ = builder.write(buffers_.kmeans_history);
   clusters_ = builder.write(buffers_.clusters);
 }
 
@@ -168,7 +174,10 @@ void KMeansStage::run(StageContext& context) {
   const RadianceImage& kd = context.get(kd_);
   const std::size_t clustered = gather_points(kd, context.get(valid_), points_, pixels_);
   if (auto* gpu = dynamic_cast<KMeansVk*>(engine_.get())) gpu->reset_gpu_ms();
-  result_ = tracker_.run(*engine_, points_, clustered);
+  const KMeansTracker* previous = context.get(previous_tracker_);
+  KMeansTracker& tracker = context.get(tracker_);
+  tracker = previous ? *previous : first_tracker_;
+  result_ = tracker.run(*engine_, points_, clustered);
   if (auto* gpu = dynamic_cast<KMeansVk*>(engine_.get()); gpu && gpu->gpu_ms()) context.report_device_ms(*gpu->gpu_ms());
   context.get(clusters_) = materials_from_clusters(result_, pixels_, kd.width(), kd.height());
 }

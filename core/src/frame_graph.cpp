@@ -110,7 +110,8 @@ void FrameGraph::validate_writers() {
 }
 
 void FrameGraph::validate_readers() {
-  for (const auto& entry : stages_) {
+  for (std::size_t stage_index = 0; stage_index < stages_.size(); ++stage_index) {
+    const auto& entry = stages_[stage_index];
     for (const auto& decl : entry.declarations) {
       if (decl.access == detail::Access::Write) continue;
       auto& buffer = buffers_[decl.buffer];
@@ -124,7 +125,10 @@ void FrameGraph::validate_readers() {
                          ", but stage '" + stages_[*buffer.writer].name + "' writes it as " + buffer.type->name);
       }
       if (decl.access == detail::Access::ReadPrevious) buffer.has_history_reader = true;
-      if (entry.stage->backend() == Backend::Vulkan && !decl.type.device_mirrorable) {
+      // A Vulkan stage's own state across frames (its history of a host type, e.g. K-means'
+      // tracker) stays on the host; everything else it reads must be able to reach the device.
+      const bool own_history = decl.access == detail::Access::ReadPrevious && buffer.writer == stage_index;
+      if (entry.stage->backend() == Backend::Vulkan && !decl.type.device_mirrorable && !own_history) {
         throw GraphError("Vulkan stage '" + entry.name + "' reads buffer '" + buffer.name + "' of type " +
                          decl.type.name + ", which cannot be mirrored on the device");
       }

@@ -333,6 +333,62 @@ TEST(FrameGraph, ChainedDeviceStagesKeepDataOnTheDevice) {
   EXPECT_EQ(device.downloads, 1);
 }
 
+/// Host-only state that a "Vulkan" stage keeps across frames through the graph's history.
+struct RunCount {
+  int runs = 0;
+};
+
+// A "Vulkan" stage counting its runs in its own history, and optionally reading another host-only
+// buffer (which no Vulkan stage may).
+class DeviceStageWithHostState final : public Stage {
+ public:
+  explicit DeviceStageWithHostState(bool read_foreign) : read_foreign_(read_foreign) {}
+  std::string name() const override { return "device_with_state"; }
+  Backend backend() const override { return Backend::Vulkan; }
+  bool has_side_effects() const override { return true; }
+  void declare(StageBuilder& b) override {
+    previous_ = b.read_previous<RunCount>("run_count");
+    count_ = b.write<RunCount>("run_count");
+    if (read_foreign_) foreign_ = b.read<RunCount>("foreign_count");
+  }
+  void run(StageContext& ctx) override {
+    const RunCount* previous = ctx.get(previous_);
+    ctx.get(count_).runs = (previous ? previous->runs : 0) + 1;
+    runs_seen.push_back(ctx.get(count_).runs);
+  }
+  std::vector<int> runs_seen;
+
+ private:
+  bool read_foreign_;
+  ReadPrevious<RunCount> previous_;
+  Write<RunCount> count_;
+  Read<RunCount> foreign_;
+};
+
+class HostCountSource final : public Stage {
+ public:
+  std::string name() const override { return "host_count"; }
+  void declare(StageBuilder& b) override { out_ = b.write<RunCount>("foreign_count"); }
+  void run(StageContext& ctx) override { ctx.get(out_).runs = 7; }
+
+ private:
+  Write<RunCount> out_;
+};
+
+TEST(FrameGraph, AVulkanStageKeepsItsOwnHostStateButReadsNoOtherHostOnlyBuffer) {
+  FakeDevice device;
+  FrameGraph graph(&device);
+  auto& stage = graph.emplace<DeviceStageWithHostState>(false);
+  for (int frame = 0; frame < 3; ++frame) ASSERT_TRUE(graph.run_frame());
+  EXPECT_EQ(stage.runs_seen, (std::vector<int>{1, 2, 3}));  // each frame continues the last one's
+  EXPECT_EQ(device.uploads + device.downloads, 0);          // host state never travels
+
+  FrameGraph foreign(&device);
+  foreign.emplace<HostCountSource>();
+  foreign.emplace<DeviceStageWithHostState>(true);
+  EXPECT_NE(compile_error(foreign).find("cannot be mirrored on the device"), std::string::npos);
+}
+
 TEST(FrameGraph, VulkanStageWithoutDeviceIsAGraphError) {
   FrameGraph graph;
   graph.emplace<CountingSource>(1);

@@ -182,6 +182,10 @@ void IndirectSmoothingStage::declare(StageBuilder& builder) {
   images_ = builder.read(kDirImages);
   gbuffer_ = builder.read(kDirGBuffer);
   frame_ = builder.read(kFrame);
+  if (enabled_) {
+    previous_history_ = builder.read_previous(kIndirectHistory);
+    history_ = builder.write(kIndirectHistory);
+  }
   real_virtual_ = builder.write(kRealVirtualRadiance);
   real_ = builder.write(kRealRadiance);
   indirect_ = builder.write(kRealVirtualIndirect);
@@ -192,7 +196,8 @@ void IndirectSmoothingStage::run(StageContext& context) {
   DifferentialImages images = context.get(images_);
   if (enabled_) {
     const MrCamera camera = frame_camera(context.get(frame_), images.real_virtual.width(), images.real_virtual.height());
-    history_ = smooth_indirect(images, context.get(gbuffer_), camera, history_ ? &*history_ : nullptr, options_);
+    context.get(history_) =
+        smooth_indirect(images, context.get(gbuffer_), camera, context.get(previous_history_), options_);
   }
   context.get(real_virtual_) = std::move(images.real_virtual);
   context.get(real_) = std::move(images.real);

@@ -50,6 +50,7 @@ struct BrdfBuffers {
   BufferName<Mask> kd_valid = kKdValid;
   BufferName<Materials> clusters = kMaterialClusters;
   BufferName<Materials> materials = kMaterials;
+  BufferName<KMeansTracker> kmeans_history = kKMeansHistory;
 };
 
 enum class SpecularMethod { NelderMead, Ceres };
@@ -120,10 +121,12 @@ class KMeansStage final : public Stage {
  private:
   Backend backend_;
   std::unique_ptr<KMeansEngine> engine_;
-  KMeansTracker tracker_;
+  KMeansTracker first_tracker_;  ///< the state of the first frame (options and seed)
   BrdfBuffers buffers_;
   Read<RadianceImage> kd_;
   Read<Mask> valid_;
+  ReadPrevious<KMeansTracker> previous_tracker_;
+  Write<KMeansTracker> tracker_;
   Write<Materials> clusters_;
   std::vector<Float3> points_;
   std::vector<std::uint32_t> pixels_;

@@ -143,6 +143,8 @@ inline constexpr std::size_t kKMeansPpMaxPoints = 32768;
 /// centre and Lloyd runs again, kept while the compactness drops (at most K - 1 times).
 class KMeansTracker {
  public:
+  /// As a frame-graph buffer (KMeansStage's history, brdf/buffers.h).
+  static constexpr const char* type_name = "KMeansTracker";
   explicit KMeansTracker(KMeansOptions options = {}, std::uint64_t seed = 1, int random_every = 5)
       : options_(options), rng_(seed), random_every_(random_every) {}
   /// Clusters this frame's points (clamped features).

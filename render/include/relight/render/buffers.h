@@ -4,6 +4,7 @@
 #include "relight/core/buffer_name.h"
 #include "relight/render/differential_images.h"
 #include "relight/render/dir/gbuffer.h"
+#include "relight/render/dir/temporal_smoothing.h"
 #include "relight/render/scene/mr_scene.h"
 #include "relight/render/scene/virtual_model.h"
 #include "relight/render/vpl/vpl.h"
@@ -16,5 +17,8 @@ inline constexpr BufferName<VplSet> kVpls{"vpls"};
 inline constexpr BufferName<DifferentialImages> kDirImages{"dir_images"};
 inline constexpr BufferName<GBuffer> kDirGBuffer{"dir_gbuffer"};
 inline constexpr BufferName<CoverageImage> kVirtualCoverage{"virtual_coverage"};
+/// The indirect light's temporal smoothing state (G-buffer, camera, indirect light of the last
+/// frame), a history the graph keeps.
+inline constexpr BufferName<TemporalHistory> kIndirectHistory{"indirect_history"};
 
 }  // namespace relight::render

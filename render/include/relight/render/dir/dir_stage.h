@@ -26,8 +26,9 @@
 //                            writes RadianceImage "L_rv", "L_r", "L_rv_indirect" (the VPL part
 //                                   of L_rv) and CoverageImage "virtual_coverage", the indirect
 //                                   light smoothed over time (temporal_smoothing.h, eq.
-//                                   5.11-5.15) with the stage's own history of the last frame
-//                                   (G-buffer, camera, indirect light); unchanged when off
+//                                   5.11-5.15); with it on, also TemporalHistory
+//                                   "indirect_history" (G-buffer, camera, indirect light), whose
+//                                   previous frame's version it reads; unchanged when off
 //   differential_composite   reads  ColorImage "color", RadianceImage "L_rv", "L_r",
 //                                   CoverageImage "virtual_coverage"
 //                            writes ColorImage "composite" (composite.h, eq. 5.1)
@@ -175,10 +176,11 @@ class IndirectSmoothingStage final : public Stage {
  private:
   bool enabled_;
   TemporalOptions options_;
-  std::optional<TemporalHistory> history_;
   Read<DifferentialImages> images_;
   Read<GBuffer> gbuffer_;
   Read<FrameInfo> frame_;
+  ReadPrevious<TemporalHistory> previous_history_;
+  Write<TemporalHistory> history_;
   Write<RadianceImage> real_virtual_;
   Write<RadianceImage> real_;
   Write<RadianceImage> indirect_;

@@ -34,6 +34,7 @@ struct TemporalOptions {
 };
 
 struct TemporalHistory {
+  static constexpr const char* type_name = "TemporalHistory";
   MrCamera camera;
   PositionMap positions;  ///< world frame; (0,0,0) where nothing was seen
   NormalMap normals;
