@@ -110,8 +110,7 @@ void FrameGraph::validate_writers() {
 }
 
 void FrameGraph::validate_readers() {
-  for (std::size_t stage_index = 0; stage_index < stages_.size(); ++stage_index) {
-    const auto& entry = stages_[stage_index];
+  for (const auto& entry : stages_) {
     for (const auto& decl : entry.declarations) {
       if (decl.access == detail::Access::Write) continue;
       auto& buffer = buffers_[decl.buffer];
@@ -125,13 +124,8 @@ void FrameGraph::validate_readers() {
                          ", but stage '" + stages_[*buffer.writer].name + "' writes it as " + buffer.type->name);
       }
       if (decl.access == detail::Access::ReadPrevious) buffer.has_history_reader = true;
-      // A Vulkan stage's own state across frames (its history of a host type, e.g. K-means'
-      // tracker) stays on the host; everything else it reads must be able to reach the device.
-      const bool own_history = decl.access == detail::Access::ReadPrevious && buffer.writer == stage_index;
-      if (entry.stage->backend() == Backend::Vulkan && !decl.type.device_mirrorable && !own_history) {
-        throw GraphError("Vulkan stage '" + entry.name + "' reads buffer '" + buffer.name + "' of type " +
-                         decl.type.name + ", which cannot be mirrored on the device");
-      }
+      // A Vulkan stage may read host-only buffers (frame info, poses, its own state across
+      // frames) on the host; device_read accepts only mirrorable types, at compile time.
     }
     if (entry.stage->backend() == Backend::Vulkan && device_ == nullptr) {
       throw GraphError("stage '" + entry.name + "' runs on Vulkan but the graph has no Vulkan device");
@@ -402,6 +396,26 @@ DeviceBuffer& StageContext::device_for_read(BufferId id) {
     version.device_fresh = true;
   }
   return *version.device;
+}
+
+detail::AnyBuffer* StageContext::host_previous_without_sync(BufferId id) {
+  check_declared(id, detail::Access::ReadPrevious);
+  auto& buffer = graph_.buffers_[id];
+  return buffer.previous_valid ? buffer.previous.host.get() : nullptr;
+}
+
+DeviceBuffer* StageContext::device_for_previous(BufferId id) {
+  check_declared(id, detail::Access::ReadPrevious);
+  auto& buffer = graph_.buffers_[id];
+  if (!buffer.previous_valid) return nullptr;
+  auto& version = buffer.previous;
+  if (!version.device_fresh) {
+    const auto bytes = version.host->mutable_bytes();
+    ensure_device_size(*graph_.device_, version.device, bytes.size());
+    graph_.device_->upload(bytes, *version.device);
+    version.device_fresh = true;
+  }
+  return version.device.get();
 }
 
 DeviceBuffer& StageContext::device_for_write(BufferId id) {

@@ -552,31 +552,27 @@ void DepthWarpMergeStageBase::declare(StageBuilder& builder) {
   weight_ = builder.write(kDepthWeight);
 }
 
-void DepthWarpMergeStageBase::run(StageContext& context) {
+Pose DepthWarpMergeStageBase::current_from_previous(StageContext& context) {
   const FrameInfo& frame = context.get(frame_);
-  const DepthMap* previous_depth = context.get(previous_depth_);
-  const DepthWeightMap* previous_weight = context.get(previous_weight_);
   const FrameInfo* previous_frame = context.get(previous_frame_);
-  const DepthMap& depth = context.get(depth_);
-  const bool usable = previous_depth && previous_weight && previous_depth->same_shape(depth);
   const Pose current = frame.camera_to_world.value_or(Pose::Identity());
   const Pose previous =
       previous_frame && previous_frame->camera_to_world ? *previous_frame->camera_to_world : Pose::Identity();
-  warp_and_merge(context, depth, usable ? previous_depth : nullptr, usable ? previous_weight : nullptr,
-                 frame.intrinsics, current.inverse() * previous, context.get(filtered_), context.get(weight_));
+  return current.inverse() * previous;
 }
 
-void DepthWarpMergeCpuStage::warp_and_merge(StageContext&, const DepthMap& depth, const DepthMap* previous_depth,
-                                            const DepthWeightMap* previous_weight, const PinholeIntrinsics& intrinsics,
-                                            const Pose& current_from_prev, DepthMap& merged,
-                                            DepthWeightMap& merged_weight) {
-  if (previous_depth) {
-    warp_depth(*previous_depth, *previous_weight, intrinsics, current_from_prev, options(), warped_, warped_weight_);
+void DepthWarpMergeCpuStage::run(StageContext& context) {
+  const DepthMap* previous_depth = context.get(previous_depth_);
+  const DepthWeightMap* previous_weight = context.get(previous_weight_);
+  const DepthMap& depth = context.get(depth_);
+  if (previous_depth && previous_weight && previous_depth->same_shape(depth)) {
+    warp_depth(*previous_depth, *previous_weight, context.get(frame_).intrinsics, current_from_previous(context),
+               options(), warped_, warped_weight_);
   } else {
     warped_.resize(0, 0);
     warped_weight_.resize(0, 0);
   }
-  merge_depth(depth, warped_, warped_weight_, options(), merged, merged_weight);
+  merge_depth(depth, warped_, warped_weight_, options(), context.get(filtered_), context.get(weight_));
 }
 
 }  // namespace relight

@@ -2,6 +2,8 @@
 // weights, merge, in one submission with a barrier between the passes.
 #include "relight/reconstruct/depth_warp_merge_vk.h"
 
+#include <optional>
+
 #include "relight/reconstruct/depth_warp_merge_shared.h"
 #include "relight/shaders/depth_merge_comp.h"
 #include "relight/shaders/depth_warp_comp.h"
@@ -26,8 +28,24 @@ struct DepthWarpMergeVk::Pipelines {
   vk::GpuTimer timer;
 };
 
+/// Device buffers kept across frames (remade only when the frame size changes): the warp's
+/// z-buffer and weights, a stand-in bound where there is no history, and the maps of the host API.
+struct DepthWarpMergeVk::Scratch {
+  std::optional<vk::VulkanBuffer> zbuffer, warped_weight, no_history;
+  std::optional<vk::VulkanBuffer> depth, previous_depth, previous_weight, merged, merged_weight;
+};
+
+namespace {
+
+vk::VulkanBuffer& sized(std::optional<vk::VulkanBuffer>& buffer, const vk::VulkanContext& context, std::size_t bytes) {
+  if (!buffer || buffer->size_bytes() != bytes) buffer.emplace(context, bytes);
+  return *buffer;
+}
+
+}  // namespace
+
 DepthWarpMergeVk::DepthWarpMergeVk(vk::VulkanContext& context)
-    : context_(context), pipelines_(std::make_unique<Pipelines>(context)) {}
+    : context_(context), pipelines_(std::make_unique<Pipelines>(context)), scratch_(std::make_unique<Scratch>()) {}
 
 DepthWarpMergeVk::~DepthWarpMergeVk() = default;
 
@@ -43,12 +61,33 @@ void DepthWarpMergeVk::run(const DepthMap& depth, const DepthMap* previous_depth
   const bool has_weight = history && previous_weight && previous_weight->same_shape(depth);
   const std::size_t bytes = depth.bytes().size();
   vk::VulkanTransfer& transfer = context_.transfer();
-  vk::VulkanBuffer depth_buffer(context_, bytes), previous_buffer(context_, bytes), previous_weight_buffer(context_, bytes);
-  vk::VulkanBuffer zbuffer(context_, bytes), warped_weight(context_, bytes);
-  vk::VulkanBuffer merged_buffer(context_, bytes), merged_weight_buffer(context_, bytes);
-  transfer.upload(depth.bytes(), depth_buffer);
-  if (history) transfer.upload(previous_depth->bytes(), previous_buffer);
-  if (has_weight) transfer.upload(previous_weight->bytes(), previous_weight_buffer);
+  Scratch& s = *scratch_;
+  transfer.upload(depth.bytes(), sized(s.depth, context_, bytes));
+  if (history) transfer.upload(previous_depth->bytes(), sized(s.previous_depth, context_, bytes));
+  if (has_weight) transfer.upload(previous_weight->bytes(), sized(s.previous_weight, context_, bytes));
+  run(*s.depth, history ? &*s.previous_depth : nullptr, has_weight ? &*s.previous_weight : nullptr, width, height,
+      intrinsics, current_from_prev, options, sized(s.merged, context_, bytes),
+      sized(s.merged_weight, context_, bytes));
+  transfer.download(*s.merged, merged.bytes());
+  transfer.download(*s.merged_weight, merged_weight.bytes());
+}
+
+void DepthWarpMergeVk::run(const vk::VulkanBuffer& depth, const vk::VulkanBuffer* previous_depth,
+                           const vk::VulkanBuffer* previous_weight, int width, int height,
+                           const PinholeIntrinsics& intrinsics, const Pose& current_from_prev,
+                           const DepthWarpMergeOptions& options, vk::VulkanBuffer& merged,
+                           vk::VulkanBuffer& merged_weight) {
+  last_gpu_ms_.reset();
+  const std::size_t bytes = static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * sizeof(float);
+  if (bytes == 0) return;
+  const bool history = previous_depth != nullptr;
+  const bool has_weight = history && previous_weight != nullptr;
+  Scratch& s = *scratch_;
+  vk::VulkanBuffer& zbuffer = sized(s.zbuffer, context_, bytes);
+  vk::VulkanBuffer& warped_weight = sized(s.warped_weight, context_, bytes);
+  // Bound where a map is missing; the shaders do not read it then (no history: only the clear
+  // pass runs; no weights: has_weight = 0).
+  vk::VulkanBuffer& unused = sized(s.no_history, context_, bytes);
 
   gpu::DepthWarpParams warp{};
   warp.width = static_cast<gpu::uint>(width);
@@ -68,8 +107,9 @@ void DepthWarpMergeVk::run(const DepthMap& depth, const DepthMap* previous_depth
   constexpr std::uint32_t local = RELIGHT_DEPTH_WARP_LOCAL_SIZE;
   const std::uint32_t groups_x = vk::ComputePipeline::group_count(warp.width, local);
   const std::uint32_t groups_y = vk::ComputePipeline::group_count(warp.height, local);
-  const auto warp_set = p.warp.bind({&previous_buffer, &previous_weight_buffer, &zbuffer, &warped_weight});
-  const auto merge_set = p.merge.bind({&depth_buffer, &zbuffer, &warped_weight, &merged_buffer, &merged_weight_buffer});
+  const auto warp_set = p.warp.bind(
+      {history ? previous_depth : &unused, has_weight ? previous_weight : &unused, &zbuffer, &warped_weight});
+  const auto merge_set = p.merge.bind({&depth, &zbuffer, &warped_weight, &merged, &merged_weight});
   context_.submit([&](VkCommandBuffer cmd) {
     p.timer.start(cmd);
     warp.mode = RELIGHT_DEPTH_WARP_CLEAR;
@@ -86,15 +126,22 @@ void DepthWarpMergeVk::run(const DepthMap& depth, const DepthMap* previous_depth
     p.timer.stop(cmd);
   });
   last_gpu_ms_ = p.timer.elapsed_ms();
-  transfer.download(merged_buffer, merged.bytes());
-  transfer.download(merged_weight_buffer, merged_weight.bytes());
 }
 
-void DepthWarpMergeVkStage::warp_and_merge(StageContext& context, const DepthMap& depth, const DepthMap* previous_depth,
-                                           const DepthWeightMap* previous_weight, const PinholeIntrinsics& intrinsics,
-                                           const Pose& current_from_prev, DepthMap& merged,
-                                           DepthWeightMap& merged_weight) {
-  method_.run(depth, previous_depth, previous_weight, intrinsics, current_from_prev, options(), merged, merged_weight);
+void DepthWarpMergeVkStage::run(StageContext& context) {
+  const DepthMap& depth_shape = context.shape_of(depth_);
+  const int width = depth_shape.width(), height = depth_shape.height();
+  const DepthMap* previous_shape = context.shape_of(previous_depth_);
+  const DepthWeightMap* previous_weight_shape = context.shape_of(previous_weight_);
+  const bool usable = previous_shape && previous_weight_shape && previous_shape->same_shape(depth_shape);
+  const vk::VulkanBuffer* previous_depth = usable ? context.device_read<vk::VulkanBuffer>(previous_depth_) : nullptr;
+  const vk::VulkanBuffer* previous_weight = usable ? context.device_read<vk::VulkanBuffer>(previous_weight_) : nullptr;
+  const vk::VulkanBuffer& depth = context.device_read<vk::VulkanBuffer>(depth_);
+  auto& merged = context.device_write<vk::VulkanBuffer>(filtered_, [&](DepthMap& d) { d.resize(width, height); });
+  auto& merged_weight =
+      context.device_write<vk::VulkanBuffer>(weight_, [&](DepthWeightMap& w) { w.resize(width, height); });
+  method_.run(depth, previous_depth, previous_weight, width, height, context.get(frame_).intrinsics,
+              current_from_previous(context), options(), merged, merged_weight);
   if (const auto ms = method_.last_gpu_ms()) context.report_device_ms(*ms);
 }
 

@@ -92,5 +92,24 @@ TEST_F(DepthWarpMergeVkTest, StageIsADropInForTheCpuStage) {
   EXPECT_GE(close, compared * 98 / 100);  // four frames of each backend's own history
 }
 
+// The history (filtered depth and weight) stays on the device, and after the first two frames
+// (one without history, one that fills the second half of the graph's double buffer) no frame
+// allocates device memory: the stage's scratch and the graph's buffers are reused.
+TEST_F(DepthWarpMergeVkTest, ASteadyRunAllocatesNoDeviceMemory) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const auto sequence = test::render_sequence(synth::Trajectory::Orbit, 10, 80, 60, {}, 5);
+  FrameGraph graph(&context.transfer());
+  graph.emplace<test::SequenceSource>(sequence);
+  graph.emplace<DepthWarpMergeVkStage>(context);
+  graph.keep("depth_filtered");
+  graph.compile();
+  const std::uint64_t before = context.memory_allocations();
+  std::vector<std::uint64_t> allocations;
+  while (graph.run_frame()) allocations.push_back(context.memory_allocations());
+  ASSERT_EQ(allocations.size(), 10u);
+  EXPECT_GT(allocations.front(), before);  // the first frame did allocate (the count works)
+  EXPECT_EQ(allocations.back(), allocations[1]) << "device memory allocated in frames 3-10";
+}
+
 }  // namespace
 }  // namespace relight

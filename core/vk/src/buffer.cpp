@@ -53,6 +53,7 @@ VulkanBuffer::VulkanBuffer(const VulkanContext& context, std::size_t bytes, Buff
   allocate.memoryTypeIndex = type;
   VkDeviceMemory memory = VK_NULL_HANDLE;
   RELIGHT_VK_CHECK(vkAllocateMemory(device, &allocate, nullptr, &memory));
+  context.count_memory_allocation();
   memory_ = UniqueMemory(device, memory);
   RELIGHT_VK_CHECK(vkBindBufferMemory(device, buffer, memory, 0));
 

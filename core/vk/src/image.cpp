@@ -32,6 +32,7 @@ VulkanImage::VulkanImage(const VulkanContext& context, std::uint32_t width, std:
   allocate.memoryTypeIndex = context.find_memory_type(requirements.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
   VkDeviceMemory memory = VK_NULL_HANDLE;
   RELIGHT_VK_CHECK(vkAllocateMemory(device, &allocate, nullptr, &memory));
+  context.count_memory_allocation();
   memory_ = UniqueMemory(device, memory);
   RELIGHT_VK_CHECK(vkBindImageMemory(device, image, memory, 0));
 

@@ -175,6 +175,20 @@ class StageContext {
   [[nodiscard]] D& device_read(Read<T> handle) {
     return device_cast<D>(device_for_read(handle.id));
   }
+  /// Device copy of the previous frame's version of a buffer (device-resident history: the graph
+  /// keeps both frames' device buffers and swaps them, uploading only when the previous version
+  /// exists on the host alone); nullptr when there is no previous frame.
+  template <class D, DeviceMirrorable T>
+  [[nodiscard]] D* device_read(ReadPrevious<T> handle) {
+    DeviceBuffer* previous = device_for_previous(handle.id);
+    return previous ? &device_cast<D>(*previous) : nullptr;
+  }
+  /// The previous frame's host object for its shape only (never downloads); nullptr as get().
+  template <class T>
+  [[nodiscard]] const T* shape_of(ReadPrevious<T> handle) {
+    detail::AnyBuffer* previous = host_previous_without_sync(handle.id);
+    return previous ? &typed<T>(*previous) : nullptr;
+  }
   /// Device buffer for an output. `shape` sets the host buffer's shape (its contents are filled
   /// by a download only when a CPU stage or the caller later reads it).
   template <class D, DeviceMirrorable T, std::invocable<T&> Shape>
@@ -207,7 +221,9 @@ class StageContext {
   detail::AnyBuffer& host_for_write(BufferId id);
   detail::AnyBuffer& host_for_shape(BufferId id);
   detail::AnyBuffer& host_without_sync(BufferId id);
+  detail::AnyBuffer* host_previous_without_sync(BufferId id);
   DeviceBuffer& device_for_read(BufferId id);
+  DeviceBuffer* device_for_previous(BufferId id);
   DeviceBuffer& device_for_write(BufferId id);
   void check_declared(BufferId id, detail::Access access) const;
 

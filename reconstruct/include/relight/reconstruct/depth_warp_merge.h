@@ -66,16 +66,12 @@ class DepthWarpMergeStageBase : public Stage {
   explicit DepthWarpMergeStageBase(DepthWarpMergeOptions options) : options_(options) {}
   [[nodiscard]] std::string name() const final { return "depth_warp_merge"; }
   void declare(StageBuilder& builder) final;
-  void run(StageContext& context) final;
 
  protected:
-  /// previous_depth and previous_weight are null without usable history.
-  virtual void warp_and_merge(StageContext& context, const DepthMap& depth, const DepthMap* previous_depth,
-                              const DepthWeightMap* previous_weight, const PinholeIntrinsics& intrinsics,
-                              const Pose& current_from_prev, DepthMap& merged, DepthWeightMap& merged_weight) = 0;
   [[nodiscard]] const DepthWarpMergeOptions& options() const { return options_; }
+  /// T_current_from_prev of this frame (identity without poses).
+  [[nodiscard]] Pose current_from_previous(StageContext& context);
 
- private:
   DepthWarpMergeOptions options_;
   Read<DepthMap> depth_;
   Read<FrameInfo> frame_;
@@ -90,11 +86,9 @@ class DepthWarpMergeStageBase : public Stage {
 class DepthWarpMergeCpuStage final : public DepthWarpMergeStageBase {
  public:
   explicit DepthWarpMergeCpuStage(DepthWarpMergeOptions options = {}) : DepthWarpMergeStageBase(options) {}
+  void run(StageContext& context) override;
 
  private:
-  void warp_and_merge(StageContext& context, const DepthMap& depth, const DepthMap* previous_depth,
-                      const DepthWeightMap* previous_weight, const PinholeIntrinsics& intrinsics,
-                      const Pose& current_from_prev, DepthMap& merged, DepthWeightMap& merged_weight) override;
   DepthMap warped_;              // scratch, kept to avoid reallocating every frame
   DepthWeightMap warped_weight_;
 };

@@ -15,6 +15,8 @@
 // batching several stages into one submission is a later optimisation.
 #include <vulkan/vulkan.h>
 
+#include <atomic>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -63,6 +65,12 @@ class VulkanContext {
   [[nodiscard]] const VkPhysicalDeviceProperties& properties() const { return properties_; }
   [[nodiscard]] const VkPhysicalDeviceMemoryProperties& memory_properties() const { return memory_properties_; }
 
+  /// Device memory allocations made through this context so far (every VulkanBuffer and
+  /// VulkanImage makes one): what the tests count to show that a steady run allocates nothing.
+  [[nodiscard]] std::uint64_t memory_allocations() const { return memory_allocations_.load(); }
+  /// Called by VulkanBuffer and VulkanImage for each vkAllocateMemory.
+  void count_memory_allocation() const { ++memory_allocations_; }
+
   /// The queue submit() uses: a family with compute (and graphics where one has both).
   [[nodiscard]] VkQueue compute_queue() const { return compute_queue_; }
   [[nodiscard]] std::uint32_t compute_queue_family() const { return compute_family_; }
@@ -97,6 +105,7 @@ class VulkanContext {
   [[nodiscard]] VulkanTransfer& transfer() { return *transfer_; }
 
  private:
+  mutable std::atomic<std::uint64_t> memory_allocations_{0};
   void create_instance(bool want_validation);
   void pick_physical_device(const std::string& selector);
   void create_device();
