@@ -376,7 +376,13 @@ int run_replay(const ReplayOptions& options) {
   ProgressBar progress("replay", total, options.quiet);
   const auto start = std::chrono::steady_clock::now();
   const auto view_quit = [&pipeline] { return pipeline.view && pipeline.view->quit_requested(); };
-  while (!InterruptGuard::interrupted() && !view_quit() && graph.run_frame()) progress.update(graph.frames_run());
+  // Device memory allocations after the first two frames (a steady run should need none: every
+  // stage keeps its device buffers, the graph double-buffers history).
+  std::uint64_t allocations_at_frame_2 = 0;
+  while (!InterruptGuard::interrupted() && !view_quit() && graph.run_frame()) {
+    progress.update(graph.frames_run());
+    if (pipeline.vulkan && graph.frames_run() == 2) allocations_at_frame_2 = pipeline.vulkan->memory_allocations();
+  }
   progress.finish();
   graph.finish();
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -387,6 +393,12 @@ int run_replay(const ReplayOptions& options) {
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
   report["stopped_by"] = interrupted ? "interrupt" : quit_from_view ? "view" : "end";
+  if (pipeline.vulkan) {
+    const std::uint64_t allocations = pipeline.vulkan->memory_allocations();
+    report["device_memory"] = {
+        {"allocations", allocations},
+        {"allocations_after_frame_2", graph.frames_run() > 2 ? allocations - allocations_at_frame_2 : 0}};
+  }
   add_pipeline_summaries(report, pipeline, options);
   write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
   if (interrupted) {

@@ -31,8 +31,26 @@ struct NormalsRawDepthVk::Pipelines {
   vk::GpuTimer timer;
 };
 
+/// Device buffers kept across frames, remade only when a size changes: a steady run allocates
+/// no device memory.
+struct NormalsRawDepthVk::Scratch {
+  std::optional<vk::VulkanBuffer> depth, positions, normals, blended, previous_positions, pyramid, curvature;
+};
+
+namespace {
+
+vk::VulkanBuffer& sized(std::optional<vk::VulkanBuffer>& buffer, const vk::VulkanContext& context, std::size_t bytes) {
+  if (!buffer || buffer->size_bytes() != bytes) buffer.emplace(context, bytes);
+  return *buffer;
+}
+
+}  // namespace
+
 NormalsRawDepthVk::NormalsRawDepthVk(vk::VulkanContext& context)
-    : context_(context), cross_(context), pipelines_(std::make_unique<Pipelines>(context)) {}
+    : context_(context),
+      cross_(context),
+      pipelines_(std::make_unique<Pipelines>(context)),
+      scratch_(std::make_unique<Scratch>()) {}
 
 NormalsRawDepthVk::~NormalsRawDepthVk() = default;
 
@@ -46,10 +64,11 @@ void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intr
   if (depth.empty()) return;
   const std::size_t map_bytes = positions.bytes().size();
   vk::VulkanTransfer& transfer = context_.transfer();
-  vk::VulkanBuffer depth_buffer(context_, depth.bytes().size());
-  vk::VulkanBuffer position_buffer(context_, map_bytes);
-  vk::VulkanBuffer normal_buffer(context_, map_bytes);
-  vk::VulkanBuffer blended_buffer(context_, map_bytes);
+  Scratch& scratch = *scratch_;
+  vk::VulkanBuffer& depth_buffer = sized(scratch.depth, context_, depth.bytes().size());
+  vk::VulkanBuffer& position_buffer = sized(scratch.positions, context_, map_bytes);
+  vk::VulkanBuffer& normal_buffer = sized(scratch.normals, context_, map_bytes);
+  vk::VulkanBuffer& blended_buffer = sized(scratch.blended, context_, map_bytes);
   transfer.upload(depth.bytes(), depth_buffer);
   std::optional<double> total =
       cross_.run(depth_buffer, position_buffer, normal_buffer, width, height, intrinsics,
@@ -58,18 +77,17 @@ void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intr
   const bool usable_history = previous && previous->normals.same_shape(depth) && previous->positions.same_shape(depth);
   // Without history the blend is the identity: let the fill pass read the fresh normals directly.
   const vk::VulkanBuffer* fill_input = &normal_buffer;
-  std::optional<vk::VulkanBuffer> previous_positions, pyramid_buffer, curvature_buffer;
   if (usable_history) {
     const std::vector<NormalsPyramidLevel> pyramid =
         normals_history_pyramid(previous->normals, options.mip_levels, options.threads);
     std::vector<Float3> texels;
     for (const auto& level : pyramid) texels.insert(texels.end(), level.normal.pixels().begin(), level.normal.pixels().end());
-    previous_positions.emplace(context_, map_bytes);
-    pyramid_buffer.emplace(context_, texels.size() * sizeof(Float3));
-    curvature_buffer.emplace(context_, pyramid.front().curvature.bytes().size());
-    transfer.upload(previous->positions.bytes(), *previous_positions);
-    transfer.upload(std::as_bytes(std::span<const Float3>(texels)), *pyramid_buffer);
-    transfer.upload(pyramid.front().curvature.bytes(), *curvature_buffer);
+    vk::VulkanBuffer& previous_positions = sized(scratch.previous_positions, context_, map_bytes);
+    vk::VulkanBuffer& pyramid_buffer = sized(scratch.pyramid, context_, texels.size() * sizeof(Float3));
+    vk::VulkanBuffer& curvature_buffer = sized(scratch.curvature, context_, pyramid.front().curvature.bytes().size());
+    transfer.upload(previous->positions.bytes(), previous_positions);
+    transfer.upload(std::as_bytes(std::span<const Float3>(texels)), pyramid_buffer);
+    transfer.upload(pyramid.front().curvature.bytes(), curvature_buffer);
 
     // The same float matrices as the CPU's Rigid (pose in double, rounded per element).
     const Pose prev_from_current = previous->camera_to_world.inverse() * camera_to_world;
@@ -90,7 +108,7 @@ void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intr
     params.levels = static_cast<gpu::uint>(pyramid.size());
     constexpr std::uint32_t local = RELIGHT_NORMALS_BLEND_LOCAL_SIZE;
     const auto set = pipelines_->blend.bind(
-        {&position_buffer, &normal_buffer, &*previous_positions, &*pyramid_buffer, &*curvature_buffer, &blended_buffer});
+        {&position_buffer, &normal_buffer, &previous_positions, &pyramid_buffer, &curvature_buffer, &blended_buffer});
     context_.submit([&](VkCommandBuffer cmd) {
       pipelines_->timer.start(cmd);
       pipelines_->blend.dispatch(cmd, set, params, vk::ComputePipeline::group_count(params.width, local),

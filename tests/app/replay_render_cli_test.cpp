@@ -188,3 +188,25 @@ TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
 
 }  // namespace
 }  // namespace relight
+
+namespace relight {
+namespace {
+
+// With every stage that can on the Vulkan device, the main job (the pebble on the sample's desk)
+// allocates device memory only in its first two frames: stages keep their device buffers, the
+// graph keeps history on the device, and buffers whose size changes every frame (the
+// reconstruction mesh, ISM points, K-means points) grow with headroom. report.json says so.
+TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
+  TempDir dir;
+  const auto out = dir.path() / "out";
+  const auto result = relight("replay --quiet --backend vulkan --loop 3 --no-video --no-frames --out " + out.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
+  ASSERT_TRUE(report.contains("device_memory")) << report.dump(2);
+  EXPECT_EQ(report["frames"].get<int>(), 12);
+  EXPECT_GT(report["device_memory"]["allocations"].get<int>(), 10);
+  EXPECT_EQ(report["device_memory"]["allocations_after_frame_2"].get<int>(), 0);
+}
+
+}  // namespace
+}  // namespace relight

@@ -96,7 +96,7 @@ void GBufferVk::set_scene(const MrScene& scene, std::optional<Layer> only) {
   const detail::MeshLayers layers = !only                 ? detail::MeshLayers::All
                                     : *only == Layer::Real ? detail::MeshLayers::Real
                                                            : detail::MeshLayers::Virtual;
-  impl_->vertices = detail::upload_scene_vertices(impl_->context, scene, layers);
+  detail::upload_scene_vertices(impl_->context, scene, layers, impl_->vertices);
 }
 
 std::size_t GBufferVk::packed_bytes(int width, int height) {

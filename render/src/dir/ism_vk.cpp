@@ -56,8 +56,10 @@ void IsmVk::set_points(const IsmPointPools& points) {
   real_points_ = static_cast<std::uint32_t>(points.real.size());
   virtual_bounds_ = points.virtual_bounds;
   virtual_points_ = static_cast<std::uint32_t>(points.virtual_points.size());
-  points_ = std::make_unique<vk::VulkanBuffer>(context_, std::max<std::size_t>(packed.size(), 8) * sizeof(float),
-                                               vk::BufferDomain::Device);
+  // Kept while large enough, grown with headroom: the points change in number every frame.
+  const std::size_t bytes = std::max<std::size_t>(packed.size(), 8) * sizeof(float);
+  if (!points_ || points_->size_bytes() < bytes)
+    points_ = std::make_unique<vk::VulkanBuffer>(context_, bytes + bytes / 4, vk::BufferDomain::Device);
   if (!packed.empty()) context_.transfer().upload(std::as_bytes(std::span(packed)), *points_);
 }
 

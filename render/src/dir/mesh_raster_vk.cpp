@@ -10,7 +10,7 @@
 
 namespace relight::render::detail {
 
-SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers) {
+void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers, SceneVertices& out) {
   scene.validate();
   std::vector<RasterVertex> vertices;
   for (const TriangleMesh& mesh : scene.meshes) {
@@ -28,12 +28,13 @@ SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& s
       }
     }
   }
-  SceneVertices out;
-  out.buffer = std::make_unique<vk::VulkanBuffer>(context, std::max<std::size_t>(4, vertices.size() * sizeof(RasterVertex)),
-                                                  vk::BufferDomain::Upload, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  const std::size_t bytes = std::max<std::size_t>(4, vertices.size() * sizeof(RasterVertex));
+  if (!out.buffer || out.buffer->size_bytes() < bytes) {
+    out.buffer = std::make_unique<vk::VulkanBuffer>(context, bytes + bytes / 4, vk::BufferDomain::Upload,
+                                                    VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  }
   if (!vertices.empty()) out.buffer->write(std::as_bytes(std::span(vertices)));
   out.count = static_cast<std::uint32_t>(vertices.size());
-  return out;
 }
 
 vk::UniqueRenderPass create_raster_pass(VkDevice device, std::span<const VkFormat> colour_formats, VkFormat depth_format) {

@@ -35,9 +35,12 @@ struct SceneVertices {
 
 enum class MeshLayers { All, Real, Virtual };
 
-/// The triangles of `scene` in `layers`; meshes without vertex normals get their face normal.
-[[nodiscard]] SceneVertices upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene,
-                                                  MeshLayers layers = MeshLayers::All);
+/// The triangles of `scene` in `layers` into `vertices`; meshes without vertex normals get their
+/// face normal. The buffer is kept when it is large enough and grows with headroom, so that the
+/// reconstruction mesh, whose size changes every frame, needs no allocation in a steady run.
+/// The previous frame's draws must have completed (submissions wait).
+void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers,
+                           SceneVertices& vertices);
 
 /// Colour targets cleared and left in TRANSFER_SRC_OPTIMAL for a copy to a buffer; depth cleared
 /// and discarded.

@@ -31,8 +31,8 @@ ShadowMapsVk::ShadowMapsVk(vk::VulkanContext& context)
                                                         .position_only = true})) {}
 
 void ShadowMapsVk::set_scene(const MrScene& scene) {
-  real_vertices_ = upload_scene_vertices(context_, scene, MeshLayers::Real);
-  virtual_vertices_ = upload_scene_vertices(context_, scene, MeshLayers::Virtual);
+  upload_scene_vertices(context_, scene, MeshLayers::Real, real_vertices_);
+  upload_scene_vertices(context_, scene, MeshLayers::Virtual, virtual_vertices_);
 }
 
 void ShadowMapsVk::ensure_targets(int width, int height) {

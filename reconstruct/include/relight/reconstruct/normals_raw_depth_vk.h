@@ -41,9 +41,11 @@ class NormalsRawDepthVk {
 
  private:
   struct Pipelines;
+  struct Scratch;
   vk::VulkanContext& context_;
   CrossNormalsVk cross_;
   std::unique_ptr<Pipelines> pipelines_;
+  std::unique_ptr<Scratch> scratch_;
   std::optional<double> last_gpu_ms_;
 };
 
