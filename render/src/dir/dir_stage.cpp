@@ -170,6 +170,11 @@ void DirRenderStage::run(StageContext& context) {
     renderer_->set_scene(scene, options_);
     images = renderer_->render(camera, vpls, options_);
     gbuffer = renderer_->last_gbuffer();
+    // The GPU time of the steps that ran on the device (timestamps; none on devices without them).
+    const DirVkTimings& t = renderer_->last_timings();
+    const double gpu_ms =
+        t.gbuffer_ms + t.shadow_maps_ms + t.ism_ms + (t.cpu_shading ? 0.0 : t.shading_ms + t.merge_ms);
+    if (gpu_ms > 0.0) context.report_device_ms(gpu_ms);
   }
   if (albedo_buffers_) {
     modulate_camera_albedo(images, gbuffer, scene, context.get(albedo_), context.get(albedo_valid_));
