@@ -90,9 +90,18 @@ void NormalsFromPositionsVkStage::declare(StageBuilder& builder) {
 }
 
 void NormalsFromPositionsVkStage::run(StageContext& context) {
-  cross_.run(context.get(depth_), context.get(frame_).intrinsics, options_, context.get(positions_),
-             context.get(normals_));
-  if (const auto ms = cross_.last_gpu_ms()) context.report_device_ms(*ms);
+  // All three maps stay on the device: after method 2's Vulkan warp and merge the merged depth is
+  // already there, and the graph downloads positions and normals only for a CPU reader.
+  const DepthMap& shape = context.shape_of(depth_);
+  const int width = shape.width(), height = shape.height();
+  const auto& depth = context.device_read<vk::VulkanBuffer>(depth_);
+  auto& positions =
+      context.device_write<vk::VulkanBuffer>(positions_, [&](PositionMap& p) { p.resize(width, height); });
+  auto& normals = context.device_write<vk::VulkanBuffer>(normals_, [&](NormalMap& n) { n.resize(width, height); });
+  if (width > 0 && height > 0) {
+    cross_.run(depth, positions, normals, width, height, context.get(frame_).intrinsics, options_);
+    if (const auto ms = cross_.last_gpu_ms()) context.report_device_ms(*ms);
+  }
 }
 
 }  // namespace relight

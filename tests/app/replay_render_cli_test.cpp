@@ -217,6 +217,16 @@ TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
     }
     EXPECT_TRUE(found) << name;
   }
+  // Method 2 on the device: warp and merge keep depth and weight as device history, and the
+  // plain normals read the merged depth where it already is.
+  const auto method2 = dir.path() / "method2";
+  ASSERT_EQ(relight("replay --quiet --backend vulkan --no-object --geometry method2 --method2-normals plain --loop 3 "
+                    "--no-video --no-frames --out " +
+                    method2.string())
+                .exit_code,
+            0);
+  const auto method2_report = nlohmann::json::parse(read_text_file(method2 / "report.json"));
+  EXPECT_EQ(method2_report["device_memory"]["allocations_after_frame_2"].get<int>(), 0);
 }
 
 }  // namespace

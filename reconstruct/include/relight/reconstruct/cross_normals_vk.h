@@ -62,12 +62,14 @@ class CrossNormalsVk {
 
 /// Method 2's normal stage on Vulkan, a drop-in for NormalsFromPositionsCpuStage (same name and
 /// buffers: reads DepthMap "depth_filtered" and FrameInfo "frame", writes PositionMap "positions"
-/// and NormalMap "normals"), on the graph's host buffers with its own upload and download.
+/// and NormalMap "normals"), on the graph's device buffers (backend() Vulkan): the graph moves
+/// data only where the other side needs it.
 class NormalsFromPositionsVkStage final : public Stage {
  public:
   explicit NormalsFromPositionsVkStage(vk::VulkanContext& context, CrossNormalOptions options = {})
       : cross_(context), options_(options) {}
   [[nodiscard]] std::string name() const override { return "normals_from_positions"; }
+  [[nodiscard]] Backend backend() const override { return Backend::Vulkan; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
