@@ -5,7 +5,7 @@
 // device drops frames meanwhile, and the overlay counts them).
 //
 // Reads: the picture (ColorImage: the final composite, or "color" when nothing renders), the
-//        side buffer when given (BufferPreviews' kinds), "camera_pose" (CameraPose),
+//        side buffer when given (a PreviewBuffer, drawn by its type), "camera_pose" (CameraPose),
 //        "source_frame" (FrameInfo: the frame index).
 #include <array>
 #include <chrono>
