@@ -116,6 +116,9 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_flag("--buffers", options.write_buffers,
                    "Also write L_rv, L_r and (with colour mapping) delta_L per frame as EXR under frames/");
   command.add_flag("!--no-video", options.video, "Do not write composite.mp4");
+}
+
+void add_view_options(CLI::App& command, ReplayOptions& options) {
   command.add_flag("--view", options.view,
                    "Show the final picture in a window as it is made, with fps, tracking state and dropped frames; "
                    "keys: q quit, space pause, s snapshot (to DIR/snapshots/)");
@@ -158,6 +161,7 @@ void register_replay(CLI::App& app) {
   add_pose_options(*replay, *options);
   add_compute_options(*replay, *options);
   add_render_options(*replay, *options);
+  add_view_options(*replay, *options);
   add_no_object_option(*replay, *options);
   registry().runners[replay] = [options] { return run_replay(*options); };
 }
@@ -169,6 +173,7 @@ void register_graph(CLI::App& app) {
   auto options = std::make_shared<ReplayOptions>();
   add_pose_options(*graph, *options);
   add_compute_options(*graph, *options);
+  add_render_options(*graph, *options);  // the graph for any content: --object, --colormap, ...
   add_no_object_option(*graph, *options);
   registry().runners[graph] = [dot, options] {
     ReplayPipeline pipeline = build_replay_pipeline(open_replay_source(*options), *options);

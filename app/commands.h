@@ -19,8 +19,11 @@ void register_render(CLI::App& app, Runners& runners);
 /// `relight devices`, `relight live` and `relight record` (OpenNI2 devices, live_command.cpp).
 void register_live(CLI::App& app, Runners& runners);
 
-/// The options of differential rendering (--object, --place, --lights, ...) shared by replay and live.
+/// The options of differential rendering (--object, --place, --lights, ...) shared by replay,
+/// live and graph.
 void add_render_options(CLI::App& command, ReplayOptions& options);
+/// --view and --view-side (a window on the final picture), shared by replay and live.
+void add_view_options(CLI::App& command, ReplayOptions& options);
 /// --pose auto|sequence|marker|odometry|marker+odometry, shared by replay and live.
 void add_pose_option(CLI::App& command, ReplayOptions& options);
 /// --method2-normals filtered|plain, shared by replay and live.

@@ -312,6 +312,7 @@ void register_live(CLI::App& app, Runners& runners) {
   add_pose_option(*live, live_options->replay);
   add_live_compute_options(*live, live_options->replay);
   add_render_options(*live, live_options->replay);
+  add_view_options(*live, live_options->replay);
   runners[live] = [live_options] { return run_live(*live_options); };
 
   auto record_options = std::make_shared<RecordOptions>();

@@ -221,6 +221,23 @@ TEST(Cli, GraphDotIsAValidGraph) {
   EXPECT_EQ(order.out.rfind("source\n", 0), 0u) << order.out;
 }
 
+// `relight graph` takes replay's rendering options, so it shows the graph of any content: here
+// without colour mapping the mapping stages are gone, and without content no renderer runs.
+TEST(Cli, GraphFollowsTheRenderingOptions) {
+  const auto mapped = relight("graph");
+  ASSERT_EQ(mapped.exit_code, 0) << mapped.err;
+  EXPECT_NE(mapped.out.find("\ndir\n"), std::string::npos) << mapped.out;
+  EXPECT_NE(mapped.out.find("\nmapped_composite\n"), std::string::npos) << mapped.out;
+  const auto unmapped = relight("graph --colormap none");
+  ASSERT_EQ(unmapped.exit_code, 0) << unmapped.err;
+  EXPECT_NE(unmapped.out.find("\ndir\n"), std::string::npos) << unmapped.out;
+  EXPECT_EQ(unmapped.out.find("mapped_composite"), std::string::npos) << unmapped.out;
+  const auto geometry = relight("graph --no-object");
+  ASSERT_EQ(geometry.exit_code, 0) << geometry.err;
+  EXPECT_EQ(geometry.out.find("\ndir\n"), std::string::npos) << geometry.out;
+  EXPECT_NE(relight("graph --view").exit_code, 0);  // a window is replay's and live's, not graph's
+}
+
 TEST(Cli, SynthWritesASequenceThatReplayReads) {
   TempDir dir;
   const auto sequence = dir.path() / "synth";
