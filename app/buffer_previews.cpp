@@ -22,11 +22,11 @@ ColorImage preview(const DepthMap& depth) { return depth_preview(depth); }
 ColorImage preview(const NormalMap& normals) { return normal_preview(normals); }
 ColorImage preview(const render::CoverageImage& coverage) { return coverage_preview(coverage); }
 
-}  // namespace
-
-std::string name_of(const PreviewBuffer& buffer) {
+std::string buffer_name(const PreviewBuffer& buffer) {
   return std::visit([](auto name) { return std::string(name.name()); }, buffer);
 }
+
+}  // namespace
 
 void BufferPreviews::declare(StageBuilder& builder) {
   for (Entry& entry : entries_) std::visit([&](auto name) { entry.handle = builder.read(name); }, entry.buffer);
@@ -35,7 +35,7 @@ void BufferPreviews::declare(StageBuilder& builder) {
 void BufferPreviews::for_each(StageContext& context,
                               const std::function<void(const std::string&, const ColorImage&)>& visit) const {
   for (const Entry& entry : entries_) {
-    const std::string name = name_of(entry.buffer);
+    const std::string name = buffer_name(entry.buffer);
     std::visit(
         [&](auto handle) {
           const auto& image = context.get(handle);

@@ -19,7 +19,6 @@ namespace relight::app {
 /// A buffer that can be drawn, by its typed name.
 using PreviewBuffer = std::variant<BufferName<ColorImage>, BufferName<DepthMap>, BufferName<NormalMap>,
                                    BufferName<render::CoverageImage>>;
-[[nodiscard]] std::string name_of(const PreviewBuffer& buffer);
 
 class BufferPreviews {
  public:

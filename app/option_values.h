@@ -8,28 +8,21 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <type_traits>
 
 #include "relight/core/named_values.h"
 
 namespace relight::app {
 
-template <class E, std::size_t N>
-CLI::Option* add_choice_option(CLI::App& command, const std::string& flag, E& value,
+/// `value` is an E, or a std::optional<E> that stays empty unless the option is given (no default
+/// then).
+template <class Value, class E, std::size_t N>
+CLI::Option* add_choice_option(CLI::App& command, const std::string& flag, Value& value,
                                const std::array<NamedValue<E>, N>& table, const std::string& description) {
   CLI::Option* option = command.add_option_function<std::string>(
       flag, [&value, &table, flag](const std::string& text) { value = parse_named(table, flag, text); }, description);
   option->check(CLI::IsMember(names_of(table)));
-  option->default_str(name_of(table, value));
-  return option;
-}
-
-/// The same for an optional value without a default (absent: the option was not given).
-template <class E, std::size_t N>
-CLI::Option* add_choice_option(CLI::App& command, const std::string& flag, std::optional<E>& value,
-                               const std::array<NamedValue<E>, N>& table, const std::string& description) {
-  CLI::Option* option = command.add_option_function<std::string>(
-      flag, [&value, &table, flag](const std::string& text) { value = parse_named(table, flag, text); }, description);
-  option->check(CLI::IsMember(names_of(table)));
+  if constexpr (std::is_same_v<Value, E>) option->default_str(name_of(table, value));
   return option;
 }
 

@@ -40,6 +40,10 @@ struct FrameGraph::BufferState {
     std::unique_ptr<DeviceBuffer> device;
     bool host_fresh = false;
     bool device_fresh = false;
+    /// The device copy, uploaded first when only the host copy holds the newest data.
+    DeviceBuffer& device_copy(DeviceTransfer& transfer);
+    /// The host copy, downloaded first when only the device copy holds the newest data.
+    detail::AnyBuffer& host_copy(DeviceTransfer* transfer);
   };
   std::string name;
   std::optional<std::size_t> writer;
@@ -318,11 +322,14 @@ std::string FrameGraph::to_dot() const {
   return dot.str();
 }
 
-void FrameGraph::make_host_current(BufferState& buffer) {
-  auto& version = buffer.current;
-  if (version.host_fresh || !version.device_fresh) return;
-  device_->download(*version.device, version.host->mutable_bytes());
-  version.host_fresh = true;
+void FrameGraph::make_host_current(BufferState& buffer) { buffer.current.host_copy(device_); }
+
+detail::AnyBuffer& FrameGraph::BufferState::Version::host_copy(DeviceTransfer* transfer) {
+  if (!host_fresh && device_fresh) {
+    transfer->download(*device, host->mutable_bytes());
+    host_fresh = true;
+  }
+  return *host;
 }
 
 detail::AnyBuffer* FrameGraph::find_host(std::string_view name, std::type_index type) {
@@ -355,13 +362,7 @@ detail::AnyBuffer& StageContext::host_for_read(BufferId id) {
 detail::AnyBuffer* StageContext::host_previous(BufferId id) {
   check_declared(id, detail::Access::ReadPrevious);
   auto& buffer = graph_.buffers_[id];
-  if (!buffer.previous_valid) return nullptr;
-  auto& version = buffer.previous;
-  if (!version.host_fresh && version.device_fresh) {
-    graph_.device_->download(*version.device, version.host->mutable_bytes());
-    version.host_fresh = true;
-  }
-  return version.host.get();
+  return buffer.previous_valid ? &buffer.previous.host_copy(graph_.device_) : nullptr;
 }
 
 detail::AnyBuffer& StageContext::host_for_write(BufferId id) {
@@ -386,16 +387,19 @@ void ensure_device_size(DeviceTransfer& device, std::unique_ptr<DeviceBuffer>& b
 }
 }  // namespace
 
+DeviceBuffer& FrameGraph::BufferState::Version::device_copy(DeviceTransfer& transfer) {
+  if (!device_fresh) {
+    const auto bytes = host->mutable_bytes();
+    ensure_device_size(transfer, device, bytes.size());
+    transfer.upload(bytes, *device);
+    device_fresh = true;
+  }
+  return *device;
+}
+
 DeviceBuffer& StageContext::device_for_read(BufferId id) {
   check_declared(id, detail::Access::Read);
-  auto& version = graph_.buffers_[id].current;
-  if (!version.device_fresh) {
-    const auto bytes = version.host->mutable_bytes();
-    ensure_device_size(*graph_.device_, version.device, bytes.size());
-    graph_.device_->upload(bytes, *version.device);
-    version.device_fresh = true;
-  }
-  return *version.device;
+  return graph_.buffers_[id].current.device_copy(*graph_.device_);
 }
 
 detail::AnyBuffer* StageContext::host_previous_without_sync(BufferId id) {
@@ -407,15 +411,7 @@ detail::AnyBuffer* StageContext::host_previous_without_sync(BufferId id) {
 DeviceBuffer* StageContext::device_for_previous(BufferId id) {
   check_declared(id, detail::Access::ReadPrevious);
   auto& buffer = graph_.buffers_[id];
-  if (!buffer.previous_valid) return nullptr;
-  auto& version = buffer.previous;
-  if (!version.device_fresh) {
-    const auto bytes = version.host->mutable_bytes();
-    ensure_device_size(*graph_.device_, version.device, bytes.size());
-    graph_.device_->upload(bytes, *version.device);
-    version.device_fresh = true;
-  }
-  return version.device.get();
+  return buffer.previous_valid ? &buffer.previous.device_copy(*graph_.device_) : nullptr;
 }
 
 DeviceBuffer& StageContext::device_for_write(BufferId id) {

@@ -35,15 +35,6 @@ struct DepthWarpMergeVk::Scratch {
   std::optional<vk::VulkanBuffer> depth, previous_depth, previous_weight, merged, merged_weight;
 };
 
-namespace {
-
-vk::VulkanBuffer& sized(std::optional<vk::VulkanBuffer>& buffer, const vk::VulkanContext& context, std::size_t bytes) {
-  if (!buffer || buffer->size_bytes() != bytes) buffer.emplace(context, bytes);
-  return *buffer;
-}
-
-}  // namespace
-
 DepthWarpMergeVk::DepthWarpMergeVk(vk::VulkanContext& context)
     : context_(context), pipelines_(std::make_unique<Pipelines>(context)), scratch_(std::make_unique<Scratch>()) {}
 
@@ -62,12 +53,12 @@ void DepthWarpMergeVk::run(const DepthMap& depth, const DepthMap* previous_depth
   const std::size_t bytes = depth.bytes().size();
   vk::VulkanTransfer& transfer = context_.transfer();
   Scratch& s = *scratch_;
-  transfer.upload(depth.bytes(), sized(s.depth, context_, bytes));
-  if (history) transfer.upload(previous_depth->bytes(), sized(s.previous_depth, context_, bytes));
-  if (has_weight) transfer.upload(previous_weight->bytes(), sized(s.previous_weight, context_, bytes));
+  transfer.upload(depth.bytes(), vk::buffer_of_size(s.depth, context_, bytes));
+  if (history) transfer.upload(previous_depth->bytes(), vk::buffer_of_size(s.previous_depth, context_, bytes));
+  if (has_weight) transfer.upload(previous_weight->bytes(), vk::buffer_of_size(s.previous_weight, context_, bytes));
   run(*s.depth, history ? &*s.previous_depth : nullptr, has_weight ? &*s.previous_weight : nullptr, width, height,
-      intrinsics, current_from_prev, options, sized(s.merged, context_, bytes),
-      sized(s.merged_weight, context_, bytes));
+      intrinsics, current_from_prev, options, vk::buffer_of_size(s.merged, context_, bytes),
+      vk::buffer_of_size(s.merged_weight, context_, bytes));
   transfer.download(*s.merged, merged.bytes());
   transfer.download(*s.merged_weight, merged_weight.bytes());
 }
@@ -83,11 +74,11 @@ void DepthWarpMergeVk::run(const vk::VulkanBuffer& depth, const vk::VulkanBuffer
   const bool history = previous_depth != nullptr;
   const bool has_weight = history && previous_weight != nullptr;
   Scratch& s = *scratch_;
-  vk::VulkanBuffer& zbuffer = sized(s.zbuffer, context_, bytes);
-  vk::VulkanBuffer& warped_weight = sized(s.warped_weight, context_, bytes);
+  vk::VulkanBuffer& zbuffer = vk::buffer_of_size(s.zbuffer, context_, bytes);
+  vk::VulkanBuffer& warped_weight = vk::buffer_of_size(s.warped_weight, context_, bytes);
   // Bound where a map is missing; the shaders do not read it then (no history: only the clear
   // pass runs; no weights: has_weight = 0).
-  vk::VulkanBuffer& unused = sized(s.no_history, context_, bytes);
+  vk::VulkanBuffer& unused = vk::buffer_of_size(s.no_history, context_, bytes);
 
   gpu::DepthWarpParams warp{};
   warp.width = static_cast<gpu::uint>(width);

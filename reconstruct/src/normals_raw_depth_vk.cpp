@@ -37,15 +37,6 @@ struct NormalsRawDepthVk::Scratch {
   std::optional<vk::VulkanBuffer> depth, positions, normals, blended, previous_positions, pyramid, curvature;
 };
 
-namespace {
-
-vk::VulkanBuffer& sized(std::optional<vk::VulkanBuffer>& buffer, const vk::VulkanContext& context, std::size_t bytes) {
-  if (!buffer || buffer->size_bytes() != bytes) buffer.emplace(context, bytes);
-  return *buffer;
-}
-
-}  // namespace
-
 NormalsRawDepthVk::NormalsRawDepthVk(vk::VulkanContext& context)
     : context_(context),
       cross_(context),
@@ -65,10 +56,10 @@ void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intr
   const std::size_t map_bytes = positions.bytes().size();
   vk::VulkanTransfer& transfer = context_.transfer();
   Scratch& scratch = *scratch_;
-  vk::VulkanBuffer& depth_buffer = sized(scratch.depth, context_, depth.bytes().size());
-  vk::VulkanBuffer& position_buffer = sized(scratch.positions, context_, map_bytes);
-  vk::VulkanBuffer& normal_buffer = sized(scratch.normals, context_, map_bytes);
-  vk::VulkanBuffer& blended_buffer = sized(scratch.blended, context_, map_bytes);
+  vk::VulkanBuffer& depth_buffer = vk::buffer_of_size(scratch.depth, context_, depth.bytes().size());
+  vk::VulkanBuffer& position_buffer = vk::buffer_of_size(scratch.positions, context_, map_bytes);
+  vk::VulkanBuffer& normal_buffer = vk::buffer_of_size(scratch.normals, context_, map_bytes);
+  vk::VulkanBuffer& blended_buffer = vk::buffer_of_size(scratch.blended, context_, map_bytes);
   transfer.upload(depth.bytes(), depth_buffer);
   std::optional<double> total =
       cross_.run(depth_buffer, position_buffer, normal_buffer, width, height, intrinsics,
@@ -82,9 +73,10 @@ void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intr
         normals_history_pyramid(previous->normals, options.mip_levels, options.threads);
     std::vector<Float3> texels;
     for (const auto& level : pyramid) texels.insert(texels.end(), level.normal.pixels().begin(), level.normal.pixels().end());
-    vk::VulkanBuffer& previous_positions = sized(scratch.previous_positions, context_, map_bytes);
-    vk::VulkanBuffer& pyramid_buffer = sized(scratch.pyramid, context_, texels.size() * sizeof(Float3));
-    vk::VulkanBuffer& curvature_buffer = sized(scratch.curvature, context_, pyramid.front().curvature.bytes().size());
+    vk::VulkanBuffer& previous_positions = vk::buffer_of_size(scratch.previous_positions, context_, map_bytes);
+    vk::VulkanBuffer& pyramid_buffer = vk::buffer_of_size(scratch.pyramid, context_, texels.size() * sizeof(Float3));
+    vk::VulkanBuffer& curvature_buffer =
+        vk::buffer_of_size(scratch.curvature, context_, pyramid.front().curvature.bytes().size());
     transfer.upload(previous->positions.bytes(), previous_positions);
     transfer.upload(std::as_bytes(std::span<const Float3>(texels)), pyramid_buffer);
     transfer.upload(pyramid.front().curvature.bytes(), curvature_buffer);

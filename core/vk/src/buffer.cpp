@@ -113,4 +113,9 @@ void VulkanBuffer::read(std::span<std::byte> destination) const {
   std::memcpy(destination.data(), mapped_, destination.size());
 }
 
+VulkanBuffer& buffer_of_size(std::optional<VulkanBuffer>& slot, const VulkanContext& context, std::size_t bytes) {
+  if (!slot || slot->size_bytes() != bytes) slot.emplace(context, bytes);
+  return *slot;
+}
+
 }  // namespace relight::vk

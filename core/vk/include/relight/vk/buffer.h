@@ -9,6 +9,7 @@
 #include <vulkan/vulkan.h>
 
 #include <cstddef>
+#include <optional>
 #include <span>
 
 #include "relight/core/device_transfer.h"
@@ -55,5 +56,9 @@ class VulkanBuffer final : public DeviceBuffer {
   std::byte* mapped_ = nullptr;  // unmapped implicitly when memory_ is freed
   bool coherent_ = true;
 };
+
+/// `slot`'s buffer of exactly `bytes` (device domain), made only when it is empty or its size
+/// changed: a stage's per-frame scratch, so that same-sized frames allocate nothing.
+VulkanBuffer& buffer_of_size(std::optional<VulkanBuffer>& slot, const VulkanContext& context, std::size_t bytes);
 
 }  // namespace relight::vk
