@@ -122,8 +122,8 @@ void add_view_options(CLI::App& command, ReplayOptions& options) {
   command.add_flag("--view", options.view,
                    "Show the final picture in a window as it is made, with fps, tracking state and dropped frames; "
                    "keys: q quit, space pause, s snapshot (to DIR/snapshots/)");
-  command.add_option("--view-side", options.view_side, "With --view: a buffer shown beside the picture")
-      ->check(CLI::IsMember(names_of(kViewSides)));
+  add_choice_option(command, "--view-side", options.view_side, kViewSides,
+                    "With --view: a buffer shown beside the picture");
 }
 
 namespace {

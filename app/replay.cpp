@@ -232,17 +232,19 @@ void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
 /// --view: the window (opened now, so that a missing display fails before any frame) and the
 /// stage that feeds it the final picture.
 void add_view(ReplayPipeline& pipeline, const ReplayOptions& options, bool method2) {
-  const std::string& side = options.view_side;
-  const bool needs_render = side == kComposite.name() || side == render::kVirtualCoverage.name();
-  if (needs_render && !pipeline.renders) throw Error("--view-side " + side + " needs something to render (--object)");
-  if (side == kDepthFiltered.name() && !method2) throw Error("--view-side depth_filtered needs --geometry method2");
-  pipeline.view = std::make_unique<LiveView>("relight " + (options.live_device.empty() ? std::string("replay")
-                                                                                       : "live: " + options.live_device),
-                                             options.out / "snapshots");
-  const auto side_buffer =
-      side.empty() ? std::nullopt : std::optional<PreviewBuffer>(parse_named(kViewSides, "--view-side", side));
-  pipeline.view_stage = &pipeline.graph->emplace<ViewStage>(
-      *pipeline.view, pipeline.renders ? pipeline.final_composite : kColor, side_buffer);
+  const std::optional<PreviewBuffer>& side = options.view_side;
+  const bool needs_render = side == PreviewBuffer{kComposite} || side == PreviewBuffer{render::kVirtualCoverage};
+  if (needs_render && !pipeline.renders) {
+    throw Error(std::string("--view-side ") + name_of(kViewSides, *side) + " needs something to render (--object)");
+  }
+  if (side == PreviewBuffer{kDepthFiltered} && !method2) {
+    throw Error("--view-side depth_filtered needs --geometry method2");
+  }
+  pipeline.view = std::make_unique<LiveView>(
+      "relight " + (options.live_device.empty() ? std::string("replay") : "live: " + options.live_device),
+      options.out / "snapshots");
+  pipeline.view_stage =
+      &pipeline.graph->emplace<ViewStage>(*pipeline.view, pipeline.renders ? pipeline.final_composite : kColor, side);
 }
 
 void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, bool method2) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "buffer_previews.h"
 #include "relight/capture/camera_pose.h"
 #include "relight/capture/frame_source.h"
 #include "relight/colormap/colormap_stages.h"
@@ -90,9 +91,9 @@ struct ReplayOptions {
   bool channel_swap = false;                  ///< sample mapping: add channel-permuted pairs
   bool video = true;                           ///< composite.mp4
   /// A window showing the final picture as it is made (live_view.h), with `view_side` (a buffer:
-  /// color, depth, normals, ...; empty none) beside it.
+  /// color, depth, normals, ... of view_stage.h's kViewSides; none: nothing) beside it.
   bool view = false;
-  std::string view_side;
+  std::optional<PreviewBuffer> view_side;
   /// `relight live`: the device the frames come from (it has no sequence folder; errors name it).
   std::string live_device;
   /// `relight live`: the folder with scene.json / probe.hdr the device serves (relight's own
