@@ -10,7 +10,8 @@
 # glslc writes the words as text (-mfmt=num: "0x07230203,0x00010300,..."), which the generated
 # header #includes inside an array initialiser; no conversion script is needed. glslc's depfile
 # makes the shader rebuild when a header it #includes changes. INCLUDE_DIRS are passed as -I
-# (shared C++/GLSL headers live in the stage's include/ folder).
+# (shared C++/GLSL headers live in the stage's include/ folder); core/shaders, the GLSL twins of
+# core's models (phong.glsl), is on every shader's include path.
 find_package(Vulkan REQUIRED COMPONENTS glslc)
 
 function(relight_embed_shaders target)
@@ -22,7 +23,7 @@ function(relight_embed_shaders target)
   set(out_dir ${out_root}/relight/shaders)
   file(MAKE_DIRECTORY ${out_dir})
 
-  set(include_flags "")
+  set(include_flags -I ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/../core/shaders)
   foreach(dir IN LISTS ARG_INCLUDE_DIRS)
     list(APPEND include_flags -I ${dir})
   endforeach()

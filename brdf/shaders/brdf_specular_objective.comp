@@ -1,9 +1,10 @@
 #version 450
 // The specular objective F (specular_fit.h, eq. 4.15) for a batch of parameter candidates
 // (specular_objective_vk.h): invocation x evaluates sample x under candidate y with the model of
-// shading.h (both the diffuse and the Phong term, the same expression as model_radiance in
-// src/specular_model.h, here in float), and each work group adds its samples' squared residuals
+// shading.h (both the diffuse and the Phong term of core/shaders/phong.glsl, the same expression as
+// model_radiance in src/specular_model.h, here in float), and each work group adds its samples' squared residuals
 // into one partial sum per candidate, which the host adds up in double.
+#include "phong.glsl"
 #include "relight/brdf/specular_shared.h"
 
 layout(local_size_x = RELIGHT_SPECULAR_GROUP) in;
@@ -16,8 +17,6 @@ layout(push_constant) uniform Push { SpecularObjectiveParams params; };
 
 shared float sums[RELIGHT_SPECULAR_GROUP];
 
-const float kInvPi = 0.31830988618379067;
-
 float squared_residual(uint sample_index, uint candidate) {
   const uint s = sample_index * RELIGHT_SPECULAR_SAMPLE_VEC4S;
   const vec3 radiance = samples[s].xyz, p = samples[s + 1].xyz, normal = samples[s + 2].xyz;
@@ -26,7 +25,7 @@ float squared_residual(uint sample_index, uint candidate) {
   const vec3 kd = params.kd.xyz;
   vec3 model = kd * params.ambient.xyz;
   const vec3 v = -p / sqrt(dot(p, p));
-  const float lobe_scale = ks * (n + 2.0) * 0.5 * kInvPi;
+  const float lobe_scale = ks * phong_lobe_normalisation(n);
   for (uint l = 0u; l < params.lights; ++l) {
     vec3 to_light = lights[RELIGHT_SPECULAR_LIGHT_VEC4S * l].xyz;
     const bool point = lights[RELIGHT_SPECULAR_LIGHT_VEC4S * l].w > 0.5;
@@ -43,9 +42,9 @@ float squared_residual(uint sample_index, uint candidate) {
     const float cosine = dot(normal, to_light);
     if (!(cosine > 0.0)) continue;
     const float rv = dot(2.0 * cosine * normal - to_light, v);
-    const float lobe = rv > 1e-12 ? pow(rv, n) : 0.0;
+    const float lobe = phong_lobe(n, rv);
     const vec3 power = lights[RELIGHT_SPECULAR_LIGHT_VEC4S * l + 1u].xyz;
-    model += (scale * cosine) * power * (kd * kInvPi + lobe_scale * lobe);
+    model += (scale * cosine) * power * (kd * kPhongInvPi + lobe_scale * lobe);
   }
   const vec3 r = radiance - model;
   return dot(r, r);

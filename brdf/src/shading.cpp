@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "relight/core/phong.h"
+
 namespace relight::brdf {
 
 ShadingLights to_camera_frame(const LightSet& set, const Pose& camera_to_world, const Eigen::Vector3f& ambient) {
@@ -46,14 +48,12 @@ Eigen::Vector3f phong_radiance(const ShadingLights& lights, const Eigen::Vector3
   constexpr float inv_pi = std::numbers::inv_pi_v<float>;
   const Eigen::Vector3f view = -position.normalized();
   Eigen::Vector3f radiance = kd.cwiseProduct(lights.ambient);
-  const float lobe_scale = ks * (n + 2.f) * 0.5f * inv_pi;
   for (const ShadingLight& light : lights.lights) {
     const LightAtPoint at = light_at(light, position);
     const float cosine = normal.dot(at.direction);
     if (cosine <= 0.f) continue;
-    const Eigen::Vector3f mirror = 2.f * cosine * normal - at.direction;
-    const float lobe = std::pow(std::max(0.f, mirror.dot(view)), n);
-    radiance += (at.irradiance * cosine).cwiseProduct(kd * inv_pi + Eigen::Vector3f::Constant(lobe_scale * lobe));
+    const float specular = phong_specular(ks, n, phong_reflect(at.direction, normal).dot(view));
+    radiance += (at.irradiance * cosine).cwiseProduct(kd * inv_pi + Eigen::Vector3f::Constant(specular));
   }
   return radiance;
 }

@@ -1,11 +1,12 @@
 #pragma once
 // The per-sample model of the specular fit, templated on the scalar so that Nelder-Mead (double)
-// and Ceres (Jets) evaluate exactly the same expression. Private to relight_brdf.
+// and Ceres (Jets) evaluate exactly the same expression, with the Phong terms of core/phong.h. Private to relight_brdf.
 #include <cmath>
 #include <numbers>
 #include <vector>
 
 #include "relight/brdf/specular_fit.h"
+#include "relight/core/phong.h"
 
 namespace relight::brdf::detail {
 
@@ -34,7 +35,7 @@ void model_radiance(const SpecularSample& s, const Eigen::Vector3f& kd, const Sh
   const T nx = T(double(s.normal.x())), ny = T(double(s.normal.y())), nz = T(double(s.normal.z()));
   const T view_scale = T(1.0) / sqrt(px * px + py * py + pz * pz);
   const T vx = -px * view_scale, vy = -py * view_scale, vz = -pz * view_scale;
-  const T lobe_scale = ks * (n + T(2.0)) * T(0.5) * inv_pi;
+  const T lobe_scale = ks * phong_lobe_normalisation(n);
   for (std::size_t l = 0; l < lights.lights.size(); ++l) {
     const ShadingLight& light = lights.lights[l];
     T lx = T(double(light.vector.x())), ly = T(double(light.vector.y())), lz = T(double(light.vector.z()));
@@ -64,7 +65,7 @@ void model_radiance(const SpecularSample& s, const Eigen::Vector3f& kd, const Sh
     const T cosine = nx * lx + ny * ly + nz * lz;
     if (!(cosine > T(0.0))) continue;
     const T rv = (T(2.0) * cosine * nx - lx) * vx + (T(2.0) * cosine * ny - ly) * vy + (T(2.0) * cosine * nz - lz) * vz;
-    const T lobe = rv > T(1e-12) ? pow(rv, n) : T(0.0);
+    const T lobe = phong_lobe(n, rv);
     const T e = scale * cosine;
     for (int c = 0; c < 3; ++c) {
       out[c] += e * T(double(light.power[c])) * (T(double(kd[c])) * inv_pi + lobe_scale * lobe);

@@ -7,13 +7,15 @@
 #include <numeric>
 #include <numbers>
 
+#include "relight/core/phong.h"
+
 namespace relight::brdf::detail {
 
 namespace {
 
 constexpr double kInvPi = std::numbers::inv_pi;
-// <omega_o . r_l> at or below this counts as no lobe (as in model_radiance).
-constexpr double kMinRv = 1e-12;
+// <omega_o . r_l> at or below this counts as no lobe (core/phong.h, as in model_radiance).
+constexpr double kMinRv = kPhongMinLobeCosine;
 // exp(n g) below exp(-46) ~ 1e-20: a sample whose every lobe is that small for the current n
 // contributes its observation alone (the lobes change F by less than double rounding).
 constexpr double kNegligibleExponent = -46.0;
@@ -126,7 +128,7 @@ double ShapeTerms::objective(double ks, double n) const {
   const Eigen::Index lit = lit_samples(n);
   std::array<Eigen::ArrayXd, 3> sums;
   lobe_sums(n, lit, sums, nullptr);
-  const double scale = ks * (n + 2.0) * 0.5 * kInvPi;
+  const double scale = ks * phong_lobe_normalisation(n);
   double f = tail_bb_[static_cast<std::size_t>(lit)];
   for (std::size_t c = 0; c < 3; ++c) f += (base_[c].head(lit) - scale * sums[c]).square().sum();
   return f;
@@ -136,7 +138,7 @@ ShapeTerms::Projected ShapeTerms::best_ks(double n, double ks_max) const {
   const Eigen::Index lit = lit_samples(n);
   std::array<Eigen::ArrayXd, 3> sums;
   lobe_sums(n, lit, sums, nullptr);
-  const double lobe_scale = (n + 2.0) * 0.5 * kInvPi;
+  const double lobe_scale = phong_lobe_normalisation(n);
   const double bb = tail_bb_[0];
   double bt = 0.0, tt = 0.0;
   for (std::size_t c = 0; c < 3; ++c) {
@@ -151,7 +153,7 @@ void ShapeTerms::residuals(double ks, double n, double* residuals, double* jacob
   const Eigen::Index lit = lit_samples(n), count = samples();
   std::array<Eigen::ArrayXd, 3> sums, slope;
   lobe_sums(n, lit, sums, jacobian ? &slope : nullptr);
-  const double lobe_scale = (n + 2.0) * 0.5 * kInvPi;
+  const double lobe_scale = phong_lobe_normalisation(n);
   for (std::size_t c = 0; c < 3; ++c) {
     Eigen::Map<Eigen::ArrayXd, 0, Eigen::InnerStride<3>> r(residuals + c, count);
     r.head(lit) = base_[c].head(lit) - ks * lobe_scale * sums[c];
@@ -241,7 +243,7 @@ double FullModel::objective(double ks_in, double n_in, const double* offsets) {
   const auto ks = static_cast<float>(ks_in), n = static_cast<float>(n_in);
   constexpr float kInvPiF = std::numbers::inv_pi_v<float>;
   constexpr auto kMinRvF = static_cast<float>(kMinRv);
-  const float lobe_scale = ks * (n + 2.f) * 0.5f * kInvPiF;
+  const float lobe_scale = ks * phong_lobe_normalisation(n);
   const Eigen::Index count = px_.size();
   for (int c = 0; c < 3; ++c) model_[static_cast<std::size_t>(c)].setConstant(count, kd_[c] * ambient_[c]);
   for (std::size_t l = 0; l < lights_.lights.size(); ++l) {

@@ -183,9 +183,7 @@ Vector3d shade(const Scene& scene, const Vector3d& point, const Vector3d& normal
     const double cosine = normal.dot(l);
     if (cosine <= 0.0 || occluded(scene, origin, light.position)) continue;
     const Vector3d irradiance = light.colour * (light.intensity * cosine / distance2);
-    const Vector3d mirror = 2.0 * cosine * normal - l;
-    const double lobe = std::pow(std::max(0.0, mirror.dot(to_viewer)), material.n);
-    const double specular = material.ks * (material.n + 2.0) / (2.0 * pi) * lobe;
+    const double specular = phong_specular(material.ks, material.n, phong_reflect(l, normal).dot(to_viewer));
     radiance += irradiance.cwiseProduct(material.kd / pi + Vector3d::Constant(specular));
   }
   return radiance;

@@ -20,14 +20,14 @@ void add_materials(Scene& scene) {
   const Vector3d grey{0.70, 0.70, 0.68};
   const Vector3d wood{0.50, 0.34, 0.20};
   scene.materials = {
-      {"floor", wood, 0.05, 10.0},
-      {"wall", grey, 0.0, 1.0},
-      {"table", wood, 0.15, 20.0},
-      {"red_paint", {0.70, 0.12, 0.10}, 0.05, 10.0},
-      {"glossy_blue", {0.10, 0.18, 0.60}, 0.60, 80.0},
-      {"yellow_plastic", {0.75, 0.62, 0.12}, 0.20, 30.0},
-      {"tag_black", {0.03, 0.03, 0.03}, 0.0, 1.0},
-      {"tag_white", grey, 0.0, 1.0},
+      {{wood, 0.05, 10.0}, "floor"},
+      {{grey, 0.0, 1.0}, "wall"},
+      {{wood, 0.15, 20.0}, "table"},
+      {{{0.70, 0.12, 0.10}, 0.05, 10.0}, "red_paint"},
+      {{{0.10, 0.18, 0.60}, 0.60, 80.0}, "glossy_blue"},
+      {{{0.75, 0.62, 0.12}, 0.20, 30.0}, "yellow_plastic"},
+      {{{0.03, 0.03, 0.03}, 0.0, 1.0}, "tag_black"},
+      {{grey, 0.0, 1.0}, "tag_white"},
   };
 }
 

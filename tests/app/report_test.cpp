@@ -123,7 +123,7 @@ nlohmann::ordered_json two_stage_timing() {
 TEST(HtmlReport, PageIsSelfContainedAndShowsEverySection) {
   ReportContent content;
   content.contact_sheet.push_back({0, {{"composite", std::string("\xff\xd8\xff\xe0", 4), 8, 6}}});
-  content.materials = std::vector<brdf::MaterialParams>{{{0.5f, 0.25f, 0.125f}, 0.3f, 40.f, 1234, 0.01f}};
+  content.materials = std::vector<brdf::MaterialParams>{{{{0.5f, 0.25f, 0.125f}, 0.3f, 40.f}, 1234, 0.01f}};
   content.lights = LightSet{{directional_light({0, 0.6, 0.8}, {2, 2, 2})}};
   const std::string html = html_report("title", two_stage_timing(), content, "digraph {}", std::nullopt);
 

@@ -34,7 +34,7 @@ TEST(DepthMesh, SyntheticFrameMeshReproducesTheDepthAndTheMaterials) {
   DepthMeshMaterials materials;
   materials.labels = &frame.material;
   for (std::uint32_t label = 0; label <= scene.materials.size(); ++label) {
-    materials.material_of_label.push_back(mr.add_material({"label " + std::to_string(label), {}, 0.f, 1.f, {}}));
+    materials.material_of_label.push_back(mr.add_material({{{}, 0.f, 1.f}, "label " + std::to_string(label), {}}));
   }
   PositionMap positions = positions_from_depth(frame.depth, k);
   mr.meshes.push_back(mesh_from_positions(positions, &frame.normals, pose, materials));

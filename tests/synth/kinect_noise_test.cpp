@@ -17,7 +17,7 @@ using Eigen::Vector3d;
 // A large wall facing the camera at distance z (camera frame = world frame).
 RenderedFrame fronto_parallel_plane(double z) {
   Scene scene;
-  scene.materials = {{"grey", {0.5, 0.5, 0.5}, 0.0, 1.0}};
+  scene.materials = {{{{0.5, 0.5, 0.5}, 0.0, 1.0}, "grey"}};
   scene.objects.push_back({"wall", Rect{{0, 0, z}, -Vector3d::UnitZ(), Vector3d::UnitX(), Vector3d::UnitY(), 50, 50}, 0});
   return render_frame(scene, PinholeIntrinsics::kinect_v1(), Pose::Identity(), 0);
 }
@@ -113,7 +113,7 @@ TEST(KinectNoise, NoDepthBelowHalfAMetreOrBeyondFourMetres) {
 TEST(KinectNoise, GrazingAnglesDropOut) {
   // A floor seen from 0.3 m above, looking level: the angle to the normal grows towards the horizon.
   Scene scene;
-  scene.materials = {{"grey", {0.5, 0.5, 0.5}, 0.0, 1.0}};
+  scene.materials = {{{{0.5, 0.5, 0.5}, 0.0, 1.0}, "grey"}};
   scene.objects.push_back({"floor", Rect{{0, 0, 0}, Vector3d::UnitZ(), Vector3d::UnitX(), Vector3d::UnitY(), 50, 50}, 0});
   const PinholeIntrinsics k = PinholeIntrinsics::kinect_v1();
   const Pose pose = look_at({0, 0, 0.3}, {0, 3, 0.0});

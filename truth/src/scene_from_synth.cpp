@@ -33,9 +33,7 @@ render::TriangleMesh tessellate(const synth::Shape& shape, std::uint32_t materia
 
 render::MrScene scene_from_synth(const synth::Scene& scene, const render::TessellationOptions& options) {
   render::MrScene out;
-  for (const synth::Material& m : scene.materials)
-    out.add_material(
-        {m.name, m.kd.cast<float>(), static_cast<float>(m.ks), static_cast<float>(m.n), Eigen::Vector3f::Zero()});
+  for (const synth::Material& m : scene.materials) out.add_material({m.cast<float>(), m.name, Eigen::Vector3f::Zero()});
   for (const synth::Object& object : scene.objects) {
     render::TriangleMesh mesh = tessellate(object.shape, static_cast<std::uint32_t>(object.material), options);
     mesh.name = object.name;

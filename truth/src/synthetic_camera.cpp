@@ -55,7 +55,7 @@ SyntheticTriple make_synthetic_triple(const SyntheticTripleOptions& options) {
 
   SyntheticTriple triple;
   triple.real = synth::render_frame(scene, intrinsics, pose).radiance;
-  scene.materials.push_back({"virtual", options.virtual_albedo, 0.05, 10.0});
+  scene.materials.push_back({{options.virtual_albedo, 0.05, 10.0}, "virtual"});
   const int material = static_cast<int>(scene.materials.size()) - 1;
   scene.objects.push_back(
       {"virtual_sphere", synth::Sphere{{0.05, -0.12, 0.75 + options.virtual_radius}, options.virtual_radius}, material});

@@ -15,6 +15,7 @@
 // Output per pixel (4 vec4): direct L_rv + emission (w: virtual coverage), direct L_r,
 // indirect L_rv, indirect L_r.
 #include "dir_common.glsl"
+#include "phong.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -61,16 +62,8 @@ layout(push_constant) uniform Params {
   vec4 virtual_bounds;  // IsmPointPools::virtual_bounds
 } params;
 
-// phong_brdf() (phong_brdf.h).
-vec3 phong(Material m, vec3 n, vec3 wi, vec3 wo) {
-  if (dot(n, wi) <= 0.0 || dot(n, wo) <= 0.0) return vec3(0.0);
-  vec3 f = m.kd_ks.xyz / PI;
-  if (m.kd_ks.w > 0.0) {
-    const float cos_alpha = max(0.0, dot(2.0 * dot(n, wi) * n - wi, wo));
-    f += m.kd_ks.w * (m.emission_n.w + 2.0) / (2.0 * PI) * pow(cos_alpha, m.emission_n.w);
-  }
-  return f;
-}
+// phong_brdf() (core/phong.h, core/shaders/phong.glsl) of a packed material.
+vec3 phong(Material m, vec3 n, vec3 wi, vec3 wo) { return phong_brdf(m.kd_ks.xyz, m.kd_ks.w, m.emission_n.w, n, wi, wo); }
 
 // shadow_visibility() (shadow_maps.h).
 float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {

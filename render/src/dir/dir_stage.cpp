@@ -17,8 +17,8 @@ void add_cluster_materials(MrScene& scene, const brdf::Materials& materials, Dep
   mesh_materials.material_of_label.push_back(0);  // label 0: no cluster, replaced below
   for (std::size_t i = 0; i < materials.clusters.size(); ++i) {
     const brdf::MaterialParams& c = materials.clusters[i];
-    mesh_materials.material_of_label.push_back(
-        scene.add_material({"cluster " + std::to_string(i), c.kd, c.ks, std::max(c.n, 1.f), Eigen::Vector3f::Zero()}));
+    mesh_materials.material_of_label.push_back(scene.add_material(
+        {{c.kd, c.ks, std::max(c.n, 1.f)}, "cluster " + std::to_string(i), Eigen::Vector3f::Zero()}));
     weighted += static_cast<float>(c.pixels) * c.kd;
     pixels += static_cast<float>(c.pixels);
   }

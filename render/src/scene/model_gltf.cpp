@@ -251,7 +251,7 @@ VirtualModel load_gltf(const std::filesystem::path& path) {
   model.name = path.stem().string();
   for (const tinygltf::Material& m : gltf.materials) model.materials.push_back(from_gltf(m));
   const auto default_material = static_cast<std::uint32_t>(model.materials.size());
-  model.materials.push_back(PhongMaterial{"default", {0.8f, 0.8f, 0.8f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
+  model.materials.push_back(PhongMaterial{{{0.8f, 0.8f, 0.8f}, 0.f, 1.f}, "default", {0.f, 0.f, 0.f}});
   GltfMeshCollector collector(gltf, model, path.string(), default_material);
   const int scene = gltf.defaultScene >= 0 ? gltf.defaultScene : 0;
   if (static_cast<std::size_t>(scene) < gltf.scenes.size()) {

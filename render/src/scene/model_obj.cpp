@@ -86,7 +86,7 @@ VirtualModel load_obj(const std::filesystem::path& path) {
   model.name = path.stem().string();
   for (const tinyobj::material_t& m : reader.GetMaterials()) model.materials.push_back(from_mtl(m));
   const auto default_material = static_cast<std::uint32_t>(model.materials.size());
-  model.materials.push_back(PhongMaterial{"default", {0.7f, 0.7f, 0.7f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
+  model.materials.push_back(PhongMaterial{{{0.7f, 0.7f, 0.7f}, 0.f, 1.f}, "default", {0.f, 0.f, 0.f}});
   const tinyobj::attrib_t& attrib = reader.GetAttrib();
   for (const tinyobj::shape_t& shape : reader.GetShapes()) {
     TriangleMesh mesh = mesh_from_shape(path, shape, attrib, default_material);

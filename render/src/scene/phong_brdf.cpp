@@ -35,17 +35,6 @@ void orthonormal_basis(const Eigen::Vector3f& n, Eigen::Vector3f& t, Eigen::Vect
   b = Eigen::Vector3f(c, sign + n.y() * n.y() * a, -n.y());
 }
 
-Eigen::Vector3f phong_brdf(const PhongMaterial& material, const Eigen::Vector3f& normal, const Eigen::Vector3f& wi,
-                           const Eigen::Vector3f& wo) {
-  if (normal.dot(wi) <= 0.f || normal.dot(wo) <= 0.f) return Eigen::Vector3f::Zero();
-  Eigen::Vector3f f = material.kd / kPi;
-  if (material.ks > 0.f) {
-    const float cos_alpha = std::max(0.f, reflect(wi, normal).dot(wo));
-    f.array() += material.ks * (material.n + 2.f) / (2.f * kPi) * std::pow(cos_alpha, material.n);
-  }
-  return f;
-}
-
 float phong_pdf(const PhongMaterial& material, const Eigen::Vector3f& normal, const Eigen::Vector3f& wi,
                 const Eigen::Vector3f& wo) {
   const float cos_i = normal.dot(wi);
@@ -53,8 +42,8 @@ float phong_pdf(const PhongMaterial& material, const Eigen::Vector3f& normal, co
   const float pd = diffuse_probability(material);
   float pdf = pd * cos_i / kPi;
   if (pd < 1.f) {
-    const float cos_alpha = std::max(0.f, reflect(wo, normal).dot(wi));
-    pdf += (1.f - pd) * (material.n + 1.f) / (2.f * kPi) * std::pow(cos_alpha, material.n);
+    // The specular lobe's own normalisation as a pdf: (n + 1) / (2 pi) cos^n.
+    pdf += (1.f - pd) * (material.n + 1.f) / (2.f * kPi) * phong_lobe(material.n, phong_reflect(wo, normal).dot(wi));
   }
   return pdf;
 }
@@ -70,7 +59,7 @@ std::optional<BrdfSample> sample_phong(const PhongMaterial& material, const Eige
     wi = around(normal, std::sqrt(1.f - u), 2.f * kPi * u2);
   } else {
     const float u = pd < 1.f ? (u1 - pd) / (1.f - pd) : u1;
-    wi = around(reflect(wo, normal), std::pow(u, 1.f / (material.n + 1.f)), 2.f * kPi * u2);
+    wi = around(phong_reflect(wo, normal), std::pow(u, 1.f / (material.n + 1.f)), 2.f * kPi * u2);
   }
   const float pdf = phong_pdf(material, normal, wi, wo);
   if (pdf <= 0.f) return std::nullopt;

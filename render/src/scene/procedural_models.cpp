@@ -22,7 +22,7 @@ VirtualModel make_glossy_pebble(int segments) {
   if (segments < 8) throw Error("the pebble needs at least 8 segments");
   VirtualModel model;
   model.name = "glossy_pebble";
-  model.materials.push_back({"glossy_red", {0.55f, 0.08f, 0.06f}, 0.35f, 60.f, {0.f, 0.f, 0.f}});
+  model.materials.push_back({{{0.55f, 0.08f, 0.06f}, 0.35f, 60.f}, "glossy_red", {0.f, 0.f, 0.f}});
   TriangleMesh mesh;
   mesh.name = "pebble";
   const int rings = segments / 2;
@@ -66,7 +66,7 @@ VirtualModel make_glossy_pebble(int segments) {
 VirtualModel make_matte_box() {
   VirtualModel model;
   model.name = "matte_box";
-  model.materials.push_back({"matte_blue", {0.20f, 0.35f, 0.60f}, 0.f, 1.f, {0.f, 0.f, 0.f}});
+  model.materials.push_back({{{0.20f, 0.35f, 0.60f}, 0.f, 1.f}, "matte_blue", {0.f, 0.f, 0.f}});
   TriangleMesh mesh = tessellate_box({-0.06f, 0.0f, -0.06f}, {0.06f, 0.12f, 0.06f}, 0);
   mesh.name = "box";
   model.meshes.push_back(std::move(mesh));

@@ -6,14 +6,14 @@
 #include <vector>
 
 #include "relight/core/image.h"
+#include "relight/core/phong.h"
 
 namespace relight::brdf {
 
-struct MaterialParams {
-  Eigen::Vector3f kd = Eigen::Vector3f::Zero();  ///< diffuse albedo, linear RGB (the cluster centre)
-  float ks = 0.f;                                ///< scalar specular coefficient (white highlights); 0 = diffuse
-  float n = 1.f;                                 ///< Phong exponent
-  int pixels = 0;                                ///< camera pixels in the cluster this frame
+/// A cluster's Phong material (core/phong.h): k_d is the cluster centre (linear RGB), k_s = 0 a
+/// diffuse cluster.
+struct MaterialParams : Phong {
+  int pixels = 0;  ///< camera pixels in the cluster this frame
   /// RMS radiance residual of the specular fit over the cluster's samples (-1: not fitted).
   float fit_rms = -1.f;
 };

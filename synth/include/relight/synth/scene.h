@@ -6,7 +6,8 @@
 // top is at z = 0.75. Every object is an analytic primitive with a Phong material, so tests can
 // compare rendered depth against closed-form intersections.
 //
-// Shading model (what the colour camera and the probe see), in linear radiance:
+// Shading model (what the colour camera and the probe see), in linear radiance, with the Phong
+// model of core/phong.h:
 //   L = k_d * L_env                                  (ambient: unoccluded sky of radiance L_env)
 //     + sum over visible lights of E * (k_d / pi + k_s * (n + 2) / (2 pi) * max(0, r.v)^n)
 //   with irradiance E = colour * intensity * max(0, n.l) / d^2 (point light of radiant intensity
@@ -17,16 +18,14 @@
 #include <variant>
 #include <vector>
 
+#include "relight/core/phong.h"
 #include "relight/synth/tag36h11.h"
 
 namespace relight::synth {
 
-/// Phong parameters: diffuse albedo k_d (linear RGB, in [0, 1]), scalar specular k_s, exponent n.
-struct Material {
+/// A named material: relight's Phong model (core/phong.h) in double, k_d in [0, 1].
+struct Material : BasicPhong<double> {
   std::string name;
-  Eigen::Vector3d kd{0.5, 0.5, 0.5};
-  double ks = 0.0;
-  double n = 1.0;
 };
 
 /// Sphere of the given centre and radius (metres).

@@ -72,7 +72,7 @@ struct DirStageOptions {
   DirRenderOptions renderer{};
   VplOptions vpls{.count = 64};
   DepthMeshOptions mesh{.stride = 2};
-  PhongMaterial reconstruction_material{"reconstruction", {0.5f, 0.5f, 0.5f}, 0.f, 1.f, {0.f, 0.f, 0.f}};
+  PhongMaterial reconstruction_material{{{0.5f, 0.5f, 0.5f}, 0.f, 1.f}, "reconstruction", {0.f, 0.f, 0.f}};
   colormap::ToneMap tone_map{};
   std::optional<BufferName<brdf::Materials>> materials_buffer;  ///< none: no Materials input
   /// ObjectPlacements of the objects (virtual_model.h), e.g. resolved on a real surface at the

@@ -14,18 +14,15 @@
 #include <vector>
 
 #include "relight/core/camera.h"
+#include "relight/core/phong.h"
 #include "relight/core/pose.h"
 
 namespace relight::render {
 
-/// Phong material as the renderer evaluates it (phong_brdf.h):
-///   f(wi, wo) = k_d / pi + k_s (n + 2) / (2 pi) max(0, r(wi) . wo)^n
-/// plus an emitted radiance (a virtual light source shaped like its mesh).
-struct PhongMaterial {
+/// A material of the scene: relight's Phong model (core/phong.h; sampled in phong_brdf.h), a name,
+/// and an emitted radiance (a virtual light source shaped like its mesh).
+struct PhongMaterial : Phong {
   std::string name;
-  Eigen::Vector3f kd{0.5f, 0.5f, 0.5f};
-  float ks = 0.f;
-  float n = 1.f;
   Eigen::Vector3f emission{0.f, 0.f, 0.f};
 };
 

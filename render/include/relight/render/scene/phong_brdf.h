@@ -1,10 +1,10 @@
 #pragma once
-// The normalised Phong BRDF shared by the path tracer and the DIR renderer, and its importance
-// sampling (Lafortune & Willems 1994):
+// Importance sampling of relight's Phong model (core/phong.h, which evaluates f; Lafortune &
+// Willems 1994) for the path tracer and the VPL tracer:
 //
 //   f(wi, wo) = k_d / pi + k_s (n + 2) / (2 pi) max(0, r(wi) . wo)^n,   r(wi) = 2 (n.wi) n - wi
 //
-// the same model as the synthetic scene (synth/scene.h), so that a material estimated there
+// the same model as the synthetic scene and BRDF estimation, so that a material estimated there
 // renders back to the camera image. Sampling picks the diffuse lobe (cosine-weighted) with
 // probability p_d = lum(k_d) / (lum(k_d) + k_s) and otherwise the specular lobe (pdf
 // (n + 1) / (2 pi) cos^n around r(wo)); the returned pdf is the mixture's, so the estimator
@@ -15,14 +15,6 @@
 #include "relight/render/scene/mr_scene.h"
 
 namespace relight::render {
-
-[[nodiscard]] inline Eigen::Vector3f reflect(const Eigen::Vector3f& direction, const Eigen::Vector3f& normal) {
-  return 2.f * normal.dot(direction) * normal - direction;
-}
-
-/// f(wi, wo) for a surface of unit normal `normal`; zero when either direction is below it.
-[[nodiscard]] Eigen::Vector3f phong_brdf(const PhongMaterial& material, const Eigen::Vector3f& normal,
-                                         const Eigen::Vector3f& wi, const Eigen::Vector3f& wo);
 
 struct BrdfSample {
   Eigen::Vector3f wi;
