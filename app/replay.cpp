@@ -34,13 +34,10 @@
 #include "relight/core/error.h"
 #include "relight/core/progress.h"
 #include "relight/lights/buffers.h"
-#include "relight/reconstruct/cross_normals_vk.h"
 #include "relight/reconstruct/depth_box_filter.h"
 #include "relight/reconstruct/depth_warp_merge.h"
-#include "relight/reconstruct/depth_warp_merge_vk.h"
 #include "relight/reconstruct/normals_from_positions.h"
 #include "relight/reconstruct/normals_raw_depth.h"
-#include "relight/reconstruct/normals_raw_depth_vk.h"
 #include "relight/render/buffers.h"
 #include "relight/render/dir/dir_stage.h"
 #include "relight/render/dir/mapped_composite_stage.h"
@@ -199,7 +196,9 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view
   // keep their shadows, at a quarter of the rasterisation and memory of 512.
   dir.renderer.shadow_tile = 256;
-  render::add_dir_stages(graph, pipeline.vulkan.get(), std::move(content), dir);
+  // DIR rasterises: on Vulkan wherever a device exists, lavapipe included (vk::StageKind).
+  const Backend rendering = vk::choose_backend(vk::StageKind::Rasterisation, pipeline.vulkan.get(), options.backend);
+  render::add_dir_stages(graph, rendering, pipeline.vulkan.get(), std::move(content), dir);
   graph.keep(kComposite);
   pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, dir.tone_map);
   if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", pipeline.final_composite);
@@ -310,23 +309,12 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
   // Geometry (positions + normals) follows the per-pixel backend; method 1's
   // pass-1 pyramid stays on the CPU either way (normals_raw_depth_vk.h).
   const bool method2 = options.geometry == GeometryMethod::Method2;
-  const bool geometry_on_gpu = per_pixel == Backend::Vulkan && pipeline.vulkan;
-  if (method2 && geometry_on_gpu) {
-    graph.emplace<DepthWarpMergeVkStage>(*pipeline.vulkan);
-  } else if (method2) {
-    graph.emplace<DepthWarpMergeCpuStage>();
-  }
+  if (method2) graph.add(make_depth_warp_merge_stage(per_pixel, pipeline.vulkan.get()));
   const auto input = method2 ? NormalsDepthInput::Filtered : NormalsDepthInput::Raw;
   if (method2 && options.method2_normals == Method2Normals::Plain) {
-    if (geometry_on_gpu) {
-      graph.emplace<NormalsFromPositionsVkStage>(*pipeline.vulkan);
-    } else {
-      graph.emplace<NormalsFromPositionsCpuStage>();
-    }
-  } else if (geometry_on_gpu) {
-    graph.emplace<NormalsRawDepthVkStage>(*pipeline.vulkan, NormalsRawDepthOptions{}, input);
+    graph.add(make_normals_from_positions_stage(per_pixel, pipeline.vulkan.get()));
   } else {
-    graph.emplace<NormalsRawDepthCpuStage>(NormalsRawDepthOptions{}, input);
+    graph.add(make_normals_raw_depth_stage(per_pixel, pipeline.vulkan.get(), NormalsRawDepthOptions{}, input));
   }
   graph.keep(kNormals);
   graph.keep(kPositions);

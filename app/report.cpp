@@ -39,6 +39,7 @@ nlohmann::ordered_json timing_report(const FrameGraph& graph, double total_secon
     nlohmann::ordered_json stage;
     stage["stage"] = timing.stage;
     stage["backend"] = to_string(timing.backend);
+    stage["buffers"] = timing.device_buffers ? "device" : "host";
     stage["frames"] = timing.wall_ms.size();
     stage["median_ms"] = wall.median;
     stage["mean_ms"] = wall.mean;

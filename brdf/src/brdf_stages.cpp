@@ -148,15 +148,18 @@ void DiffuseStage::run(StageContext& context) {
                    context.get(kd_), context.get(valid_));
 }
 
-KMeansStage::KMeansStage(KMeansOptions options, std::uint64_t seed, BrdfBuffers buffers)
-    : backend_(Backend::Cpu),
-      engine_(std::make_unique<KMeansCpu>(options.threads)),
-      first_tracker_(options, seed),
-      buffers_(std::move(buffers)) {}
+namespace {
 
-KMeansStage::KMeansStage(vk::VulkanContext& context, KMeansOptions options, std::uint64_t seed, BrdfBuffers buffers)
-    : backend_(Backend::Vulkan),
-      engine_(std::make_unique<KMeansVk>(context)),
+std::unique_ptr<KMeansEngine> kmeans_engine(vk::VulkanContext* context, const KMeansOptions& options) {
+  if (context) return std::make_unique<KMeansVk>(*context);
+  return std::make_unique<KMeansCpu>(options.threads);
+}
+
+}  // namespace
+
+KMeansStage::KMeansStage(vk::VulkanContext* context, KMeansOptions options, std::uint64_t seed, BrdfBuffers buffers)
+    : backend_(context ? Backend::Vulkan : Backend::Cpu),
+      engine_(kmeans_engine(context, options)),
       first_tracker_(options, seed),
       buffers_(std::move(buffers)) {}
 
@@ -182,12 +185,9 @@ void KMeansStage::run(StageContext& context) {
   context.get(clusters_) = materials_from_clusters(result_, pixels_, kd.width(), kd.height());
 }
 
-SpecularFitStage::SpecularFitStage(BrdfOptions options, BrdfBuffers buffers)
-    : options_(std::move(options)), buffers_(std::move(buffers)), solver_(make_solver(options_.solver)) {}
-
-SpecularFitStage::SpecularFitStage(vk::VulkanContext& context, BrdfOptions options, BrdfBuffers buffers)
-    : SpecularFitStage(std::move(options), std::move(buffers)) {
-  gpu_start_ = std::make_unique<SpecularObjectiveVk>(context);
+SpecularFitStage::SpecularFitStage(vk::VulkanContext* context, BrdfOptions options, BrdfBuffers buffers)
+    : options_(std::move(options)), buffers_(std::move(buffers)), solver_(make_solver(options_.solver)) {
+  if (context) gpu_start_ = std::make_unique<SpecularObjectiveVk>(*context);
 }
 
 SpecularFitStage::~SpecularFitStage() = default;
@@ -215,14 +215,9 @@ void add_brdf_stages(FrameGraph& graph, const BrdfOptions& options, Backend back
                      const BrdfBuffers& buffers) {
   graph.emplace<HighlightRemovalStage>(options.highlight, buffers);
   graph.emplace<DiffuseStage>(options.diffuse, options.ambient, buffers);
-  if (backend == Backend::Vulkan) {
-    if (!context) throw LogicError("add_brdf_stages: the Vulkan backend needs a VulkanContext");
-    graph.emplace<KMeansStage>(*context, options.kmeans, options.seed, buffers);
-    graph.emplace<SpecularFitStage>(*context, options, buffers);
-  } else {
-    graph.emplace<KMeansStage>(options.kmeans, options.seed, buffers);
-    graph.emplace<SpecularFitStage>(options, buffers);
-  }
+  vk::VulkanContext* device = context_for_backend(backend, context, "add_brdf_stages");
+  graph.emplace<KMeansStage>(device, options.kmeans, options.seed, buffers);
+  graph.emplace<SpecularFitStage>(device, options, buffers);
 }
 
 }  // namespace relight::brdf

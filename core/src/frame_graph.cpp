@@ -236,6 +236,7 @@ bool FrameGraph::run_frame() {
     auto& timing = timings_[timing_index++];
     timing.wall_ms.push_back(std::chrono::duration<double, std::milli>(stop - start).count());
     if (context.device_ms_ >= 0.0) timing.device_ms.push_back(context.device_ms_);
+    timing.device_buffers = context.device_access_;
   }
   ++frames_run_;
   return true;
@@ -399,6 +400,7 @@ DeviceBuffer& FrameGraph::BufferState::Version::device_copy(DeviceTransfer& tran
 
 DeviceBuffer& StageContext::device_for_read(BufferId id) {
   check_declared(id, detail::Access::Read);
+  device_access_ = true;
   return graph_.buffers_[id].current.device_copy(*graph_.device_);
 }
 
@@ -410,11 +412,13 @@ detail::AnyBuffer* StageContext::host_previous_without_sync(BufferId id) {
 
 DeviceBuffer* StageContext::device_for_previous(BufferId id) {
   check_declared(id, detail::Access::ReadPrevious);
+  device_access_ = true;
   auto& buffer = graph_.buffers_[id];
   return buffer.previous_valid ? &buffer.previous.device_copy(*graph_.device_) : nullptr;
 }
 
 DeviceBuffer& StageContext::device_for_write(BufferId id) {
+  device_access_ = true;
   auto& buffer = graph_.buffers_[id];
   auto& version = buffer.current;
   ensure_device_size(*graph_.device_, version.device, version.host->mutable_bytes().size());

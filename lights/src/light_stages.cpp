@@ -14,6 +14,12 @@ LightExtractionStage::LightExtractionStage(LightExtractionOptions options, Light
 
 LightExtractionStage::~LightExtractionStage() = default;
 
+std::unique_ptr<Stage> make_light_extraction_stage(Backend backend, vk::VulkanContext* context,
+                                                   LightExtractionOptions options, LightExtractionBuffers buffers) {
+  return std::make_unique<LightExtractionStage>(std::move(options), std::move(buffers),
+                                                context_for_backend(backend, context, "make_light_extraction_stage"));
+}
+
 void LightExtractionStage::declare(StageBuilder& builder) {
   probe_ = builder.read(buffers_.probe);
   lights_ = builder.write(buffers_.lights);

@@ -104,4 +104,10 @@ void NormalsFromPositionsVkStage::run(StageContext& context) {
   }
 }
 
+std::unique_ptr<Stage> make_normals_from_positions_stage(Backend backend, vk::VulkanContext* context,
+                                                         CrossNormalOptions options) {
+  return make_stage_for_backend<NormalsFromPositionsCpuStage, NormalsFromPositionsVkStage>(
+      backend, context, "make_normals_from_positions_stage", options);
+}
+
 }  // namespace relight

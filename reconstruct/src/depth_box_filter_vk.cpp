@@ -1,6 +1,7 @@
 // Vulkan implementation of the depth box filter (definition in depth_box_filter.h): one
 // invocation per pixel, shaders/depth_box_filter.comp, embedded at build time.
 #include "relight/core/error.h"
+#include "relight/core/stage_backend.h"
 #include "relight/reconstruct/depth_box_filter.h"
 #include "relight/reconstruct/depth_box_filter_shared.h"
 #include "relight/shaders/depth_box_filter_comp.h"
@@ -81,9 +82,8 @@ void DepthBoxFilterVkStage::run(StageContext& context) {
 
 std::unique_ptr<Stage> make_depth_box_filter_stage(Backend backend, vk::VulkanContext* context,
                                                    DepthBoxFilterBuffers buffers) {
-  if (backend == Backend::Cpu) return std::make_unique<DepthBoxFilterCpuStage>(std::move(buffers));
-  if (!context) throw LogicError("make_depth_box_filter_stage: the Vulkan backend needs a VulkanContext");
-  return std::make_unique<DepthBoxFilterVkStage>(*context, std::move(buffers));
+  return make_stage_for_backend<DepthBoxFilterCpuStage, DepthBoxFilterVkStage>(backend, context,
+                                                                               "make_depth_box_filter_stage", buffers);
 }
 
 }  // namespace relight

@@ -136,4 +136,10 @@ void DepthWarpMergeVkStage::run(StageContext& context) {
   if (const auto ms = method_.last_gpu_ms()) context.report_device_ms(*ms);
 }
 
+std::unique_ptr<Stage> make_depth_warp_merge_stage(Backend backend, vk::VulkanContext* context,
+                                                   DepthWarpMergeOptions options) {
+  return make_stage_for_backend<DepthWarpMergeCpuStage, DepthWarpMergeVkStage>(backend, context,
+                                                                               "make_depth_warp_merge_stage", options);
+}
+
 }  // namespace relight

@@ -339,26 +339,24 @@ void NormalsRawDepthStageBase::declare(StageBuilder& builder) {
   normals_ = builder.write(kNormals);
 }
 
-void NormalsRawDepthStageBase::run(StageContext& context) {
-  const FrameInfo& frame = context.get(frame_);
-  const Pose camera_to_world = frame.camera_to_world.value_or(Pose::Identity());
-  const NormalMap* previous_normals = context.get(previous_normals_);
-  const PositionMap* previous_positions = context.get(previous_positions_);
-  const FrameInfo* previous_frame = context.get(previous_frame_);
-  std::optional<NormalsHistory> history;
-  if (previous_normals && previous_positions) {
-    const Pose previous_pose =
-        previous_frame && previous_frame->camera_to_world ? *previous_frame->camera_to_world : Pose::Identity();
-    history.emplace(NormalsHistory{*previous_normals, *previous_positions, previous_pose});
-  }
-  estimate(context, context.get(depth_), frame.intrinsics, camera_to_world, history ? &*history : nullptr,
-           context.get(positions_), context.get(normals_));
+Pose NormalsRawDepthStageBase::camera_to_world(StageContext& context) const {
+  return context.get(frame_).camera_to_world.value_or(Pose::Identity());
 }
 
-void NormalsRawDepthCpuStage::estimate(StageContext&, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
-                                       const Pose& camera_to_world, const NormalsHistory* previous,
-                                       PositionMap& positions, NormalMap& normals) {
-  method_.run(depth, intrinsics, camera_to_world, previous, options(), positions, normals);
+Pose NormalsRawDepthStageBase::previous_camera_to_world(StageContext& context) const {
+  const FrameInfo* previous_frame = context.get(previous_frame_);
+  return previous_frame && previous_frame->camera_to_world ? *previous_frame->camera_to_world : Pose::Identity();
+}
+
+void NormalsRawDepthCpuStage::run(StageContext& context) {
+  const NormalMap* previous_normals = context.get(previous_normals_);
+  const PositionMap* previous_positions = context.get(previous_positions_);
+  std::optional<NormalsHistory> history;
+  if (previous_normals && previous_positions) {
+    history.emplace(NormalsHistory{*previous_normals, *previous_positions, previous_camera_to_world(context)});
+  }
+  method_.run(context.get(depth_), context.get(frame_).intrinsics, camera_to_world(context),
+              history ? &*history : nullptr, options(), context.get(positions_), context.get(normals_));
 }
 
 }  // namespace relight

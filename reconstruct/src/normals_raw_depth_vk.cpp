@@ -32,9 +32,10 @@ struct NormalsRawDepthVk::Pipelines {
 };
 
 /// Device buffers kept across frames, remade only when a size changes: a steady run allocates
-/// no device memory.
+/// no device memory. The first group serves the device path, the second the host convenience.
 struct NormalsRawDepthVk::Scratch {
-  std::optional<vk::VulkanBuffer> depth, positions, normals, blended, previous_positions, pyramid, curvature;
+  std::optional<vk::VulkanBuffer> fresh_normals, blended, pyramid, curvature;
+  std::optional<vk::VulkanBuffer> depth, positions, normals, previous_positions;
 };
 
 NormalsRawDepthVk::NormalsRawDepthVk(vk::VulkanContext& context)
@@ -45,39 +46,45 @@ NormalsRawDepthVk::NormalsRawDepthVk(vk::VulkanContext& context)
 
 NormalsRawDepthVk::~NormalsRawDepthVk() = default;
 
-void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
-                            const NormalsHistory* previous, const NormalsRawDepthOptions& options,
-                            PositionMap& positions, NormalMap& normals) {
-  const int width = depth.width(), height = depth.height();
-  positions.resize(width, height);
-  normals.resize(width, height);
-  last_gpu_ms_.reset();
-  if (depth.empty()) return;
-  const std::size_t map_bytes = positions.bytes().size();
-  vk::VulkanTransfer& transfer = context_.transfer();
-  Scratch& scratch = *scratch_;
-  vk::VulkanBuffer& depth_buffer = vk::buffer_of_size(scratch.depth, context_, depth.bytes().size());
-  vk::VulkanBuffer& position_buffer = vk::buffer_of_size(scratch.positions, context_, map_bytes);
-  vk::VulkanBuffer& normal_buffer = vk::buffer_of_size(scratch.normals, context_, map_bytes);
-  vk::VulkanBuffer& blended_buffer = vk::buffer_of_size(scratch.blended, context_, map_bytes);
-  transfer.upload(depth.bytes(), depth_buffer);
-  std::optional<double> total =
-      cross_.run(depth_buffer, position_buffer, normal_buffer, width, height, intrinsics,
-                 cross_normal_options(options));
+namespace {
 
-  const bool usable_history = previous && previous->normals.same_shape(depth) && previous->positions.same_shape(depth);
-  // Without history the blend is the identity: let the fill pass read the fresh normals directly.
-  const vk::VulkanBuffer* fill_input = &normal_buffer;
+void add_ms(std::optional<double>& total, std::optional<double> ms) {
+  if (ms && total) *total += *ms;
+}
+
+}  // namespace
+
+std::optional<double> NormalsRawDepthVk::run(const vk::VulkanBuffer& depth, int width, int height,
+                                             const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                                             const NormalsDeviceHistory* previous,
+                                             const NormalsRawDepthOptions& options, vk::VulkanBuffer& positions,
+                                             vk::VulkanBuffer& normals) {
+  last_gpu_ms_.reset();
+  if (width <= 0 || height <= 0) return last_gpu_ms_;
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  const std::size_t map_bytes = pixels * sizeof(Float3);
+  if (positions.size_bytes() < map_bytes || normals.size_bytes() < map_bytes) {
+    throw LogicError("NormalsRawDepthVk::run: output buffers smaller than width*height Float3");
+  }
+  Scratch& scratch = *scratch_;
+  vk::VulkanBuffer& fresh_normals = vk::buffer_of_size(scratch.fresh_normals, context_, map_bytes);
+  std::optional<double> total =
+      cross_.run(depth, positions, fresh_normals, width, height, intrinsics, cross_normal_options(options));
+
+  const bool usable_history = previous && previous->normals.width() == width && previous->normals.height() == height &&
+                              previous->positions.size_bytes() >= map_bytes;
+  // Without history the blend is the identity: the fill pass reads the fresh normals directly.
+  const vk::VulkanBuffer* fill_input = &fresh_normals;
   if (usable_history) {
     const std::vector<NormalsPyramidLevel> pyramid =
         normals_history_pyramid(previous->normals, options.mip_levels, options.threads);
     std::vector<Float3> texels;
     for (const auto& level : pyramid) texels.insert(texels.end(), level.normal.pixels().begin(), level.normal.pixels().end());
-    vk::VulkanBuffer& previous_positions = vk::buffer_of_size(scratch.previous_positions, context_, map_bytes);
+    vk::VulkanBuffer& blended = vk::buffer_of_size(scratch.blended, context_, map_bytes);
     vk::VulkanBuffer& pyramid_buffer = vk::buffer_of_size(scratch.pyramid, context_, texels.size() * sizeof(Float3));
     vk::VulkanBuffer& curvature_buffer =
         vk::buffer_of_size(scratch.curvature, context_, pyramid.front().curvature.bytes().size());
-    transfer.upload(previous->positions.bytes(), previous_positions);
+    vk::VulkanTransfer& transfer = context_.transfer();
     transfer.upload(std::as_bytes(std::span<const Float3>(texels)), pyramid_buffer);
     transfer.upload(pyramid.front().curvature.bytes(), curvature_buffer);
 
@@ -100,39 +107,86 @@ void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intr
     params.levels = static_cast<gpu::uint>(pyramid.size());
     constexpr std::uint32_t local = RELIGHT_NORMALS_BLEND_LOCAL_SIZE;
     const auto set = pipelines_->blend.bind(
-        {&position_buffer, &normal_buffer, &previous_positions, &pyramid_buffer, &curvature_buffer, &blended_buffer});
+        {&positions, &fresh_normals, &previous->positions, &pyramid_buffer, &curvature_buffer, &blended});
     context_.submit([&](VkCommandBuffer cmd) {
       pipelines_->timer.start(cmd);
       pipelines_->blend.dispatch(cmd, set, params, vk::ComputePipeline::group_count(params.width, local),
                                  vk::ComputePipeline::group_count(params.height, local));
       pipelines_->timer.stop(cmd);
     });
-    if (const auto ms = pipelines_->timer.elapsed_ms(); ms && total) *total += *ms;
-    fill_input = &blended_buffer;
+    add_ms(total, pipelines_->timer.elapsed_ms());
+    fill_input = &blended;
   }
 
-  // Fill reads fill_input and writes the other buffer, so no pixel sees a neighbour's fill.
-  vk::VulkanBuffer& fill_output = fill_input == &normal_buffer ? blended_buffer : normal_buffer;
+  // Fill reads fill_input and writes the output, so no pixel sees a neighbour's fill.
   const gpu::NormalsFillParams fill_params{static_cast<gpu::uint>(width), static_cast<gpu::uint>(height)};
   constexpr std::uint32_t local = RELIGHT_NORMALS_BLEND_LOCAL_SIZE;
-  const auto fill_set = pipelines_->fill.bind({&position_buffer, fill_input, &fill_output});
+  const auto fill_set = pipelines_->fill.bind({&positions, fill_input, &normals});
   context_.submit([&](VkCommandBuffer cmd) {
     pipelines_->timer.start(cmd);
     pipelines_->fill.dispatch(cmd, fill_set, fill_params, vk::ComputePipeline::group_count(fill_params.width, local),
                               vk::ComputePipeline::group_count(fill_params.height, local));
     pipelines_->timer.stop(cmd);
   });
-  if (const auto ms = pipelines_->timer.elapsed_ms(); ms && total) *total += *ms;
+  add_ms(total, pipelines_->timer.elapsed_ms());
   last_gpu_ms_ = total;
-  transfer.download(position_buffer, positions.bytes());
-  transfer.download(fill_output, normals.bytes());
+  return last_gpu_ms_;
 }
 
-void NormalsRawDepthVkStage::estimate(StageContext& context, const DepthMap& depth,
-                                      const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
-                                      const NormalsHistory* previous, PositionMap& positions, NormalMap& normals) {
-  method_.run(depth, intrinsics, camera_to_world, previous, options(), positions, normals);
-  if (const auto ms = method_.last_gpu_ms()) context.report_device_ms(*ms);
+void NormalsRawDepthVk::run(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
+                            const NormalsHistory* previous, const NormalsRawDepthOptions& options,
+                            PositionMap& positions, NormalMap& normals) {
+  const int width = depth.width(), height = depth.height();
+  positions.resize(width, height);
+  normals.resize(width, height);
+  last_gpu_ms_.reset();
+  if (depth.empty()) return;
+  const std::size_t map_bytes = positions.bytes().size();
+  vk::VulkanTransfer& transfer = context_.transfer();
+  Scratch& scratch = *scratch_;
+  vk::VulkanBuffer& depth_buffer = vk::buffer_of_size(scratch.depth, context_, depth.bytes().size());
+  vk::VulkanBuffer& position_buffer = vk::buffer_of_size(scratch.positions, context_, map_bytes);
+  vk::VulkanBuffer& normal_buffer = vk::buffer_of_size(scratch.normals, context_, map_bytes);
+  transfer.upload(depth.bytes(), depth_buffer);
+  std::optional<NormalsDeviceHistory> history;
+  if (previous && previous->normals.same_shape(depth) && previous->positions.same_shape(depth)) {
+    vk::VulkanBuffer& previous_positions = vk::buffer_of_size(scratch.previous_positions, context_, map_bytes);
+    transfer.upload(previous->positions.bytes(), previous_positions);
+    history.emplace(NormalsDeviceHistory{previous->normals, previous_positions, previous->camera_to_world});
+  }
+  run(depth_buffer, width, height, intrinsics, camera_to_world, history ? &*history : nullptr, options, position_buffer,
+      normal_buffer);
+  transfer.download(position_buffer, positions.bytes());
+  transfer.download(normal_buffer, normals.bytes());
+}
+
+void NormalsRawDepthVkStage::run(StageContext& context) {
+  auto& depth = context.device_read<vk::VulkanBuffer>(depth_);
+  // Only the shape is needed on the host; shape_of never downloads device-side pixels.
+  const DepthMap& depth_shape = context.shape_of(depth_);
+  const int width = depth_shape.width(), height = depth_shape.height();
+  auto& positions =
+      context.device_write<vk::VulkanBuffer>(positions_, [&](PositionMap& p) { p.resize(width, height); });
+  auto& normals = context.device_write<vk::VulkanBuffer>(normals_, [&](NormalMap& n) { n.resize(width, height); });
+  // The previous normals on the host for pass 1's pyramid; the previous positions on the device.
+  std::optional<NormalsDeviceHistory> history;
+  const PositionMap* previous_positions_shape = context.shape_of(previous_positions_);
+  if (const NormalMap* previous_normals = context.get(previous_normals_);
+      previous_normals && previous_positions_shape && previous_positions_shape->same_shape(depth_shape)) {
+    if (const auto* previous_positions = context.device_read<vk::VulkanBuffer>(previous_positions_)) {
+      history.emplace(NormalsDeviceHistory{*previous_normals, *previous_positions, previous_camera_to_world(context)});
+    }
+  }
+  const std::optional<double> gpu_ms =
+      method_.run(depth, width, height, context.get(frame_).intrinsics, camera_to_world(context),
+                  history ? &*history : nullptr, options(), positions, normals);
+  if (gpu_ms) context.report_device_ms(*gpu_ms);
+}
+
+std::unique_ptr<Stage> make_normals_raw_depth_stage(Backend backend, vk::VulkanContext* context,
+                                                    NormalsRawDepthOptions options, NormalsDepthInput input) {
+  return make_stage_for_backend<NormalsRawDepthCpuStage, NormalsRawDepthVkStage>(
+      backend, context, "make_normals_raw_depth_stage", options, input);
 }
 
 }  // namespace relight

@@ -138,6 +138,7 @@ TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
     if (stage["stage"] != "depth_box_filter") continue;
     found = true;
     EXPECT_EQ(stage["backend"], "Vulkan");
+    EXPECT_EQ(stage["buffers"], "device");
     EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0);
   }
   EXPECT_TRUE(found);
@@ -146,7 +147,8 @@ TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
 }
 
 // The geometry stages follow the per-pixel backend: with --backend vulkan both methods (and
-// both kinds of method-2 normals) report device time for each of their stages.
+// both kinds of method-2 normals) report device time for each of their stages and work on the
+// graph's device buffers.
 TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
   TempDir dir;
   const std::vector<std::pair<std::string, std::vector<std::string>>> runs = {
@@ -166,6 +168,9 @@ TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
         if (stage["stage"] != name) continue;
         found = true;
         EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0) << name;
+        // The graph hands them device buffers: no stage transfers on its own.
+        EXPECT_EQ(stage["backend"], "Vulkan") << name;
+        EXPECT_EQ(stage["buffers"], "device") << name;
       }
       EXPECT_TRUE(found) << arguments << ": " << name;
     }

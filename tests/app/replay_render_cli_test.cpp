@@ -206,14 +206,18 @@ TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
   EXPECT_EQ(report["frames"].get<int>(), 12);
   EXPECT_GT(report["device_memory"]["allocations"].get<int>(), 10);
   EXPECT_EQ(report["device_memory"]["allocations_after_frame_2"].get<int>(), 0);
-  // Every stage that dispatches on the device reports its GPU time (lavapipe has timestamps).
+  // Every stage that dispatches on the device says so and reports its GPU time (lavapipe has
+  // timestamps); where its buffers live is its own row (the per-pixel ones on the device).
   for (const char* name : {"depth_box_filter", "normals_raw_depth", "kmeans", "dir", "colormap_statistics"}) {
     bool found = false;
     for (const auto& stage : report["stages"]) {
       if (stage["stage"] != name) continue;
       found = true;
+      EXPECT_EQ(stage["backend"], "Vulkan") << name;
       ASSERT_TRUE(stage.contains("device_median_ms")) << name;
       EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0) << name;
+      const bool host_buffers = std::string(name) == "kmeans" || std::string(name) == "dir";
+      EXPECT_EQ(stage["buffers"], host_buffers ? "host" : "device") << name;
     }
     EXPECT_TRUE(found) << name;
   }

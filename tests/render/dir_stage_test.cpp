@@ -38,7 +38,7 @@ StageRun run_stage(vk::VulkanContext* context) {
   DirStageOptions options;
   options.renderer.shadow_tile = 256;
   options.renderer.ism.tile = 32;
-  add_dir_stages(graph, context, std::move(content), options);
+  add_dir_stages(graph, context ? Backend::Vulkan : Backend::Cpu, context, std::move(content), options);
   graph.keep("composite");
   graph.keep("mr_scene");
   graph.keep("vpls");

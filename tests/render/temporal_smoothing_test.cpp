@@ -127,7 +127,7 @@ double flicker(vk::VulkanContext& context, bool smoothing, Geometry geometry, co
   options.renderer.shadow_tile = 256;
   options.renderer.ism.tile = 32;
   options.temporal_smoothing = smoothing;
-  add_dir_stages(graph, &context, std::move(content), options);
+  add_dir_stages(graph, Backend::Vulkan, &context, std::move(content), options);
   graph.keep("L_rv_indirect");
   graph.keep("dir_gbuffer");
   graph.compile();

@@ -40,8 +40,9 @@ MrCamera frame_camera(const FrameInfo& frame, int width, int height) {
 
 }  // namespace
 
-void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneContent content,
+void add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* given_context, DirSceneContent content,
                     const DirStageOptions& options) {
+  vk::VulkanContext* context = context_for_backend(backend, given_context, "add_dir_stages");
   graph.emplace<MrSceneStage>(std::move(content), options);
   graph.emplace<VplStage>(options.vpls, context);
   graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffers);

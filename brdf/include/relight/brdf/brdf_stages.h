@@ -26,6 +26,7 @@
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/core/stage_backend.h"
 #include "relight/lights/buffers.h"
 #include "relight/lights/light_set.h"
 
@@ -106,11 +107,12 @@ class DiffuseStage final : public Stage {
   Write<Mask> valid_;
 };
 
-/// K-means on the CPU engine, or on the Vulkan engine when constructed with a context.
+/// K-means on the CPU engine, or on the Vulkan engine when `context` is not null (add_brdf_stages
+/// chooses, core/stage_backend.h). Its buffers live on the host either way.
 class KMeansStage final : public Stage {
  public:
-  explicit KMeansStage(KMeansOptions options = {}, std::uint64_t seed = 1, BrdfBuffers buffers = {});
-  KMeansStage(vk::VulkanContext& context, KMeansOptions options = {}, std::uint64_t seed = 1, BrdfBuffers buffers = {});
+  explicit KMeansStage(vk::VulkanContext* context, KMeansOptions options = {}, std::uint64_t seed = 1,
+                       BrdfBuffers buffers = {});
   ~KMeansStage() override;
   [[nodiscard]] std::string name() const override { return "kmeans"; }
   [[nodiscard]] Backend backend() const override { return backend_; }
@@ -134,15 +136,15 @@ class KMeansStage final : public Stage {
 };
 
 /// The specular fit on the CPU, or with each cluster's starting point chosen on the GPU
-/// (fit_materials()'s gpu_start) when constructed with a context. Either way it declares the CPU
-/// backend: its buffers (Materials, the samples it gathers) live on the host, and the GPU start
-/// uploads its own small batch.
+/// (fit_materials()'s gpu_start) when `context` is not null (add_brdf_stages chooses). Its
+/// buffers (Materials, the samples it gathers) live on the host either way; the GPU start
+/// uploads its own small batch of samples.
 class SpecularFitStage final : public Stage {
  public:
-  explicit SpecularFitStage(BrdfOptions options = {}, BrdfBuffers buffers = {});
-  SpecularFitStage(vk::VulkanContext& context, BrdfOptions options = {}, BrdfBuffers buffers = {});
+  explicit SpecularFitStage(vk::VulkanContext* context, BrdfOptions options = {}, BrdfBuffers buffers = {});
   ~SpecularFitStage() override;
   [[nodiscard]] std::string name() const override { return "specular_fit"; }
+  [[nodiscard]] Backend backend() const override { return gpu_start_ ? Backend::Vulkan : Backend::Cpu; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 

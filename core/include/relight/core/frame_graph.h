@@ -230,6 +230,7 @@ class StageContext {
   FrameGraph& graph_;
   std::size_t stage_;
   bool end_of_stream_ = false;
+  bool device_access_ = false;  ///< device_read or device_write was called this run
   double device_ms_ = -1.0;
 };
 
@@ -238,6 +239,9 @@ class Stage {
  public:
   virtual ~Stage() = default;
   [[nodiscard]] virtual std::string name() const = 0;
+  /// Where the stage's work runs: Vulkan when it dispatches to the GPU, whether its graph
+  /// buffers live on the device (device_read/device_write) or on the host (StageTimings says
+  /// which it used). Chosen by the stage's factory (core/stage_backend.h).
   [[nodiscard]] virtual Backend backend() const { return Backend::Cpu; }
   /// Stages with effects outside the graph (sources, writers) are never culled.
   [[nodiscard]] virtual bool has_side_effects() const { return false; }
@@ -254,6 +258,8 @@ struct StageTimings {
   Backend backend = Backend::Cpu;
   std::vector<double> wall_ms;    ///< one entry per frame the stage ran in
   std::vector<double> device_ms;  ///< GPU time where the stage reported it (else empty)
+  /// Whether the stage's last run read or wrote graph buffers on the device (else on the host).
+  bool device_buffers = false;
 };
 
 class FrameGraph {

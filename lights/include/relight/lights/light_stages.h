@@ -11,6 +11,7 @@
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/named_values.h"
+#include "relight/core/stage_backend.h"
 #include "relight/lights/buffers.h"
 #include "relight/lights/importance_sampling.h"
 #include "relight/lights/median_cut.h"
@@ -33,7 +34,8 @@ struct LightExtractionBuffers {
   BufferName<LightSet> lights = kLightsRaw;
 };
 
-/// Either method on the CPU, or importance sampling on Vulkan when `context` is given.
+/// Either method on the CPU, or importance sampling on Vulkan when `context` is not null (made
+/// by make_light_extraction_stage, which chooses). Its buffers live on the host either way.
 class LightExtractionStage final : public Stage {
  public:
   explicit LightExtractionStage(LightExtractionOptions options, LightExtractionBuffers buffers = {},
@@ -54,6 +56,12 @@ class LightExtractionStage final : public Stage {
   Read<RadianceImage> probe_;
   Write<LightSet> lights_;
 };
+
+/// LightExtractionStage for `backend` (core/stage_backend.h); Backend::Vulkan requires a non-null
+/// `context` and LightMethod::Importance (else relight::LogicError).
+[[nodiscard]] std::unique_ptr<Stage> make_light_extraction_stage(Backend backend, vk::VulkanContext* context,
+                                                                 LightExtractionOptions options,
+                                                                 LightExtractionBuffers buffers = {});
 
 /// Runs the chosen method once on a probe (what the stage does per frame).
 [[nodiscard]] LightSet extract_lights(const RadianceImage& probe, const LightExtractionOptions& options);

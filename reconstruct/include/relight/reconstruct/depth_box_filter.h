@@ -97,8 +97,8 @@ class DepthBoxFilterVkStage final : public Stage {
   Write<DepthMap> output_;
 };
 
-/// The stage for `backend` (pick it with vk::choose_backend(StageKind::PerPixel, ...)).
-/// Backend::Vulkan requires a non-null `context` (else relight::LogicError).
+/// The stage for `backend` (core/stage_backend.h; pick it with vk::choose_backend(StageKind::PerPixel,
+/// ...)). Backend::Vulkan requires a non-null `context` (else relight::LogicError).
 [[nodiscard]] std::unique_ptr<Stage> make_depth_box_filter_stage(Backend backend, vk::VulkanContext* context,
                                                                  DepthBoxFilterBuffers buffers = {});
 

@@ -24,6 +24,7 @@
 // camera_to_world: identity when absent) and the previous frame's DepthMap "depth_filtered",
 // DepthWeightMap "depth_weight" and FrameInfo "frame"; it writes DepthMap "depth_filtered" and
 // DepthWeightMap "depth_weight".
+#include <memory>
 #include <string>
 
 #include "relight/core/camera.h"
@@ -31,6 +32,7 @@
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/core/stage_backend.h"
 
 namespace relight {
 
@@ -92,5 +94,10 @@ class DepthWarpMergeCpuStage final : public DepthWarpMergeStageBase {
   DepthMap warped_;              // scratch, kept to avoid reallocating every frame
   DepthWeightMap warped_weight_;
 };
+
+/// DepthWarpMergeCpuStage or DepthWarpMergeVkStage (depth_warp_merge_vk.h) for `backend`
+/// (core/stage_backend.h); Backend::Vulkan requires a non-null `context`.
+[[nodiscard]] std::unique_ptr<Stage> make_depth_warp_merge_stage(Backend backend, vk::VulkanContext* context,
+                                                                 DepthWarpMergeOptions options = {});
 
 }  // namespace relight

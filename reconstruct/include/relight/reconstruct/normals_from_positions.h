@@ -19,6 +19,7 @@
 //
 // Stage NormalsFromPositionsCpuStage reads DepthMap "depth_filtered" and FrameInfo "frame"
 // (intrinsics) and writes PositionMap "positions" and NormalMap "normals".
+#include <memory>
 #include <string>
 
 #include "relight/core/buffers.h"
@@ -26,6 +27,7 @@
 #include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/core/stage_backend.h"
 
 namespace relight {
 
@@ -68,5 +70,10 @@ class NormalsFromPositionsCpuStage final : public Stage {
   Write<PositionMap> positions_;
   Write<NormalMap> normals_;
 };
+
+/// NormalsFromPositionsCpuStage or NormalsFromPositionsVkStage (cross_normals_vk.h) for `backend`
+/// (core/stage_backend.h); Backend::Vulkan requires a non-null `context`.
+[[nodiscard]] std::unique_ptr<Stage> make_normals_from_positions_stage(Backend backend, vk::VulkanContext* context,
+                                                                       CrossNormalOptions options = {});
 
 }  // namespace relight

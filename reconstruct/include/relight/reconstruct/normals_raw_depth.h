@@ -57,6 +57,7 @@
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/core/stage_backend.h"
 #include "relight/reconstruct/normals_from_positions.h"
 
 namespace relight {
@@ -136,26 +137,20 @@ void normals_raw_depth_blend(const PinholeIntrinsics& intrinsics, const Pose& ca
 /// Which depth the stage estimates from: the sensor's (method 1) or method 2's merged depth.
 enum class NormalsDepthInput { Raw, Filtered };
 
-/// What the CPU and Vulkan stages of method 1 share: the buffers they declare (see the header
-/// comment) and how last frame's normals, positions and pose become the NormalsHistory
-/// (identity poses when a frame has none). Subclasses only estimate.
+/// What the CPU and Vulkan stages of method 1 share: the name, the buffers they declare (see the
+/// header comment) and the poses of this and the previous frame (identity when a frame has none).
 class NormalsRawDepthStageBase : public Stage {
  public:
   explicit NormalsRawDepthStageBase(NormalsRawDepthOptions options, NormalsDepthInput input = NormalsDepthInput::Raw)
       : options_(options), input_(input) {}
   [[nodiscard]] std::string name() const final;
   void declare(StageBuilder& builder) final;
-  void run(StageContext& context) final;
 
  protected:
-  virtual void estimate(StageContext& context, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
-                        const Pose& camera_to_world, const NormalsHistory* previous, PositionMap& positions,
-                        NormalMap& normals) = 0;
   [[nodiscard]] const NormalsRawDepthOptions& options() const { return options_; }
+  [[nodiscard]] Pose camera_to_world(StageContext& context) const;
+  [[nodiscard]] Pose previous_camera_to_world(StageContext& context) const;
 
- private:
-  NormalsRawDepthOptions options_;
-  NormalsDepthInput input_;
   Read<DepthMap> depth_;
   Read<FrameInfo> frame_;
   ReadPrevious<NormalMap> previous_normals_;
@@ -163,6 +158,10 @@ class NormalsRawDepthStageBase : public Stage {
   ReadPrevious<FrameInfo> previous_frame_;
   Write<PositionMap> positions_;
   Write<NormalMap> normals_;
+
+ private:
+  NormalsRawDepthOptions options_;
+  NormalsDepthInput input_;
 };
 
 /// Frame-graph stage of method 1 on the CPU (the reference).
@@ -170,12 +169,16 @@ class NormalsRawDepthCpuStage final : public NormalsRawDepthStageBase {
  public:
   explicit NormalsRawDepthCpuStage(NormalsRawDepthOptions options = {}, NormalsDepthInput input = NormalsDepthInput::Raw)
       : NormalsRawDepthStageBase(options, input) {}
+  void run(StageContext& context) override;
 
  private:
-  void estimate(StageContext& context, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
-                const Pose& camera_to_world, const NormalsHistory* previous, PositionMap& positions,
-                NormalMap& normals) override;
   NormalsRawDepthCpu method_;
 };
+
+/// NormalsRawDepthCpuStage or NormalsRawDepthVkStage (normals_raw_depth_vk.h) for `backend`
+/// (core/stage_backend.h); Backend::Vulkan requires a non-null `context`.
+[[nodiscard]] std::unique_ptr<Stage> make_normals_raw_depth_stage(Backend backend, vk::VulkanContext* context,
+                                                                  NormalsRawDepthOptions options = {},
+                                                                  NormalsDepthInput input = NormalsDepthInput::Raw);
 
 }  // namespace relight

@@ -4,11 +4,12 @@
 //   2. pass 2's temporal blend with the history (eq. 4.7–4.8; shaders/normals_blend.comp),
 //   3. hole filling from the 4-neighbours (shaders/normals_fill_holes.comp).
 // Pass 1 (the half-resolution mean/curvature pyramid, eq. 4.1–4.3) runs on the CPU
-// (normals_history_pyramid) and is uploaded, with the previous frame's positions.
+// (normals_history_pyramid) from the previous frame's normals on the host, and is uploaded;
+// the previous frame's positions stay on the device.
 //
-// Reads:  depth, intrinsics, this frame's camera_to_world, the previous frame's NormalsHistory
-//         (null on the first frame; ignored when its shape differs), NormalsRawDepthOptions
-//         (threads only for the CPU pyramid).
+// Reads:  depth, intrinsics, this frame's camera_to_world, the previous frame's normals,
+//         positions and pose (none on the first frame; ignored when their shape differs),
+//         NormalsRawDepthOptions (threads only for the CPU pyramid).
 // Writes: positions and normals exactly as normals_raw_depth defines them, to float rounding.
 // This header includes no Vulkan headers.
 #include <memory>
@@ -24,6 +25,14 @@
 
 namespace relight {
 
+/// The previous frame as the device version of method 1 reads it: normals on the host (pass 1's
+/// pyramid is built on the CPU), positions on the device (`positions` >= width*height Float3).
+struct NormalsDeviceHistory {
+  const NormalMap& normals;
+  const vk::VulkanBuffer& positions;
+  Pose camera_to_world;
+};
+
 /// Holds the pipelines: create once, reuse every frame.
 class NormalsRawDepthVk {
  public:
@@ -32,7 +41,15 @@ class NormalsRawDepthVk {
   NormalsRawDepthVk(const NormalsRawDepthVk&) = delete;
   NormalsRawDepthVk& operator=(const NormalsRawDepthVk&) = delete;
 
-  /// One frame (uploads, three dispatches, downloads). Resizes the outputs.
+  /// One frame on device buffers: `depth` >= width*height floats, `positions` and `normals` >=
+  /// width*height Float3. `previous` may be null (first frame) and is ignored when its normals
+  /// are not width x height. Waits for completion; returns the GPU time when the device has
+  /// timestamps. Scratch buffers are kept across calls (no allocation while the size holds).
+  std::optional<double> run(const vk::VulkanBuffer& depth, int width, int height, const PinholeIntrinsics& intrinsics,
+                            const Pose& camera_to_world, const NormalsDeviceHistory* previous,
+                            const NormalsRawDepthOptions& options, vk::VulkanBuffer& positions,
+                            vk::VulkanBuffer& normals);
+  /// Convenience on host maps (tests, benchmarks): uploads, runs, downloads. Resizes the outputs.
   void run(const DepthMap& depth, const PinholeIntrinsics& intrinsics, const Pose& camera_to_world,
            const NormalsHistory* previous, const NormalsRawDepthOptions& options, PositionMap& positions,
            NormalMap& normals);
@@ -53,20 +70,18 @@ class NormalsRawDepthVk {
 /// buffers for either NormalsDepthInput: reads DepthMap "depth" or "depth_filtered", FrameInfo
 /// "frame" and the previous frame's "normals", "positions" and "frame"; writes NormalMap
 /// "normals" and PositionMap "positions").
-/// It works on the graph's host buffers and does its own uploads and downloads, because the
-/// graph hands previous-frame buffers to stages on the host only and pass 1 runs on the CPU
-/// anyway; so backend() is Cpu in the graph's sense, while the GPU time of the dispatches is
-/// reported to the graph's timing table.
+/// It works on the graph's device buffers (backend() Vulkan): depth, this frame's outputs and
+/// the previous frame's positions on the device (the graph double-buffers them), the previous
+/// normals on the host for pass 1. It reports the GPU time of its dispatches.
 class NormalsRawDepthVkStage final : public NormalsRawDepthStageBase {
  public:
   explicit NormalsRawDepthVkStage(vk::VulkanContext& context, NormalsRawDepthOptions options = {},
                                   NormalsDepthInput input = NormalsDepthInput::Raw)
       : NormalsRawDepthStageBase(options, input), method_(context) {}
+  [[nodiscard]] Backend backend() const override { return Backend::Vulkan; }
+  void run(StageContext& context) override;
 
  private:
-  void estimate(StageContext& context, const DepthMap& depth, const PinholeIntrinsics& intrinsics,
-                const Pose& camera_to_world, const NormalsHistory* previous, PositionMap& positions,
-                NormalMap& normals) override;
   NormalsRawDepthVk method_;
 };
 

@@ -51,6 +51,7 @@
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
+#include "relight/core/stage_backend.h"
 #include "relight/render/buffers.h"
 #include "relight/render/dir/dir_vk.h"
 #include "relight/render/dir/temporal_smoothing.h"
@@ -91,8 +92,9 @@ struct DirSceneContent {
   std::vector<std::pair<VirtualModel, Placement>> objects;
 };
 
-/// Adds the five stages above. `context` may be null (CPU rendering); it must outlive the graph.
-void add_dir_stages(FrameGraph& graph, vk::VulkanContext* context, DirSceneContent content,
+/// Adds the five stages above for `backend` (core/stage_backend.h: Backend::Cpu renders without a
+/// GPU, Backend::Vulkan needs `context`, which must outlive the graph).
+void add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* context, DirSceneContent content,
                     const DirStageOptions& options = {});
 
 /// Step 1 (scene): the mixed-reality scene of the frame.
@@ -125,6 +127,10 @@ class VplStage final : public Stage {
   explicit VplStage(VplOptions options, vk::VulkanContext* context = nullptr);
   ~VplStage() override;
   [[nodiscard]] std::string name() const override { return "vpls"; }
+  /// Vulkan when a step of its options runs on the GPU (the rest, and its buffers, on the host).
+  [[nodiscard]] Backend backend() const override {
+    return cone_search_ || reflective_shadow_maps_ ? Backend::Vulkan : Backend::Cpu;
+  }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
@@ -145,6 +151,9 @@ class DirRenderStage final : public Stage {
                  std::optional<RealAlbedoBuffers> albedo_buffers = std::nullopt);
   ~DirRenderStage() override;
   [[nodiscard]] std::string name() const override { return "dir"; }
+  /// Vulkan with a context (rasterisation on the GPU, shading where DirBackend says); its
+  /// buffers live on the host either way.
+  [[nodiscard]] Backend backend() const override { return context_ ? Backend::Vulkan : Backend::Cpu; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
