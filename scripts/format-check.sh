@@ -4,13 +4,9 @@
 # are held to it (git clang-format), so older code is reformatted when it is next touched.
 # Usage: scripts/format-check.sh [BASE]     Fix: git clang-format BASE
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$root"
-base="${1:-HEAD~1}"
-if ! git rev-parse --verify --quiet "$base^{commit}" >/dev/null; then
-  echo "format check: no commit $base to compare with; skipped"
-  exit 0
-fi
+check_name="format check"
+# shellcheck source=scripts/lint-base.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lint-base.sh"
 diff="$(git clang-format --diff --extensions cpp,h "$base" -- . || true)"
 if [ -z "$diff" ] || [ "$diff" = "no modified files to format" ] || [[ "$diff" == *"did not modify any files"* ]]; then
   echo "format check: the lines changed since $base follow .clang-format"

@@ -6,13 +6,9 @@
 # outside the compile commands (fuzz targets, the install test's consumer) are not checked.
 # Usage: scripts/tidy-check.sh [BASE]
 set -euo pipefail
-root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$root"
-base="${1:-HEAD~1}"
-if ! git rev-parse --verify --quiet "$base^{commit}" >/dev/null; then
-  echo "tidy check: no commit $base to compare with; skipped"
-  exit 0
-fi
+check_name="tidy check"
+# shellcheck source=scripts/lint-base.sh
+source "$(dirname "${BASH_SOURCE[0]}")/lint-base.sh"
 database=build/debug/compile_commands.json
 if [ ! -f "$database" ]; then
   echo "tidy check: $database is missing (cmake --preset debug)" >&2

@@ -50,15 +50,13 @@ void KMeansVk::set_points(std::span<const Float3> points) {
   const std::size_t bytes = points.size_bytes();
   const std::size_t groups = (points.size() + kGroup - 1) / kGroup;
   const std::size_t partial_bytes = groups * RELIGHT_KMEANS_MAX_CLUSTERS * kSums * sizeof(std::uint32_t);
-  const bool grow = !r.points || r.points->size_bytes() < bytes || r.partials->size_bytes() < partial_bytes;
-  if (grow) {
-    // With headroom: the number of points changes every frame, and a steady run should not
-    // allocate.
+  // The number of points changes every frame; a steady run should not allocate.
+  bool grew = vk::reserve_with_headroom(r.points, context_, bytes);
+  grew = vk::reserve_with_headroom(r.labels, context_, points.size() * sizeof(std::uint32_t)) || grew;
+  grew = vk::reserve_with_headroom(r.partials, context_, partial_bytes) || grew;
+  vk::reserve_with_headroom(r.partials_host, context_, partial_bytes, vk::BufferDomain::Readback);
+  if (grew) {
     r.set = {};  // the old set refers to the old buffers
-    r.points.emplace(context_, bytes + bytes / 4);
-    r.labels.emplace(context_, (points.size() + points.size() / 4) * sizeof(std::uint32_t));
-    r.partials.emplace(context_, partial_bytes + partial_bytes / 4);
-    r.partials_host.emplace(context_, partial_bytes + partial_bytes / 4, vk::BufferDomain::Readback);
     r.set = r.pipeline.bind({&*r.points, &r.centres, &*r.labels, &*r.partials});
   }
   context_.transfer().upload(std::as_bytes(points), *r.points);

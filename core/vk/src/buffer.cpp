@@ -118,4 +118,12 @@ VulkanBuffer& buffer_of_size(std::optional<VulkanBuffer>& slot, const VulkanCont
   return *slot;
 }
 
+bool reserve_with_headroom(std::optional<VulkanBuffer>& slot, const VulkanContext& context, std::size_t bytes,
+                           BufferDomain domain, VkBufferUsageFlags extra_usage) {
+  if (slot && slot->size_bytes() >= bytes) return false;
+  slot.reset();  // free the old memory before the new allocation
+  slot.emplace(context, bytes + bytes / 4, domain, extra_usage);
+  return true;
+}
+
 }  // namespace relight::vk

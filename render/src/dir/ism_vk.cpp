@@ -56,10 +56,8 @@ void IsmVk::set_points(const IsmPointPools& points) {
   real_points_ = static_cast<std::uint32_t>(points.real.size());
   virtual_bounds_ = points.virtual_bounds;
   virtual_points_ = static_cast<std::uint32_t>(points.virtual_points.size());
-  // Kept while large enough, grown with headroom: the points change in number every frame.
-  const std::size_t bytes = std::max<std::size_t>(packed.size(), 8) * sizeof(float);
-  if (!points_ || points_->size_bytes() < bytes)
-    points_ = std::make_unique<vk::VulkanBuffer>(context_, bytes + bytes / 4, vk::BufferDomain::Device);
+  // The points change in number every frame.
+  vk::reserve_with_headroom(points_, context_, std::max<std::size_t>(packed.size(), 8) * sizeof(float));
   if (!packed.empty()) context_.transfer().upload(std::as_bytes(std::span(packed)), *points_);
 }
 
@@ -87,7 +85,7 @@ void IsmVk::record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint3
   }
   ensure_buffers(static_cast<std::size_t>(tiles) * tile * tile, offsets.back());
   splat_set_ = {};  // the VPL buffer may be new: bind afresh (one small descriptor write)
-  splat_set_ = splat_.bind({points_.get(), &vpls, atlas_.get()});
+  splat_set_ = splat_.bind({&*points_, &vpls, atlas_.get()});
   if (vpl_count == 0) return;
   vkCmdFillBuffer(cmd, atlas_->handle(), 0, VK_WHOLE_SIZE, std::bit_cast<std::uint32_t>(kShadowEmpty));
   vk::compute_barrier(cmd);

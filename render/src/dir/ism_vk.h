@@ -5,6 +5,7 @@
 #include <vulkan/vulkan.h>
 
 #include <memory>
+#include <optional>
 
 #include "relight/render/dir/ism.h"
 #include "relight/vk/buffer.h"
@@ -27,7 +28,8 @@ class IsmVk {
 
   vk::VulkanContext& context_;
   vk::ComputePipeline splat_, pull_push_;
-  std::unique_ptr<vk::VulkanBuffer> points_, atlas_, pyramid_;
+  std::optional<vk::VulkanBuffer> points_;
+  std::unique_ptr<vk::VulkanBuffer> atlas_, pyramid_;
   std::uint32_t real_points_ = 0, virtual_points_ = 0;
   Eigen::Vector4f virtual_bounds_ = Eigen::Vector4f::Zero();
   vk::UniqueDescriptorSet splat_set_, pull_push_set_;

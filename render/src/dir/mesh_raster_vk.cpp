@@ -29,10 +29,7 @@ void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, Mes
     }
   }
   const std::size_t bytes = std::max<std::size_t>(4, vertices.size() * sizeof(RasterVertex));
-  if (!out.buffer || out.buffer->size_bytes() < bytes) {
-    out.buffer = std::make_unique<vk::VulkanBuffer>(context, bytes + bytes / 4, vk::BufferDomain::Upload,
-                                                    VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
-  }
+  vk::reserve_with_headroom(out.buffer, context, bytes, vk::BufferDomain::Upload, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
   if (!vertices.empty()) out.buffer->write(std::as_bytes(std::span(vertices)));
   out.count = static_cast<std::uint32_t>(vertices.size());
 }

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 
 #include "relight/render/scene/mr_scene.h"
@@ -29,7 +30,7 @@ struct RasterVertex {
 };
 
 struct SceneVertices {
-  std::unique_ptr<vk::VulkanBuffer> buffer;
+  std::optional<vk::VulkanBuffer> buffer;
   std::uint32_t count = 0;
 };
 

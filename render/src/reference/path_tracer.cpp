@@ -31,6 +31,12 @@ class PathIntegrator {
                    Pcg32& rng, std::uint32_t& rays) const;
   std::optional<SurfaceHit> nearest(const Vec3& origin, const Vec3& direction, bool with_virtual,
                                     std::uint32_t& rays) const;
+  /// Next-event estimation at v, shared by both versions of the scene: for every light (the
+  /// virtual ones only when `virtual_lights`) whose sample is lit and not blocked by real
+  /// geometry, add(light, f cos E, virtual_visible), where virtual_visible says whether no
+  /// virtual geometry blocks it either (tested only when `test_virtual`, else true).
+  template <class Add>
+  void direct_lights(const Vertex& v, bool virtual_lights, bool test_virtual, std::uint32_t& rays, Add&& add) const;
   /// Samples the continuation; false when the path ends (bounce limit, absorption, roulette).
   bool continue_path(const Vertex& v, int bounce, Vec3& throughput, Vec3& origin, Vec3& direction, Pcg32& rng) const;
 
@@ -68,6 +74,28 @@ bool PathIntegrator::continue_path(const Vertex& v, int bounce, Vec3& throughput
   return true;
 }
 
+template <class Add>
+void PathIntegrator::direct_lights(const Vertex& v, bool virtual_lights, bool test_virtual, std::uint32_t& rays,
+                                   Add&& add) const {
+  for (const MrLight& light : scene_.lights) {
+    if (!virtual_lights && !light.real) continue;
+    const std::optional<LightSample> sample = sample_light(light, v.point);
+    if (!sample) continue;
+    const Vec3 contribution = direct_light(v, *sample);
+    if (contribution.isZero()) continue;
+    const Vec3 from = offset_origin(v, sample->wi);
+    const float reach = sample->distance * (1.f - 1e-4f);
+    ++rays;
+    if (tracer_.occluded(Layer::Real, from, sample->wi, reach)) continue;
+    bool virtual_visible = true;
+    if (test_virtual) {
+      ++rays;
+      virtual_visible = !tracer_.occluded(Layer::Virtual, from, sample->wi, reach);
+    }
+    add(light, contribution, virtual_visible);
+  }
+}
+
 void PathIntegrator::trace_layer(Vec3 origin, Vec3 direction, int bounce, bool with_virtual, Vec3 throughput,
                                  Vec3& radiance, Pcg32& rng, std::uint32_t& rays) const {
   for (int k = bounce;; ++k) {
@@ -78,22 +106,10 @@ void PathIntegrator::trace_layer(Vec3 origin, Vec3 direction, int bounce, bool w
     }
     const Vertex v = make_vertex(*hit, direction, scene_);
     radiance += throughput.cwiseProduct(v.material->emission);
-    for (const MrLight& light : scene_.lights) {
-      if (!with_virtual && !light.real) continue;
-      const std::optional<LightSample> sample = sample_light(light, v.point);
-      if (!sample) continue;
-      const Vec3 contribution = direct_light(v, *sample);
-      if (contribution.isZero()) continue;
-      const Vec3 from = offset_origin(v, sample->wi);
-      const float reach = sample->distance * (1.f - 1e-4f);
-      ++rays;
-      if (tracer_.occluded(Layer::Real, from, sample->wi, reach)) continue;
-      if (with_virtual && tracer_.has_virtual_geometry()) {
-        ++rays;
-        if (tracer_.occluded(Layer::Virtual, from, sample->wi, reach)) continue;
-      }
-      radiance += throughput.cwiseProduct(contribution);
-    }
+    direct_lights(v, with_virtual, with_virtual && tracer_.has_virtual_geometry(), rays,
+                  [&](const MrLight&, const Vec3& contribution, bool virtual_visible) {
+                    if (virtual_visible) radiance += throughput.cwiseProduct(contribution);
+                  });
     if (!continue_path(v, k, throughput, origin, direction, rng)) break;
   }
 }
@@ -130,23 +146,12 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
     const Vec3 emitted = throughput.cwiseProduct(v.material->emission);
     out.real_virtual += emitted;
     out.real += emitted;
-    for (const MrLight& light : scene_.lights) {
-      const std::optional<LightSample> sample = sample_light(light, v.point);
-      if (!sample) continue;
-      const Vec3 contribution = direct_light(v, *sample);
-      if (contribution.isZero()) continue;
-      const Vec3 from = offset_origin(v, sample->wi);
-      const float reach = sample->distance * (1.f - 1e-4f);
-      ++out.rays;
-      if (tracer_.occluded(Layer::Real, from, sample->wi, reach)) continue;
-      const Vec3 weighted = throughput.cwiseProduct(contribution);
-      if (light.real) out.real += weighted;
-      if (has_virtual) {
-        ++out.rays;
-        if (tracer_.occluded(Layer::Virtual, from, sample->wi, reach)) continue;
-      }
-      out.real_virtual += weighted;
-    }
+    direct_lights(v, true, has_virtual, out.rays,
+                  [&](const MrLight& light, const Vec3& contribution, bool virtual_visible) {
+                    const Vec3 weighted = throughput.cwiseProduct(contribution);
+                    if (light.real) out.real += weighted;
+                    if (virtual_visible) out.real_virtual += weighted;
+                  });
     if (!continue_path(v, k, throughput, origin, direction, rng)) break;
   }
   return out;

@@ -61,4 +61,11 @@ class VulkanBuffer final : public DeviceBuffer {
 /// changed: a stage's per-frame scratch, so that same-sized frames allocate nothing.
 VulkanBuffer& buffer_of_size(std::optional<VulkanBuffer>& slot, const VulkanContext& context, std::size_t bytes);
 
+/// Makes `slot` hold at least `bytes`: kept while large enough, otherwise remade with a quarter
+/// more, for data whose size changes every frame (ISM points, K-means points, the scene's
+/// vertices), so that a steady run stops allocating. True when it was remade: descriptor sets
+/// bound to the old buffer must be bound again.
+bool reserve_with_headroom(std::optional<VulkanBuffer>& slot, const VulkanContext& context, std::size_t bytes,
+                           BufferDomain domain = BufferDomain::Device, VkBufferUsageFlags extra_usage = 0);
+
 }  // namespace relight::vk
