@@ -44,14 +44,15 @@ nlohmann::ordered_json CameraTrajectoryStage::summary() const {
   json["frames_without_pose"] = without;
   json["flagged_frames"] = held_frames;
   json["failures"] = reasons;
-  if (!recorded.empty() && recorded.front().pose.source == PoseSource::MarkerOdometry) {
+  if (!recorded.empty() && recorded.front().pose.source == capture::PoseSource::MarkerOdometry) {
     json["max_marker_correction_cm"] = correction_max_cm;
   }
-  const bool compared = !recorded.empty() && recorded.front().pose.source != PoseSource::Sequence && estimate.size() >= 3;
+  const bool compared =
+      !recorded.empty() && recorded.front().pose.source != capture::PoseSource::Sequence && estimate.size() >= 3;
   if (compared) {
     json["compared_with_sequence_poses"] = estimate.size();
-    json["ate_cm"] = 100.0 * absolute_trajectory_error(estimate, truth);
-    const RelativePoseError rpe = relative_pose_error(estimate, truth);
+    json["ate_cm"] = 100.0 * capture::absolute_trajectory_error(estimate, truth);
+    const capture::RelativePoseError rpe = capture::relative_pose_error(estimate, truth);
     json["rpe_deg"] = rpe.rotation_deg;
     json["rpe_cm"] = 100.0 * rpe.translation_m;
   }

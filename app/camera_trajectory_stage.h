@@ -16,12 +16,13 @@ namespace relight::app {
 
 class CameraTrajectoryStage final : public PoseTrajectoryStage {
  public:
-  explicit CameraTrajectoryStage(std::filesystem::path file) : PoseTrajectoryStage(std::move(file), kCameraPose) {}
+  explicit CameraTrajectoryStage(std::filesystem::path file)
+      : PoseTrajectoryStage(std::move(file), capture::kCameraPose) {}
   [[nodiscard]] std::string name() const override { return "camera_trajectory"; }
 
   [[nodiscard]] nlohmann::ordered_json summary() const;
   /// The last frame's pose state, for the progress line and the live view.
-  [[nodiscard]] const CameraPose* last() const { return entries().empty() ? nullptr : &entries().back().pose; }
+  [[nodiscard]] const capture::CameraPose* last() const { return entries().empty() ? nullptr : &entries().back().pose; }
 
  private:
   [[nodiscard]] std::string description() const override;

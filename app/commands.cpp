@@ -45,7 +45,7 @@ void add_pose_options(CLI::App& command, ReplayOptions& options) {
 }  // namespace
 
 void add_pose_option(CLI::App& command, ReplayOptions& options) {
-  add_choice_option(command, "--pose", options.pose, kPoseSourceNames,
+  add_choice_option(command, "--pose", options.pose, capture::kPoseSourceNames,
                     "camera pose: auto (the sequence's own poses when it has them, else marker+odometry with a "
                     "marker layout, else odometry), sequence, marker, odometry, marker+odometry; writes "
                     "camera_trajectory.txt");

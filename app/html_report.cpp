@@ -184,21 +184,21 @@ void materials_section(std::ostringstream& html, const std::vector<brdf::Materia
 }
 
 // Directional lights on a sky dome seen from above: the centre is the zenith, the circle the horizon.
-void light_dome(std::ostringstream& html, const LightSet& set) {
+void light_dome(std::ostringstream& html, const lights::LightSet& set) {
   double brightest = 0;
-  for (const auto& light : set.lights) brightest = std::max(brightest, luminance(light.power));
+  for (const auto& light : set.lights) brightest = std::max(brightest, lights::luminance(light.power));
   const double radius = 110, centre = 130;
   html << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=260 height=260 viewBox=\"0 0 260 260\" role=img "
           "aria-label=\"light directions\"><circle cx="
        << centre << " cy=" << centre << " r=" << radius << " fill=\"#20283a\"/><circle cx=" << centre << " cy=" << centre
        << " r=" << radius / 2 << " fill=none stroke=\"#556\"/>\n";
   for (const auto& light : set.lights) {
-    if (light.kind != LightKind::Directional) continue;
+    if (light.kind != lights::LightKind::Directional) continue;
     const auto d = light.direction.normalized();
     const double elevation = std::asin(std::clamp(d.z(), -1.0, 1.0));
     const double r = std::min(1.1, 1 - elevation / (M_PI / 2)) * radius;
     const double azimuth = std::atan2(d.y(), d.x());
-    const double size = 3 + 9 * (brightest > 0 ? std::sqrt(luminance(light.power) / brightest) : 0);
+    const double size = 3 + 9 * (brightest > 0 ? std::sqrt(lights::luminance(light.power) / brightest) : 0);
     const double peak = std::max({light.power.x(), light.power.y(), light.power.z(), 1e-12});
     html << "<circle cx=" << centre + r * std::cos(azimuth) << " cy=" << centre - r * std::sin(azimuth)
          << " r=" << size << " fill=\"" << srgb_hex(light.power.x() / peak, light.power.y() / peak, light.power.z() / peak)
@@ -208,18 +208,18 @@ void light_dome(std::ostringstream& html, const LightSet& set) {
        << centre + 4 << ">+x</text></svg>\n";
 }
 
-void lights_section(std::ostringstream& html, const LightSet& set) {
+void lights_section(std::ostringstream& html, const lights::LightSet& set) {
   html << "<h2>Lights (last frame)</h2>\n<div style=\"display:flex;gap:24px;align-items:flex-start\">";
   light_dome(html, set);
   html << "<table><tr><th>#<th class=l>kind<th class=l>direction / position<th class=l>power (RGB)<th class=l>real\n";
   for (std::size_t i = 0; i < set.lights.size(); ++i) {
     const auto& light = set.lights[i];
-    const auto& where = light.kind == LightKind::Directional ? light.direction : light.position;
-    html << "<tr><td>" << i + 1 << "<td class=l>" << (light.kind == LightKind::Directional ? "directional" : "point")
-         << "<td class=l>" << format("%.3f", where.x()) << ", " << format("%.3f", where.y()) << ", "
-         << format("%.3f", where.z()) << "<td class=l>" << format("%.4g", light.power.x()) << ", "
-         << format("%.4g", light.power.y()) << ", " << format("%.4g", light.power.z()) << "<td class=l>"
-         << (light.real ? "real" : "virtual") << "\n";
+    const auto& where = light.kind == lights::LightKind::Directional ? light.direction : light.position;
+    html << "<tr><td>" << i + 1 << "<td class=l>"
+         << (light.kind == lights::LightKind::Directional ? "directional" : "point") << "<td class=l>"
+         << format("%.3f", where.x()) << ", " << format("%.3f", where.y()) << ", " << format("%.3f", where.z())
+         << "<td class=l>" << format("%.4g", light.power.x()) << ", " << format("%.4g", light.power.y()) << ", "
+         << format("%.4g", light.power.z()) << "<td class=l>" << (light.real ? "real" : "virtual") << "\n";
   }
   html << "</table></div>\n<p class=note>Directions in the world frame (z up); the dome shows directional lights seen "
           "from above, the zenith in the centre, the horizon on the circle; white rims are real lights.</p>\n";

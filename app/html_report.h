@@ -29,7 +29,7 @@ struct ContactSheetRow {
 struct ReportContent {
   std::vector<ContactSheetRow> contact_sheet;
   std::optional<std::vector<brdf::MaterialParams>> materials;  ///< of the last frame
-  std::optional<LightSet> lights;                              ///< of the last frame
+  std::optional<lights::LightSet> lights;                      ///< of the last frame
 };
 
 /// The whole page. `timing` is timing_report()'s object with the run's extra keys (sequence,

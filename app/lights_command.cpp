@@ -27,7 +27,7 @@ constexpr std::array<NamedValue<ProjectionChoice>, 3> kProjectionChoiceNames{
 struct LightsCommandOptions {
   std::filesystem::path probe;
   int lights = 64;
-  LightMethod method = LightMethod::Importance;
+  lights::LightMethod method = lights::LightMethod::Importance;
   std::uint64_t seed = 0;
   std::filesystem::path out;
   std::filesystem::path preview;
@@ -61,7 +61,8 @@ RadianceImage read_probe(const std::filesystem::path& path, double gamma) {
 // A probe whose image circle is clipped white almost everywhere says nothing about where the
 // light comes from (some clipped pixels - the sun, lamps - are normal). An 8-bit 255 linearises
 // to exactly 1 and nothing else does, so the clipped pixels are those equal to (1, 1, 1).
-void check_not_over_exposed(const RadianceImage& probe, const ProbeGeometry& geometry, const std::filesystem::path& file) {
+void check_not_over_exposed(const RadianceImage& probe, const lights::ProbeGeometry& geometry,
+                            const std::filesystem::path& file) {
   std::size_t seen = 0, clipped = 0;
   for (int row = 0; row < probe.height(); ++row) {
     for (int col = 0; col < probe.width(); ++col) {
@@ -77,11 +78,12 @@ void check_not_over_exposed(const RadianceImage& probe, const ProbeGeometry& geo
   }
 }
 
-ProbeCalibration calibration_for(const LightsCommandOptions& command, const RadianceImage& probe) {
+lights::ProbeCalibration calibration_for(const LightsCommandOptions& command, const RadianceImage& probe) {
   const bool equirect = command.projection == ProjectionChoice::Auto ? probe.width() == 2 * probe.height()
                                                                      : command.projection == ProjectionChoice::Equirect;
-  ProbeCalibration calibration =
-      equirect ? ProbeCalibration::equirectangular() : ProbeCalibration::centred_fisheye(probe.width(), probe.height());
+  lights::ProbeCalibration calibration = equirect
+                                             ? lights::ProbeCalibration::equirectangular()
+                                             : lights::ProbeCalibration::centred_fisheye(probe.width(), probe.height());
   if (!command.centre.empty()) {
     calibration.fisheye.cx = command.centre[0];
     calibration.fisheye.cy = command.centre[1];
@@ -101,26 +103,27 @@ ProbeCalibration calibration_for(const LightsCommandOptions& command, const Radi
 
 int run_lights(const LightsCommandOptions& command) {
   const RadianceImage probe = read_probe(command.probe, command.gamma);
-  LightExtractionOptions options;
+  lights::LightExtractionOptions options;
   options.method = command.method;
   options.lights = command.lights;
   options.seed = command.seed;
   options.calibration = calibration_for(command, probe);
-  const ProbeGeometry geometry(options.calibration, probe.width(), probe.height());
+  const lights::ProbeGeometry geometry(options.calibration, probe.width(), probe.height());
   if (!is_hdr_file(command.probe)) check_not_over_exposed(probe, geometry, command.probe);
-  LightSet lights;
+  lights::LightSet lights;
   try {
-    lights = extract_lights(probe, options);
+    lights = lights::extract_lights(probe, options);
   } catch (const Error& error) {
     throw Error(command.probe.string() + ": " + error.what());
   }
-  write_file_atomically(command.out, lights_to_json(lights));
-  if (!command.preview.empty()) write_color(command.preview, light_preview(probe, geometry, lights));
+  write_file_atomically(command.out, lights::lights_to_json(lights));
+  if (!command.preview.empty()) write_color(command.preview, lights::light_preview(probe, geometry, lights));
   if (!command.quiet) {
     const Eigen::Vector3d e = irradiance(lights, Eigen::Vector3d::UnitZ());
-    std::cerr << "relight lights: " << lights.lights.size() << " lights (" << name_of(kLightMethodNames, command.method)
-              << ") from " << command.probe.string() << ", irradiance on +z " << e.x() << " " << e.y() << " " << e.z()
-              << " -> " << command.out.string() << "\n";
+    std::cerr << "relight lights: " << lights.lights.size() << " lights ("
+              << name_of(lights::kLightMethodNames, command.method) << ") from " << command.probe.string()
+              << ", irradiance on +z " << e.x() << " " << e.y() << " " << e.z() << " -> " << command.out.string()
+              << "\n";
   }
   return 0;
 }
@@ -133,7 +136,7 @@ void register_lights(CLI::App& app, Runners& runners) {
   lights->add_option("probe", options->probe, "Probe image: .hdr/.exr (linear), or 8-bit (linearised with --gamma)")
       ->required();
   lights->add_option("--n", options->lights, "Number of lights")->check(CLI::Range(1, 1 << 20))->capture_default_str();
-  add_choice_option(*lights, "--method", options->method, kLightMethodNames,
+  add_choice_option(*lights, "--method", options->method, lights::kLightMethodNames,
                     "importance (hierarchical warping VPLs) or median-cut");
   lights->add_option("--seed", options->seed, "Rotation of the sample set (importance)")->capture_default_str();
   lights->add_option("--out", options->out, "Output JSON (lights/light_output.h)")->required();

@@ -41,7 +41,7 @@ class LiveStatus {
  public:
   LiveStatus(std::string label, bool quiet) : label_(std::move(label)), enabled_(!quiet && isatty(STDERR_FILENO)) {}
   /// `pose`: the last frame's camera pose, shown as the tracking state (tracking, or lost and why).
-  void update(std::int64_t frames, std::int64_t dropped, const CameraPose* pose = nullptr) {
+  void update(std::int64_t frames, std::int64_t dropped, const capture::CameraPose* pose = nullptr) {
     if (!enabled_ || Clock::now() - last_ < std::chrono::milliseconds(500)) return;
     last_ = Clock::now();
     const double elapsed = seconds_since(start_);
@@ -68,9 +68,10 @@ class LiveStatus {
 
 // Ends the stream after `limit` frames (0: no limit) or on Ctrl-C, as the end of a recording would,
 // so that the frame graph finishes normally.
-class StoppableSource final : public FrameSource {
+class StoppableSource final : public capture::FrameSource {
  public:
-  StoppableSource(std::unique_ptr<OpenNiSource> source, std::int64_t limit) : source_(std::move(source)), limit_(limit) {}
+  StoppableSource(std::unique_ptr<capture::OpenNiSource> source, std::int64_t limit)
+      : source_(std::move(source)), limit_(limit) {}
   std::optional<RgbdFrame> next() override {
     if (InterruptGuard::interrupted() || (limit_ > 0 && frames_ >= limit_) || (stop_ && stop_())) return std::nullopt;
     auto frame = source_->next();
@@ -79,12 +80,12 @@ class StoppableSource final : public FrameSource {
   }
   std::int64_t size_hint() const override { return limit_; }
   std::string describe() const override { return source_->describe(); }
-  [[nodiscard]] const OpenNiSource& device() const { return *source_; }
+  [[nodiscard]] const capture::OpenNiSource& device() const { return *source_; }
   /// Also ends the stream when `stop` says so (the view's quit key).
   void stop_when(std::function<bool()> stop) { stop_ = std::move(stop); }
 
  private:
-  std::unique_ptr<OpenNiSource> source_;
+  std::unique_ptr<capture::OpenNiSource> source_;
   std::function<bool()> stop_;
   std::int64_t limit_;
   std::int64_t frames_ = 0;
@@ -97,7 +98,7 @@ struct LiveOptions {
 };
 
 int run_devices() {
-  const auto devices = list_openni_devices();
+  const auto devices = capture::list_openni_devices();
   if (devices.empty()) std::cerr << "relight devices: OpenNI2 sees no device\n";
   for (const auto& device : devices) std::cout << device.uri << "\t" << device.vendor << "\t" << device.name << "\n";
   return 0;
@@ -105,9 +106,9 @@ int run_devices() {
 
 int run_live(const LiveOptions& options) {
   InterruptGuard interrupt;
-  OpenNiOptions device_options;
+  capture::OpenNiOptions device_options;
   device_options.uri = options.device;
-  auto device = std::make_unique<OpenNiSource>(device_options);
+  auto device = std::make_unique<capture::OpenNiSource>(device_options);
   if (device->is_file()) throw Error(options.device + " is a recording: use relight replay for .oni files");
   const std::filesystem::path device_scene = device->scene_folder();
   auto source = std::make_unique<StoppableSource>(std::move(device), options.frames);
@@ -184,7 +185,8 @@ std::filesystem::path temporary_oni(const std::filesystem::path& out) {
 // Every frame read after the recorder started must be in the file, at its device time. Played
 // back, the file's timestamps count from its first frame, which may be one frame older than the
 // first we read (it can come in while the recorder starts): try both alignments.
-std::string check_recording(const OniRecordingSummary& summary, const std::vector<std::uint64_t>& delivered_us) {
+std::string check_recording(const capture::OniRecordingSummary& summary,
+                            const std::vector<std::uint64_t>& delivered_us) {
   if (summary.depth_frames != summary.color_frames) {
     return "the recording holds " + std::to_string(summary.depth_frames) + " depth but " +
            std::to_string(summary.color_frames) + " colour frames";
@@ -216,12 +218,12 @@ std::string camera_json(const PinholeIntrinsics& k, const std::string& source) {
 int run_record(const RecordOptions& options) {
   InterruptGuard interrupt;
   const bool to_oni = options.out.extension() == ".oni";
-  OpenNiOptions device_options;
+  capture::OpenNiOptions device_options;
   device_options.uri = options.device;
-  OpenNiSource source(device_options);
+  capture::OpenNiSource source(device_options);
   if (to_oni && source.is_file()) throw Error("recording a .oni file into a .oni file: copy the file instead");
 
-  std::optional<TumWriter> tum;
+  std::optional<capture::TumWriter> tum;
   const std::filesystem::path temporary = to_oni ? temporary_oni(options.out) : std::filesystem::path();
   if (to_oni) {
     if (!options.out.parent_path().empty()) std::filesystem::create_directories(options.out.parent_path());
@@ -257,7 +259,7 @@ int run_record(const RecordOptions& options) {
   std::string held;
   if (to_oni) {
     source.stop_recording();
-    const OniRecordingSummary summary = inspect_oni(temporary);
+    const capture::OniRecordingSummary summary = capture::inspect_oni(temporary);
     if (const std::string lost = check_recording(summary, delivered_us); !lost.empty()) {
       std::filesystem::remove(temporary);
       throw Error(options.out.string() + ": " + lost);

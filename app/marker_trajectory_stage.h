@@ -23,7 +23,7 @@ class MarkerTrajectoryStage final : public PoseTrajectoryStage {
  public:
   /// `layout`: how errors name the tag layout (its file).
   MarkerTrajectoryStage(std::filesystem::path file, std::string layout)
-      : PoseTrajectoryStage(std::move(file), kMarkerPose), layout_(std::move(layout)) {}
+      : PoseTrajectoryStage(std::move(file), capture::kMarkerPose), layout_(std::move(layout)) {}
   [[nodiscard]] std::string name() const override { return "marker_trajectory"; }
   void run(StageContext& context) override;
 

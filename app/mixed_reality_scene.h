@@ -33,11 +33,11 @@ inline constexpr float kSpotInnerFraction = 0.8f;
 /// The measured lights of a sequence: the lights JSON of `relight lights` when given, else for a
 /// synthetic sequence 8 lights extracted from its probe.hdr. Throws relight::Error when there
 /// is neither.
-[[nodiscard]] LightSet real_light_set(bool synthetic, const std::filesystem::path& sequence,
-                                      const std::filesystem::path& lights_file);
+[[nodiscard]] lights::LightSet real_light_set(bool synthetic, const std::filesystem::path& sequence,
+                                              const std::filesystem::path& lights_file);
 
 /// 8 lights importance-sampled from a lat-long (equirectangular) HDR probe, as `relight lights
 /// PROBE --n 8` gives them.
-[[nodiscard]] LightSet lights_from_latlong_probe(const std::filesystem::path& probe, int count);
+[[nodiscard]] lights::LightSet lights_from_latlong_probe(const std::filesystem::path& probe, int count);
 
 }  // namespace relight::app

@@ -59,15 +59,15 @@ const char* kind_name(PlacementRequest::Kind kind) {
 /// disc at that depth, show the plane for at least 90 % of their pixels: the centre itself may
 /// show something standing on the plane, or the plane only as a sliver beside it.
 struct FreeSpot {
-  Plane plane;
+  capture::Plane plane;
   Eigen::Vector2i pixel;
   double distance2;  ///< squared pixels from the image centre
 };
 
 std::optional<FreeSpot> free_spot_nearest_centre(const DepthMap& depth, const PinholeIntrinsics& intrinsics,
-                                                 const Plane& plane, double footprint_radius_m) {
+                                                 const capture::Plane& plane, double footprint_radius_m) {
   const int width = depth.width(), height = depth.height();
-  const SupportPlaneOptions tolerance;
+  const capture::SupportPlaneOptions tolerance;
   // Integral image of the plane's inlier pixels: the share of any box in O(1).
   std::vector<int> sum(static_cast<std::size_t>(width + 1) * static_cast<std::size_t>(height + 1), 0);
   const auto at = [width](int row, int col) { return static_cast<std::size_t>(row) * static_cast<std::size_t>(width + 1) + static_cast<std::size_t>(col); };
@@ -157,7 +157,7 @@ ObjectPlacementStage::ObjectPlacementStage(std::vector<PlacementRequest> request
 void ObjectPlacementStage::declare(StageBuilder& builder) {
   frame_ = builder.read(kFrame);
   depth_ = builder.read(kDepth);
-  pose_ = builder.read(kCameraPose);
+  pose_ = builder.read(capture::kCameraPose);
   placements_ = builder.write(render::kObjectPlacements);
 }
 
@@ -187,7 +187,7 @@ render::Placement ObjectPlacementStage::resolve(const PlacementRequest& request,
       throw Error(request.option + ": " + at + " is outside the " + std::to_string(depth.width()) + "x" +
                   std::to_string(depth.height()) + " image");
     }
-    const auto plane = local_plane_at(depth, intrinsics, pixel.x(), pixel.y());
+    const auto plane = capture::local_plane_at(depth, intrinsics, pixel.x(), pixel.y());
     if (!plane) throw Error(request.option + ": no surface at " + at + where + " (too little valid depth around it)");
     point = plane->ray_hit(intrinsics, pixel.x(), pixel.y());
     if (!point) throw Error(request.option + ": the surface at " + at + where + " is seen edge-on");
@@ -195,13 +195,13 @@ render::Placement ObjectPlacementStage::resolve(const PlacementRequest& request,
   } else {
     // The up-facing planes in view (the table, the floor, a shelf): the object goes onto the one
     // whose free spot is nearest the image centre, the surface the camera looks at.
-    SupportPlaneOptions support;
+    capture::SupportPlaneOptions support;
     support.min_inlier_share = 0.03;
-    const auto planes = support_planes(depth, intrinsics, 3, support);
+    const auto planes = capture::support_planes(depth, intrinsics, 3, support);
     if (planes.empty()) throw Error(request.option + ": no support plane in frame " + std::to_string(frame.index) +
                                     " (no up-facing plane holds enough of the depth; try --place-at u,v)");
     std::optional<FreeSpot> best;
-    for (const Plane& plane : planes) {
+    for (const capture::Plane& plane : planes) {
       const auto spot = free_spot_nearest_centre(depth, intrinsics, plane, request.footprint_radius_m);
       if (spot && (!best || spot->distance2 < best->distance2)) best = spot;
     }

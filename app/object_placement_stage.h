@@ -85,7 +85,7 @@ class ObjectPlacementStage final : public Stage {
   std::int64_t resolved_frame_ = -1;
   Read<FrameInfo> frame_;
   Read<DepthMap> depth_;
-  Read<CameraPose> pose_;
+  Read<capture::CameraPose> pose_;
   Write<render::ObjectPlacements> placements_;
 };
 

@@ -24,12 +24,12 @@ class PoseTrajectoryStage : public Stage {
   void finish() override;
 
  protected:
-  PoseTrajectoryStage(std::filesystem::path file, BufferName<CameraPose> pose_buffer)
+  PoseTrajectoryStage(std::filesystem::path file, BufferName<capture::CameraPose> pose_buffer)
       : file_(std::move(file)), pose_buffer_(pose_buffer) {}
   struct Entry {
     std::int64_t index;
     Timestamp timestamp;
-    CameraPose pose;
+    capture::CameraPose pose;
     std::optional<Pose> reference;  ///< the sequence's own pose, when it has one
   };
   [[nodiscard]] const std::vector<Entry>& entries() const { return entries_; }
@@ -38,9 +38,9 @@ class PoseTrajectoryStage : public Stage {
 
  private:
   std::filesystem::path file_;
-  BufferName<CameraPose> pose_buffer_;
+  BufferName<capture::CameraPose> pose_buffer_;
   std::vector<Entry> entries_;
-  Read<CameraPose> pose_;
+  Read<capture::CameraPose> pose_;
   Read<FrameInfo> frame_;
 };
 

@@ -51,7 +51,7 @@ struct RenderReferenceOptions {
 
 /// The real part of the scene: the synthetic scene's exact geometry, or the frame's depth mesh
 /// with the lights of --lights.
-MrScene real_scene(const RenderReferenceOptions& command, bool synthetic, const TumSequence& sequence,
+MrScene real_scene(const RenderReferenceOptions& command, bool synthetic, const capture::TumSequence& sequence,
                    const RgbdFrame& frame) {
   if (synthetic) {
     // The path tracer gets the synthetic scene's exact lights and sky.
@@ -102,7 +102,7 @@ int run_render_reference(const RenderReferenceOptions& command) {
     fs::create_directories(folder, ec);
     if (ec) throw Error("cannot create " + folder.string() + ": " + ec.message());
   }
-  const TumSequence sequence = TumSequence::open(command.sequence);
+  const capture::TumSequence sequence = capture::TumSequence::open(command.sequence);
   if (command.frame < 0 || static_cast<std::size_t>(command.frame) >= sequence.size())
     throw Error("frame " + std::to_string(command.frame) + " is out of range: " + command.sequence.string() + " has " +
                 std::to_string(sequence.size()) + " frames");

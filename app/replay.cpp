@@ -62,18 +62,19 @@ std::filesystem::path default_sequence() { return data_folder() / "tum_fr1_rpy";
 
 namespace {
 
-std::unique_ptr<FrameSource> open_source_once(const ReplayOptions& options) {
-  TumOptions tum;
+std::unique_ptr<capture::FrameSource> open_source_once(const ReplayOptions& options) {
+  capture::TumOptions tum;
   tum.intrinsics = options.intrinsics;
   const FrameRange range = options.frames.empty() ? FrameRange{} : parse_frame_range(options.frames);
   const auto folder = options.sequence.empty() ? default_sequence() : options.sequence;
   if (folder.extension() == ".oni") {  // OpenNI2 recording, played back through its file device
-    OpenNiOptions oni;
+    capture::OpenNiOptions oni;
     oni.uri = folder.string();
     oni.intrinsics = tum.intrinsics;
-    return std::make_unique<RangeSource>(std::make_unique<OpenNiSource>(oni), range.first, range.last);
+    return std::make_unique<capture::RangeSource>(std::make_unique<capture::OpenNiSource>(oni), range.first,
+                                                  range.last);
   }
-  auto source = std::make_unique<TumSource>(TumSequence::open(folder, tum), range.first, range.last);
+  auto source = std::make_unique<capture::TumSource>(capture::TumSequence::open(folder, tum), range.first, range.last);
   if (options.skip_bad_frames) {
     source->on_bad_frame([](std::size_t index, const std::string& message) {
       std::cerr << "relight: warning: frame " << index << " skipped: " << message << "\n";
@@ -84,10 +85,10 @@ std::unique_ptr<FrameSource> open_source_once(const ReplayOptions& options) {
 
 }  // namespace
 
-std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options) {
+std::unique_ptr<capture::FrameSource> open_replay_source(const ReplayOptions& options) {
   if (options.loops < 1) throw Error("--loop must be at least 1");
   if (options.loops == 1) return open_source_once(options);
-  return std::make_unique<LoopingSource>([options] { return open_source_once(options); }, options.loops);
+  return std::make_unique<capture::LoopingSource>([options] { return open_source_once(options); }, options.loops);
 }
 
 ReplayPipeline::ReplayPipeline() = default;
@@ -115,16 +116,16 @@ std::optional<std::filesystem::path> scene_folder(const ReplayOptions& options) 
 }
 
 // "auto" uses the scene's scene.json when it describes a tag (sequences from `relight synth`).
-std::optional<TagLayout> marker_layout(const ReplayOptions& options) {
+std::optional<capture::TagLayout> marker_layout(const ReplayOptions& options) {
   if (options.markers == "none") return std::nullopt;
-  if (options.markers != "auto") return read_tag_layout(options.markers);
+  if (options.markers != "auto") return capture::read_tag_layout(options.markers);
   const auto folder = scene_folder(options);
   if (!folder) return std::nullopt;
   const auto scene = *folder / "scene.json";
   if (!std::filesystem::exists(scene)) return std::nullopt;
   const std::string text = read_text_file(scene);
   if (text.find("\"tag\"") == std::string::npos) return std::nullopt;
-  return parse_tag_layout(text, scene.string());
+  return capture::parse_tag_layout(text, scene.string());
 }
 
 /// The colour mapping between DIR's L_rv/L_r and the camera, and its composite; returns the
@@ -155,9 +156,9 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
     throw Error("the device " + options.live_device +
                 " serves no light probe: give its lights with --lights FILE (from `relight lights`)");
   }
-  const LightSet measured = options.lights.empty() && !options.latlong_probe.empty()
-                                ? lights_from_latlong_probe(options.latlong_probe, 8)
-                                : real_light_set(synthetic, scene.value_or(""), options.lights);
+  const lights::LightSet measured = options.lights.empty() && !options.latlong_probe.empty()
+                                        ? lights_from_latlong_probe(options.latlong_probe, 8)
+                                        : real_light_set(synthetic, scene.value_or(""), options.lights);
   render::DirSceneContent content;
   render::MrScene lights;
   render::add_lights(lights, measured);
@@ -179,7 +180,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   FrameGraph& graph = *pipeline.graph;
   if (!content.objects.empty())
     pipeline.placement = &graph.emplace<ObjectPlacementStage>(std::move(requests), std::move(names));
-  graph.emplace<ConstantStage<LightSet>>(kLights, measured);
+  graph.emplace<ConstantStage<lights::LightSet>>(lights::kLights, measured);
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
   graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
   render::DirStageOptions dir;
@@ -215,16 +216,16 @@ std::string marker_layout_name(const ReplayOptions& options) {
 /// The marker pose (when there is a layout) and the camera tracking stage that turns the
 /// source's frame into the tracked "frame" every pose reader uses.
 void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
-  CameraTrackingOptions tracking;
+  capture::CameraTrackingOptions tracking;
   tracking.source = options.pose;
   auto layout = marker_layout(options);
   tracking.has_marker_layout = layout.has_value();
   if (layout) {
-    pipeline.graph->emplace<MarkerPoseStage>(std::move(*layout), TagDetectorOptions{}, kSourceFrame);
+    pipeline.graph->emplace<capture::MarkerPoseStage>(std::move(*layout), capture::TagDetectorOptions{}, kSourceFrame);
     pipeline.markers =
         &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt", marker_layout_name(options));
   }
-  pipeline.graph->emplace<CameraTrackingStage>(tracking);
+  pipeline.graph->emplace<capture::CameraTrackingStage>(tracking);
   pipeline.trajectory = &pipeline.graph->emplace<CameraTrajectoryStage>(options.out / "camera_trajectory.txt");
 }
 
@@ -256,7 +257,7 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
     if (pipeline.final_composite != kComposite) collector->add_picture(pipeline.final_composite);
     collector->add_picture(kBrdfPreview);  // a wide mosaic: last, so it wraps alone
     collector->collect_materials(brdf::kMaterials);
-    collector->collect_lights(kLights);
+    collector->collect_lights(lights::kLights);
   }
   pipeline.report = collector.get();
   pipeline.graph->add(std::move(collector));
@@ -291,7 +292,7 @@ ReplayOptions with_main_job_defaults(ReplayOptions options) {
   return options;
 }
 
-ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& given) {
+ReplayPipeline build_replay_pipeline(std::unique_ptr<capture::FrameSource> source, const ReplayOptions& given) {
   const ReplayOptions options = with_main_job_defaults(given);
   const vk::BackendPolicy policy = options.backend;
   ReplayPipeline pipeline;
@@ -304,17 +305,18 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const 
 
   FrameGraph& graph = *pipeline.graph;
   const std::int64_t total_frames = source->size_hint();
-  graph.emplace<SourceStage>(std::move(source), kSourceFrame);
-  graph.add(make_depth_box_filter_stage(per_pixel, pipeline.vulkan.get()));
+  graph.emplace<capture::SourceStage>(std::move(source), kSourceFrame);
+  graph.add(reconstruct::make_depth_box_filter_stage(per_pixel, pipeline.vulkan.get()));
   // Geometry (positions + normals) follows the per-pixel backend; method 1's
   // pass-1 pyramid stays on the CPU either way (normals_raw_depth_vk.h).
   const bool method2 = options.geometry == GeometryMethod::Method2;
-  if (method2) graph.add(make_depth_warp_merge_stage(per_pixel, pipeline.vulkan.get()));
-  const auto input = method2 ? NormalsDepthInput::Filtered : NormalsDepthInput::Raw;
+  if (method2) graph.add(reconstruct::make_depth_warp_merge_stage(per_pixel, pipeline.vulkan.get()));
+  const auto input = method2 ? reconstruct::NormalsDepthInput::Filtered : reconstruct::NormalsDepthInput::Raw;
   if (method2 && options.method2_normals == Method2Normals::Plain) {
-    graph.add(make_normals_from_positions_stage(per_pixel, pipeline.vulkan.get()));
+    graph.add(reconstruct::make_normals_from_positions_stage(per_pixel, pipeline.vulkan.get()));
   } else {
-    graph.add(make_normals_raw_depth_stage(per_pixel, pipeline.vulkan.get(), NormalsRawDepthOptions{}, input));
+    graph.add(reconstruct::make_normals_raw_depth_stage(per_pixel, pipeline.vulkan.get(),
+                                                        reconstruct::NormalsRawDepthOptions{}, input));
   }
   graph.keep(kNormals);
   graph.keep(kPositions);

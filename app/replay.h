@@ -58,7 +58,7 @@ struct ReplayOptions {
   /// "none", or a layout/scene JSON file.
   std::string markers = "auto";
   /// Camera pose source (capture/camera_tracking_stage.h); none: auto.
-  std::optional<PoseSource> pose;
+  std::optional<capture::PoseSource> pose;
   bool skip_bad_frames = false;  ///< TUM frames that cannot be read: warn and skip instead of failing
   GeometryMethod geometry = GeometryMethod::Method1;
   Method2Normals method2_normals = Method2Normals::Filtered;
@@ -133,8 +133,9 @@ struct ReplayPipeline {
 [[nodiscard]] ReplayOptions with_main_job_defaults(ReplayOptions options);
 
 /// Creates the Vulkan context the options ask for and the replay graph: source, depth filter, writer.
-[[nodiscard]] ReplayPipeline build_replay_pipeline(std::unique_ptr<FrameSource> source, const ReplayOptions& options);
-[[nodiscard]] std::unique_ptr<FrameSource> open_replay_source(const ReplayOptions& options);
+[[nodiscard]] ReplayPipeline build_replay_pipeline(std::unique_ptr<capture::FrameSource> source,
+                                                   const ReplayOptions& options);
+[[nodiscard]] std::unique_ptr<capture::FrameSource> open_replay_source(const ReplayOptions& options);
 
 /// The report.json sections every run shares (replay, live): the view's counts, the marker pose
 /// (with its no-tag warning on stderr), tracking, latency, and where each object was placed

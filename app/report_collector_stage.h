@@ -24,7 +24,7 @@ class ReportCollectorStage final : public Stage {
 
   void add_picture(PreviewBuffer buffer) { previews_.add(buffer); }
   void collect_materials(BufferName<brdf::Materials> buffer) { materials_name_ = buffer; }
-  void collect_lights(BufferName<LightSet> buffer) { lights_name_ = buffer; }
+  void collect_lights(BufferName<lights::LightSet> buffer) { lights_name_ = buffer; }
 
   [[nodiscard]] std::string name() const override { return "report"; }
   [[nodiscard]] bool has_side_effects() const override { return true; }
@@ -43,9 +43,9 @@ class ReportCollectorStage final : public Stage {
   int thumbnail_height_;
   BufferPreviews previews_;
   std::optional<BufferName<brdf::Materials>> materials_name_;
-  std::optional<BufferName<LightSet>> lights_name_;
+  std::optional<BufferName<lights::LightSet>> lights_name_;
   Read<brdf::Materials> materials_;
-  Read<LightSet> lights_;
+  Read<lights::LightSet> lights_;
   ReportContent content_;
 };
 

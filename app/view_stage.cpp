@@ -25,7 +25,7 @@ ViewStage::ViewStage(LiveView& view, BufferName<ColorImage> picture, std::option
 
 void ViewStage::declare(StageBuilder& builder) {
   picture_ = builder.read(picture_name_);
-  pose_ = builder.read(kCameraPose);
+  pose_ = builder.read(capture::kCameraPose);
   frame_ = builder.read(kSourceFrame);
   side_.declare(builder);
 }
@@ -39,7 +39,7 @@ void ViewStage::run(StageContext& context) {
 
   ColorImage picture = context.get(picture_);
   side_.for_each(context, [&picture](const std::string&, const ColorImage& side) { picture = side_by_side(picture, side); });
-  const CameraPose& pose = context.get(pose_);
+  const capture::CameraPose& pose = context.get(pose_);
   char line[160];
   std::snprintf(line, sizeof line, "frame %lld   %.1f fps", static_cast<long long>(context.get(frame_).index), fps);
   std::string overlay = line;

@@ -54,7 +54,7 @@ class ViewStage final : public Stage {
   std::function<std::int64_t()> dropped_;
   std::deque<std::chrono::steady_clock::time_point> recent_;  ///< the last frames' times, for fps
   Read<ColorImage> picture_;
-  Read<CameraPose> pose_;
+  Read<capture::CameraPose> pose_;
   Read<FrameInfo> frame_;
 };
 

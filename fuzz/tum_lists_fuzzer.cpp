@@ -11,9 +11,9 @@
 
 namespace {
 
-void check_opened(const relight::TumSequence& sequence) {
+void check_opened(const relight::capture::TumSequence& sequence) {
   for (std::size_t i = 0; i < sequence.size(); ++i) {
-    const relight::TumFrame& frame = sequence.frame(i);
+    const relight::capture::TumFrame& frame = sequence.frame(i);
     if (!std::isfinite(frame.depth_timestamp) || !std::isfinite(frame.color_timestamp)) std::abort();
     if (frame.camera_to_world && !frame.camera_to_world->matrix().allFinite()) std::abort();
   }
@@ -34,7 +34,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
   }
   try {
-    check_opened(relight::TumSequence::open(scratch().path()));
+    check_opened(relight::capture::TumSequence::open(scratch().path()));
   } catch (const relight::Error&) {
   }
   return 0;

@@ -156,7 +156,7 @@ class RelightDevice final : public oni::driver::DeviceBase {
       case ONI_DEVICE_PROPERTY_HARDWARE_VERSION: return get_value(0, data, size);
       case ONI_DEVICE_PROPERTY_FIRMWARE_VERSION: return get_string("relight 0.1.0", data, size);
       case ONI_DEVICE_PROPERTY_SERIAL_NUMBER: return get_string(producer_->serial(), data, size);
-      case kRelightDeviceSceneFolderProperty: return get_string(producer_->scene_folder(), data, size);
+      case capture::kRelightDeviceSceneFolderProperty: return get_string(producer_->scene_folder(), data, size);
       default: return ONI_STATUS_NOT_SUPPORTED;
     }
   }
@@ -174,7 +174,7 @@ class RelightDevice final : public oni::driver::DeviceBase {
   OniBool isPropertySupported(int id) override {
     return id == ONI_DEVICE_PROPERTY_IMAGE_REGISTRATION || id == ONI_DEVICE_PROPERTY_DRIVER_VERSION ||
            id == ONI_DEVICE_PROPERTY_HARDWARE_VERSION || id == ONI_DEVICE_PROPERTY_FIRMWARE_VERSION ||
-           id == ONI_DEVICE_PROPERTY_SERIAL_NUMBER || id == kRelightDeviceSceneFolderProperty;
+           id == ONI_DEVICE_PROPERTY_SERIAL_NUMBER || id == capture::kRelightDeviceSceneFolderProperty;
   }
 
   // Depth and colour come from one camera, so they are registered whichever mode is asked for.

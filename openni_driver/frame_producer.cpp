@@ -29,7 +29,7 @@ ProducedFrame pack(std::int64_t index, std::uint64_t timestamp_us, const DepthMa
   frame.timestamp_us = timestamp_us;
   frame.size = {depth.width(), depth.height()};
   frame.depth.resize(static_cast<std::size_t>(depth.width()) * static_cast<std::size_t>(depth.height()));
-  for (std::size_t i = 0; i < frame.depth.size(); ++i) frame.depth[i] = depth_to_millimetres(depth.data()[i]);
+  for (std::size_t i = 0; i < frame.depth.size(); ++i) frame.depth[i] = capture::depth_to_millimetres(depth.data()[i]);
   frame.rgb.resize(frame.depth.size() * 3);
   for (std::size_t i = 0; i < frame.depth.size(); ++i) {
     const Rgb8 c = color.data()[i];
@@ -155,7 +155,7 @@ class SyntheticProducer final : public FrameProducer {
 // adds the folder's duration plus one mean frame period, so time keeps increasing.
 class TumProducer final : public FrameProducer {
  public:
-  explicit TumProducer(const DeviceUri& uri) : uri_(uri), sequence_(TumSequence::open(uri.folder)) {
+  explicit TumProducer(const DeviceUri& uri) : uri_(uri), sequence_(capture::TumSequence::open(uri.folder)) {
     if (sequence_.size() == 0) throw Error("device URI " + uri.text + ": " + uri.folder.string() + " has no frames");
     const double first = sequence_.frame(0).depth_timestamp, last = sequence_.frame(sequence_.size() - 1).depth_timestamp;
     const double period = sequence_.size() > 1 ? (last - first) / static_cast<double>(sequence_.size() - 1) : 1.0 / uri.fps;
@@ -199,7 +199,7 @@ class TumProducer final : public FrameProducer {
 
  private:
   DeviceUri uri_;
-  TumSequence sequence_;
+  capture::TumSequence sequence_;
   Resolution size_;
   double loop_seconds_ = 1.0;
 };

@@ -11,7 +11,7 @@
 
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::test {
 
 struct CommandResult {
   int exit_code = -1;
@@ -33,4 +33,4 @@ inline CommandResult run_command(const std::string& command) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), slurp(out), slurp(err)};
 }
 
-}  // namespace relight
+}  // namespace relight::test

@@ -6,7 +6,7 @@
 
 #include <gtest/gtest.h>
 
-namespace relight {
+namespace relight::test {
 
 class TempDir {
  public:
@@ -27,4 +27,4 @@ class TempDir {
   std::filesystem::path path_;
 };
 
-}  // namespace relight
+}  // namespace relight::test

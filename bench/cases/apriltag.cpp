@@ -18,20 +18,20 @@ Json detect_case(const relight::bench::Options& options, float decimate) {
   const relight::Pose truth = relight::synth::look_at(tag + Eigen::Vector3d(-0.9, -0.9, 0.9), tag, {0, 0, 1});
   const auto frame = relight::synth::render_frame(scene, intrinsics, truth);
   const relight::ColorImage color = relight::synth::encode_color(frame.radiance);
-  const relight::TagLayout layout = relight::truth::tag_layout(scene);
+  const relight::capture::TagLayout layout = relight::truth::tag_layout(scene);
 
-  relight::TagDetectorOptions detector_options;
+  relight::capture::TagDetectorOptions detector_options;
   detector_options.decimate = decimate;
-  relight::TagDetector detector(detector_options);
-  std::vector<relight::TagDetection> detections;
+  relight::capture::TagDetector detector(detector_options);
+  std::vector<relight::capture::TagDetection> detections;
   Json json;
   json["ms"] = relight::bench::median_ms([&] { detections = detector.detect(color); }, options.repetitions);
   json["decimate"] = decimate;
   json["tags_found"] = detections.size();
-  auto pose = relight::estimate_camera_pose(detections, layout, intrinsics);
+  auto pose = relight::capture::estimate_camera_pose(detections, layout, intrinsics);
   if (pose) {
     json["pose_error_cm_colour_only"] = 100.0 * (pose->camera_to_world.translation() - truth.translation()).norm();
-    pose = relight::refine_with_depth(*pose, detections, layout, intrinsics, frame.depth);
+    pose = relight::capture::refine_with_depth(*pose, detections, layout, intrinsics, frame.depth);
     json["pose_error_cm"] = 100.0 * (pose->camera_to_world.translation() - truth.translation()).norm();
     json["pose_error_deg"] = relight::rotation_distance(pose->camera_to_world, truth) * 180.0 / 3.14159265358979;
   }

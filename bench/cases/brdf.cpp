@@ -65,10 +65,10 @@ const Frame& frame() {
         f.positions(r, c) = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
       }
     }
-    LightSet set;
+    lights::LightSet set;
     for (const synth::PointLight& l : f.scene.lights) {
-      Light light;
-      light.kind = LightKind::Point;
+      lights::Light light;
+      light.kind = lights::LightKind::Point;
       light.position = l.position;
       light.power = l.colour * l.intensity;
       set.lights.push_back(light);

@@ -13,7 +13,7 @@ using namespace relight;
 
 struct Probe {
   RadianceImage image;
-  ProbeGeometry geometry;
+  lights::ProbeGeometry geometry;
 };
 
 const Probe& probe_512() {
@@ -22,9 +22,9 @@ const Probe& probe_512() {
     const synth::LightProbe light_probe = synth::default_probe(scene);
     Probe p;
     p.image = synth::render_probe(scene, light_probe);
-    ProbeCalibration calibration;
+    lights::ProbeCalibration calibration;
     calibration.fisheye = light_probe.camera;
-    p.geometry = ProbeGeometry(calibration, p.image.width(), p.image.height());
+    p.geometry = lights::ProbeGeometry(calibration, p.image.width(), p.image.height());
     return p;
   }();
   return probe;
@@ -32,9 +32,13 @@ const Probe& probe_512() {
 
 bench::Json importance_cpu(const bench::Options& options) {
   const Probe& p = probe_512();
-  ImportancePyramid pyramid;
+  lights::ImportancePyramid pyramid;
   auto time = [&](int n) {
-    return bench::median_ms([&] { (void)sample_importance(p.image, p.geometry, {n, 0}, pyramid); }, options.repetitions);
+    return bench::median_ms(
+        [&] {
+          (void)lights::sample_importance(p.image, p.geometry, {n, 0}, pyramid);
+        },
+        options.repetitions);
   };
   return {{"ms", time(64)}, {"n_lights", 64}, {"ms_256", time(256)}, {"width", 512}, {"height", 512}};
 }
@@ -43,7 +47,7 @@ bench::Json importance_vulkan(const bench::Options& options) {
   auto context = vk::try_create_vulkan();
   if (!context) return {{"skipped", "no Vulkan device"}};
   const Probe& p = probe_512();
-  ImportanceSamplerVk sampler(*context, p.geometry);
+  lights::ImportanceSamplerVk sampler(*context, p.geometry);
   auto time = [&](int n) {
     return bench::median_ms([&] { (void)sampler.run(p.image, {n, 0}); }, options.repetitions);
   };
@@ -55,7 +59,7 @@ bench::Json importance_vulkan(const bench::Options& options) {
 
 bench::Json median_cut_cpu(const bench::Options& options) {
   const Probe& p = probe_512();
-  const double ms = bench::median_ms([&] { (void)median_cut(p.image, p.geometry, {64}); }, options.repetitions);
+  const double ms = bench::median_ms([&] { (void)lights::median_cut(p.image, p.geometry, {64}); }, options.repetitions);
   return {{"ms", ms}, {"n_lights", 64}, {"width", 512}, {"height", 512}};
 }
 

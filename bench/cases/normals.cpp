@@ -85,7 +85,7 @@ const BenchSequence& sequence() {
 #ifdef RELIGHT_HAVE_PCL
 pcl::PointCloud<pcl::PointXYZ>::Ptr organised_cloud(const DepthMap& depth, const PinholeIntrinsics& k) {
   PositionMap positions;
-  positions_from_depth(depth, k, positions);
+  reconstruct::positions_from_depth(depth, k, positions);
   auto cloud = pcl::make_shared<pcl::PointCloud<pcl::PointXYZ>>(depth.width(), depth.height());
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (std::size_t i = 0; i < positions.size(); ++i) {
@@ -128,7 +128,7 @@ struct IntegralImageBaseline {
 // depth discontinuities and the image border, where normals are hardest, so the errors over each
 // method's own pixels do not compare like for like.
 void add_baseline(Json& json, const NormalMap& baseline, const NormalMap& ours, const NormalMap& truth) {
-  const AngularError own = angular_error(baseline, truth);
+  const reconstruct::AngularError own = reconstruct::angular_error(baseline, truth);
   json["baseline_angular_error_deg"] = own.mean_deg;
   json["baseline_coverage"] = own.coverage;
   Mask both(truth.width(), truth.height());
@@ -137,8 +137,8 @@ void add_baseline(Json& json, const NormalMap& baseline, const NormalMap& ours, 
     both.pixels()[i] = is_valid_normal(baseline.pixels()[i]) && is_valid_normal(ours.pixels()[i]) ? 1 : 0;
     true_normals += is_valid_normal(truth.pixels()[i]) ? 1 : 0;
   }
-  const AngularError ours_common = angular_error(ours, truth, &both);
-  const AngularError baseline_common = angular_error(baseline, truth, &both);
+  const reconstruct::AngularError ours_common = reconstruct::angular_error(ours, truth, &both);
+  const reconstruct::AngularError baseline_common = reconstruct::angular_error(baseline, truth, &both);
   json["common_angular_error_deg"] = ours_common.mean_deg;
   json["baseline_common_angular_error_deg"] = baseline_common.mean_deg;
   json["common_median_error_deg"] = ours_common.median_deg;
@@ -172,17 +172,17 @@ Json method1_cpu(const bench::Options& options) {
   NormalMap normals[2];
   for (int i = 0; i < kFrames; ++i) {
     const int cur = i % 2, prev = 1 - cur;
-    const NormalsHistory history{normals[prev], positions[prev], s.pose};
-    normals_raw_depth(s.noisy[static_cast<std::size_t>(i)], s.intrinsics, s.pose, i > 0 ? &history : nullptr, {},
-                      positions[cur], normals[cur]);
+    const reconstruct::NormalsHistory history{normals[prev], positions[prev], s.pose};
+    reconstruct::normals_raw_depth(s.noisy[static_cast<std::size_t>(i)], s.intrinsics, s.pose,
+                                   i > 0 ? &history : nullptr, {}, positions[cur], normals[cur]);
   }
   const int last = (kFrames - 1) % 2;
-  const AngularError error = angular_error(normals[last], s.truth);
+  const reconstruct::AngularError error = reconstruct::angular_error(normals[last], s.truth);
   // Steady state: frame 10 again with frame 9's outputs as history, into scratch outputs.
-  const NormalsHistory history{normals[last], positions[last], s.pose};
+  const reconstruct::NormalsHistory history{normals[last], positions[last], s.pose};
   PositionMap scratch_positions;
   NormalMap scratch_normals;
-  NormalsRawDepthCpu method;  // as the stage: scratch memory kept between frames
+  reconstruct::NormalsRawDepthCpu method;  // as the stage: scratch memory kept between frames
   Json json = compare_with_pcl(
       [&] { method.run(s.noisy.back(), s.intrinsics, s.pose, &history, {}, scratch_positions, scratch_normals); },
       normals[last], options);
@@ -193,7 +193,7 @@ Json method1_cpu(const bench::Options& options) {
 
 /// The fields every normals/*_vulkan line adds: the error after 10 frames, the median GPU time
 /// of the dispatches (-1: no timestamp queries), the device and what ran on it.
-void add_vulkan_fields(Json& json, const AngularError& error, std::vector<double>& gpu_ms,
+void add_vulkan_fields(Json& json, const reconstruct::AngularError& error, std::vector<double>& gpu_ms,
                        const vk::VulkanContext& context, const char* passes) {
   json["angular_error_deg"] = error.mean_deg;
   json["coverage"] = error.coverage;
@@ -207,9 +207,9 @@ void add_vulkan_fields(Json& json, const AngularError& error, std::vector<double
 Json method1_vulkan(const bench::Options& options) {
   const auto context = relight::bench::timing_vulkan();
   const BenchSequence& s = sequence();
-  NormalsRawDepthVk gpu(*context);
+  reconstruct::NormalsRawDepthVk gpu(*context);
   std::vector<double> gpu_ms;
-  const auto frame = [&](const DepthMap& depth, const NormalsHistory* history, PositionMap& positions,
+  const auto frame = [&](const DepthMap& depth, const reconstruct::NormalsHistory* history, PositionMap& positions,
                          NormalMap& normals) {
     gpu.run(depth, s.intrinsics, s.pose, history, {}, positions, normals);
     if (const auto ms = gpu.last_gpu_ms()) gpu_ms.push_back(*ms);
@@ -218,13 +218,13 @@ Json method1_vulkan(const bench::Options& options) {
   NormalMap normals[2];
   for (int i = 0; i < kFrames; ++i) {
     const int cur = i % 2, prev = 1 - cur;
-    const NormalsHistory history{normals[prev], positions[prev], s.pose};
+    const reconstruct::NormalsHistory history{normals[prev], positions[prev], s.pose};
     frame(s.noisy[static_cast<std::size_t>(i)], i > 0 ? &history : nullptr, positions[cur], normals[cur]);
   }
   const int last = (kFrames - 1) % 2;
-  const AngularError error = angular_error(normals[last], s.truth);
+  const reconstruct::AngularError error = reconstruct::angular_error(normals[last], s.truth);
   // Steady state: frame 10 again with frame 9's outputs as history, into scratch outputs.
-  const NormalsHistory history{normals[last], positions[last], s.pose};
+  const reconstruct::NormalsHistory history{normals[last], positions[last], s.pose};
   PositionMap scratch_positions;
   NormalMap scratch_normals;
   gpu_ms.clear();
@@ -241,15 +241,15 @@ Json method1_vulkan(const bench::Options& options) {
 // "plain_angular_error_deg": the stride-1 cross products of the same merged positions.
 struct Method2State {
   DepthMap filtered;
-  DepthWeightMap weight;
+  reconstruct::DepthWeightMap weight;
   PositionMap positions;
   NormalMap normals;
 };
 
 /// Method 1's history from the previous frame's state (none on the first frame).
-std::optional<NormalsHistory> history_of(const Method2State* previous, const BenchSequence& s) {
+std::optional<reconstruct::NormalsHistory> history_of(const Method2State* previous, const BenchSequence& s) {
   if (!previous) return std::nullopt;
-  return NormalsHistory{previous->normals, previous->positions, s.pose};
+  return reconstruct::NormalsHistory{previous->normals, previous->positions, s.pose};
 }
 
 /// Runs `frame(depth, previous state or null, next state)` over the sequence's frames; returns
@@ -265,31 +265,32 @@ const Method2State& run_frames(const BenchSequence& s, Method2State (&states)[2]
 double plain_normals_error(const Method2State& state, const BenchSequence& s) {
   PositionMap positions;
   NormalMap normals;
-  positions_from_depth(state.filtered, s.intrinsics, positions);
-  normals_from_positions(positions, normals);
-  return angular_error(normals, s.truth).mean_deg;
+  reconstruct::positions_from_depth(state.filtered, s.intrinsics, positions);
+  reconstruct::normals_from_positions(positions, normals);
+  return reconstruct::angular_error(normals, s.truth).mean_deg;
 }
 
 Json method2_cpu(const bench::Options& options) {
   const BenchSequence& s = sequence();
-  NormalsRawDepthCpu normals_method;  // as the stage: scratch memory kept between frames
+  reconstruct::NormalsRawDepthCpu normals_method;  // as the stage: scratch memory kept between frames
   DepthMap warped;
-  DepthWeightMap warped_weight;
+  reconstruct::DepthWeightMap warped_weight;
   // One frame from `previous` (null: the first) into `next`.
   const auto frame = [&](const DepthMap& depth, const Method2State* previous, Method2State& next) {
     if (previous) {
-      warp_depth(previous->filtered, previous->weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight);
+      reconstruct::warp_depth(previous->filtered, previous->weight, s.intrinsics, Pose::Identity(), {}, warped,
+                              warped_weight);
     } else {
       warped = DepthMap();  // no history: merge_depth takes the depth alone
     }
-    merge_depth(depth, warped, warped_weight, {}, next.filtered, next.weight);
-    const std::optional<NormalsHistory> history = history_of(previous, s);
+    reconstruct::merge_depth(depth, warped, warped_weight, {}, next.filtered, next.weight);
+    const std::optional<reconstruct::NormalsHistory> history = history_of(previous, s);
     normals_method.run(next.filtered, s.intrinsics, s.pose, history ? &*history : nullptr, {}, next.positions,
                        next.normals);
   };
   Method2State states[2];
   const Method2State& last = run_frames(s, states, frame);
-  const AngularError error = angular_error(last.normals, s.truth);
+  const reconstruct::AngularError error = reconstruct::angular_error(last.normals, s.truth);
   Method2State scratch;
   Json json = compare_with_pcl([&] { frame(s.noisy.back(), &last, scratch); }, last.normals, options);
   json["angular_error_deg"] = error.mean_deg;
@@ -297,12 +298,14 @@ Json method2_cpu(const bench::Options& options) {
   json["plain_angular_error_deg"] = plain_normals_error(last, s);
   // The two halves on their own: warp + merge, and the normals of the merged depth.
   json["warp_ms"] = bench::median_ms(
-      [&] { warp_depth(last.filtered, last.weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight); },
+      [&] {
+        reconstruct::warp_depth(last.filtered, last.weight, s.intrinsics, Pose::Identity(), {}, warped, warped_weight);
+      },
       options.repetitions);
   json["merge_ms"] = bench::median_ms(
-      [&] { merge_depth(s.noisy.back(), warped, warped_weight, {}, scratch.filtered, scratch.weight); },
+      [&] { reconstruct::merge_depth(s.noisy.back(), warped, warped_weight, {}, scratch.filtered, scratch.weight); },
       options.repetitions);
-  const NormalsHistory history{last.normals, last.positions, s.pose};
+  const reconstruct::NormalsHistory history{last.normals, last.positions, s.pose};
   json["normals_ms"] = bench::median_ms(
       [&] { normals_method.run(scratch.filtered, s.intrinsics, s.pose, &history, {}, scratch.positions, scratch.normals); },
       options.repetitions);
@@ -312,13 +315,13 @@ Json method2_cpu(const bench::Options& options) {
 Json method2_vulkan(const bench::Options& options) {
   const auto context = relight::bench::timing_vulkan();
   const BenchSequence& s = sequence();
-  DepthWarpMergeVk warp_merge(*context);
-  NormalsRawDepthVk normals_method(*context);
+  reconstruct::DepthWarpMergeVk warp_merge(*context);
+  reconstruct::NormalsRawDepthVk normals_method(*context);
   std::vector<double> gpu_ms;
   const auto frame = [&](const DepthMap& depth, const Method2State* previous, Method2State& next) {
     warp_merge.run(depth, previous ? &previous->filtered : nullptr, previous ? &previous->weight : nullptr, s.intrinsics,
                    Pose::Identity(), {}, next.filtered, next.weight);
-    const std::optional<NormalsHistory> history = history_of(previous, s);
+    const std::optional<reconstruct::NormalsHistory> history = history_of(previous, s);
     normals_method.run(next.filtered, s.intrinsics, s.pose, history ? &*history : nullptr, {}, next.positions,
                        next.normals);
     if (warp_merge.last_gpu_ms() && normals_method.last_gpu_ms()) {
@@ -327,7 +330,7 @@ Json method2_vulkan(const bench::Options& options) {
   };
   Method2State states[2];
   const Method2State& last = run_frames(s, states, frame);
-  const AngularError error = angular_error(last.normals, s.truth);
+  const reconstruct::AngularError error = reconstruct::angular_error(last.normals, s.truth);
   Method2State scratch;
   gpu_ms.clear();
   Json json = compare_with_pcl([&] { frame(s.noisy.back(), &last, scratch); }, last.normals, options);
@@ -362,7 +365,7 @@ Json pcl_omp(const bench::Options& options) {
     const auto& n = normals[i];
     if (std::isfinite(n.normal_x)) map.pixels()[pixel_of[i]] = {n.normal_x, n.normal_y, n.normal_z};
   }
-  const AngularError error = angular_error(map, s.truth);
+  const reconstruct::AngularError error = reconstruct::angular_error(map, s.truth);
   Json json;
   json["ms"] = ms;
   json["angular_error_deg"] = error.mean_deg;

@@ -68,7 +68,7 @@ void add_change(const Frame& before, const NormalMap& normals_before, const Fram
 
 Json tum_stability(const bench::Options& options) {
   const std::filesystem::path folder = app::default_sequence();  // data/tum_fr1_rpy, or under $RELIGHT_DATA
-  const TumSequence sequence = TumSequence::open(folder);
+  const capture::TumSequence sequence = capture::TumSequence::open(folder);
   const PinholeIntrinsics& k = sequence.intrinsics();
   std::vector<Frame> frames;
   for (std::size_t i = 0; i < sequence.size(); ++i) {
@@ -82,35 +82,38 @@ Json tum_stability(const bench::Options& options) {
   NormalMap raw_prev, m1_prev, m2_prev, m2_plain_prev;
   PositionMap m1_positions_prev, m2_positions_prev;
   DepthMap filtered;
-  DepthWeightMap weight;
+  reconstruct::DepthWeightMap weight;
   for (std::size_t i = 0; i < frames.size(); ++i) {
     const Frame& f = frames[i];
     PositionMap positions;
     NormalMap raw_now, m1_now, m2_now;
-    positions_from_depth(f.depth, k, positions);
-    normals_from_positions(positions, raw_now);
+    reconstruct::positions_from_depth(f.depth, k, positions);
+    reconstruct::normals_from_positions(positions, raw_now);
 
     PositionMap m1_positions;
-    const NormalsHistory history{m1_prev, m1_positions_prev, i > 0 ? frames[i - 1].camera_to_world : Pose::Identity()};
-    normals_raw_depth(f.depth, k, f.camera_to_world, i > 0 ? &history : nullptr, {}, m1_positions, m1_now);
+    const reconstruct::NormalsHistory history{m1_prev, m1_positions_prev,
+                                              i > 0 ? frames[i - 1].camera_to_world : Pose::Identity()};
+    reconstruct::normals_raw_depth(f.depth, k, f.camera_to_world, i > 0 ? &history : nullptr, {}, m1_positions, m1_now);
 
     DepthMap merged;
-    DepthWeightMap merged_weight;
+    reconstruct::DepthWeightMap merged_weight;
     if (i > 0) {
       DepthMap warped;
-      DepthWeightMap warped_weight;
+      reconstruct::DepthWeightMap warped_weight;
       const Pose now_from_before = f.camera_to_world.inverse() * frames[i - 1].camera_to_world;
-      warp_depth(filtered, weight, k, now_from_before, {}, warped, warped_weight);
-      merge_depth(f.depth, warped, warped_weight, {}, merged, merged_weight);
+      reconstruct::warp_depth(filtered, weight, k, now_from_before, {}, warped, warped_weight);
+      reconstruct::merge_depth(f.depth, warped, warped_weight, {}, merged, merged_weight);
     } else {
-      merge_depth(f.depth, DepthMap(k.width, k.height), DepthWeightMap(k.width, k.height), {}, merged, merged_weight);
+      reconstruct::merge_depth(f.depth, DepthMap(k.width, k.height), reconstruct::DepthWeightMap(k.width, k.height), {},
+                               merged, merged_weight);
     }
     PositionMap m2_positions;
     NormalMap m2_plain_now;
-    const NormalsHistory m2_history{m2_prev, m2_positions_prev,
-                                    i > 0 ? frames[i - 1].camera_to_world : Pose::Identity()};
-    normals_raw_depth(merged, k, f.camera_to_world, i > 0 ? &m2_history : nullptr, {}, m2_positions, m2_now);
-    normals_from_positions(m2_positions, m2_plain_now);  // φ⁻¹(merged), as normals_raw_depth wrote them
+    const reconstruct::NormalsHistory m2_history{m2_prev, m2_positions_prev,
+                                                 i > 0 ? frames[i - 1].camera_to_world : Pose::Identity()};
+    reconstruct::normals_raw_depth(merged, k, f.camera_to_world, i > 0 ? &m2_history : nullptr, {}, m2_positions,
+                                   m2_now);
+    reconstruct::normals_from_positions(m2_positions, m2_plain_now);  // φ⁻¹(merged), as normals_raw_depth wrote them
 
     if (i > 0) {
       add_change(frames[i - 1], raw_prev, f, raw_now, k, raw);
@@ -129,10 +132,10 @@ Json tum_stability(const bench::Options& options) {
   }
   // Method 1's time on a real frame, with the previous frame as history.
   const Frame& last = frames.back();
-  const NormalsHistory history{m1_prev, m1_positions_prev, last.camera_to_world};
+  const reconstruct::NormalsHistory history{m1_prev, m1_positions_prev, last.camera_to_world};
   PositionMap scratch_positions;
   NormalMap scratch_normals;
-  NormalsRawDepthCpu method;
+  reconstruct::NormalsRawDepthCpu method;
   const double ms = bench::median_ms(
       [&] { method.run(last.depth, k, last.camera_to_world, &history, {}, scratch_positions, scratch_normals); },
       options.repetitions);

@@ -54,10 +54,10 @@ struct TrackerRun {
 };
 
 Json figures(const TrackerRun& run, const std::vector<Pose>& truth) {
-  const RelativePoseError rpe = relative_pose_error(run.poses, truth);
+  const capture::RelativePoseError rpe = capture::relative_pose_error(run.poses, truth);
   Json json;
   json["ms"] = median(run.ms);
-  json["ate_cm"] = 100.0 * absolute_trajectory_error(run.poses, truth);
+  json["ate_cm"] = 100.0 * capture::absolute_trajectory_error(run.poses, truth);
   json["rpe_deg"] = rpe.rotation_deg;
   json["rpe_cm"] = 100.0 * rpe.translation_m;
   json["failed_frames"] = run.failed;
@@ -119,20 +119,20 @@ Json odometry_640x480(const bench::Options&) {
     json["skipped"] = "no tracking sequence at " + folder.string() + " (set RELIGHT_TRACKING_SEQUENCE)";
     return json;
   }
-  TumOptions tum;
+  capture::TumOptions tum;
   tum.intrinsics = PinholeIntrinsics::kinect_v1();  // as replay uses for TUM folders (tum_sequence.h)
-  const TumSequence sequence = TumSequence::open(folder, tum);
+  const capture::TumSequence sequence = capture::TumSequence::open(folder, tum);
   const PinholeIntrinsics intrinsics = sequence.intrinsics();
 
   std::vector<TrackerRun> runs;
-  RgbdOdometry ours;
+  capture::RgbdOdometry ours;
   {
     TrackerRun run;
     run.name = "relight";
     run.step = [&ours, &intrinsics](const RgbdFrame& frame, bool first, double& ms, bool& ok) {
       if (first) ours.reset(frame.info.camera_to_world.value_or(Pose::Identity()));
       const auto start = Clock::now();
-      const OdometryResult result = ours.track(frame.depth, frame.color, intrinsics);
+      const capture::OdometryResult result = ours.track(frame.depth, frame.color, intrinsics);
       ms = elapsed_ms(start);
       ok = result.quality.tracked;
       return result.camera_to_world;

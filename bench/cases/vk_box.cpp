@@ -48,7 +48,7 @@ relight::bench::Json box3x3_vs_cpu(const relight::bench::Options& options) {
 
   constexpr int width = 640, height = 480;
   const DepthMap depth = synthetic_depth(width, height);
-  relight::DepthBoxFilterVk filter(*context);
+  relight::reconstruct::DepthBoxFilterVk filter(*context);
   vk::VulkanTransfer& transfer = context->transfer();
   vk::VulkanBuffer input(*context, depth.bytes().size());
   vk::VulkanBuffer output(*context, depth.bytes().size());
@@ -61,7 +61,7 @@ relight::bench::Json box3x3_vs_cpu(const relight::bench::Options& options) {
     if (const auto ms = filter.run(input, output, width, height)) gpu_ms.push_back(*ms);
     transfer.download(output, vulkan_result.bytes());
   };
-  const auto baseline = [&] { relight::depth_box_filter(depth, cpu_result); };
+  const auto baseline = [&] { relight::reconstruct::depth_box_filter(depth, cpu_result); };
   const auto comparison = relight::bench::compare_interleaved(ours, baseline, options.repetitions);
   const double dispatch_ms =
       relight::bench::median_ms([&] { (void)filter.run(input, output, width, height); }, options.repetitions);

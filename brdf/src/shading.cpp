@@ -8,14 +8,15 @@
 
 namespace relight::brdf {
 
-ShadingLights to_camera_frame(const LightSet& set, const Pose& camera_to_world, const Eigen::Vector3f& ambient) {
+ShadingLights to_camera_frame(const lights::LightSet& set, const Pose& camera_to_world,
+                              const Eigen::Vector3f& ambient) {
   const Pose world_to_camera = camera_to_world.inverse();
   ShadingLights out;
   out.ambient = ambient;
-  for (const Light& light : set.lights) {
+  for (const lights::Light& light : set.lights) {
     if (!light.real) continue;
     ShadingLight l;
-    l.point = light.kind == LightKind::Point;
+    l.point = light.kind == lights::LightKind::Point;
     l.vector = l.point ? (world_to_camera * light.position).cast<float>()
                        : (world_to_camera.linear() * light.direction).normalized().cast<float>();
     l.power = light.power.cast<float>();

@@ -7,7 +7,7 @@
 #include "relight/core/buffers.h"
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::capture {
 
 namespace {
 
@@ -139,4 +139,4 @@ void CameraTrackingStage::run(StageContext& context) {
   context.get(pose_) = std::move(pose);
 }
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -7,7 +7,7 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
-namespace relight {
+namespace relight::capture {
 
 namespace {
 
@@ -155,4 +155,4 @@ void MarkerPoseStage::run(StageContext& context) {
   out.failure = estimate ? "" : "no known tag in view";
 }
 
-}  // namespace relight
+}  // namespace relight::capture

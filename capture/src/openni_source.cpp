@@ -13,7 +13,7 @@
 #include "relight/capture/relight_device.h"
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::capture {
 
 namespace {
 
@@ -446,4 +446,4 @@ void OpenNiSource::stop_recording() {
   s.recorder.destroy();  // closes the file
 }
 
-}  // namespace relight
+}  // namespace relight::capture

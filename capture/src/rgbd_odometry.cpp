@@ -14,7 +14,7 @@
 #include "relight/core/parallel.h"
 #include "relight/core/pixel.h"
 
-namespace relight {
+namespace relight::capture {
 
 namespace {
 
@@ -654,4 +654,4 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
   return result;
 }
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -3,7 +3,7 @@
 
 #include <chrono>
 
-namespace relight {
+namespace relight::capture {
 
 void SourceStage::declare(StageBuilder& builder) {
   color_ = builder.write(kColor);
@@ -23,4 +23,4 @@ void SourceStage::run(StageContext& context) {
   context.get(frame_) = std::move(frame->info);
 }
 
-}  // namespace relight
+}  // namespace relight::capture

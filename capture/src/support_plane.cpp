@@ -8,7 +8,7 @@
 
 #include "relight/core/pixel.h"
 
-namespace relight {
+namespace relight::capture {
 
 namespace {
 
@@ -191,4 +191,4 @@ Pose world_from_support_plane(const Plane& plane) {
   return camera_to_world;
 }
 
-}  // namespace relight
+}  // namespace relight::capture

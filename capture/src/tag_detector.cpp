@@ -8,7 +8,7 @@
 
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::capture {
 
 // The apriltag C objects, released in the right order (detector before its family).
 struct TagDetector::Library {
@@ -83,4 +83,4 @@ std::vector<TagDetection> TagDetector::detect(const Image<std::uint8_t>& grey) {
   return detections;
 }
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -5,7 +5,7 @@
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::capture {
 
 namespace {
 
@@ -60,4 +60,4 @@ TagLayout read_tag_layout(const std::filesystem::path& file) {
   return parse_tag_layout(read_text_file(file), file.string());
 }
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -6,7 +6,7 @@
 
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::capture {
 
 double absolute_trajectory_error(const std::vector<Pose>& estimate, const std::vector<Pose>& truth) {
   if (estimate.size() != truth.size()) throw LogicError("trajectory error: trajectories differ in length");
@@ -47,4 +47,4 @@ RelativePoseError relative_pose_error(const std::vector<Pose>& estimate, const s
   return error;
 }
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -11,7 +11,7 @@
 #include "relight/core/error.h"
 #include "relight/core/image_io.h"
 
-namespace relight {
+namespace relight::capture {
 
 namespace {
 
@@ -288,4 +288,4 @@ std::string TumSource::describe() const {
          std::to_string(sequence_.size()) + " frames, intrinsics: " + sequence_.intrinsics_source() + ")";
 }
 
-}  // namespace relight
+}  // namespace relight::capture

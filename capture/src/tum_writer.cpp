@@ -7,7 +7,7 @@
 #include "relight/core/error.h"
 #include "relight/core/image_io.h"
 
-namespace relight {
+namespace relight::capture {
 
 TumWriter::TumWriter(std::filesystem::path folder, double depth_scale)
     : folder_(std::move(folder)), depth_scale_(depth_scale) {
@@ -62,4 +62,4 @@ void TumWriter::finish() {
   write_file_atomically(folder_ / "rgb.txt", rgb.str());
 }
 
-}  // namespace relight
+}  // namespace relight::capture

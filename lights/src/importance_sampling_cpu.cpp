@@ -10,7 +10,7 @@
 #include "relight/lights/importance_sampling.h"
 #include "relight/lights/importance_shared.h"
 
-namespace relight {
+namespace relight::lights {
 
 namespace {
 
@@ -193,4 +193,4 @@ LightSet sample_importance(const RadianceImage& probe, const ProbeGeometry& geom
   return sample_importance(probe, geometry, options, pyramid);
 }
 
-}  // namespace relight
+}  // namespace relight::lights

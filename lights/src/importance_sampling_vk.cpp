@@ -12,7 +12,7 @@
 #include "relight/vk/timer.h"
 #include "relight/vk/transfer.h"
 
-namespace relight {
+namespace relight::lights {
 
 namespace {
 
@@ -137,4 +137,4 @@ LightSet ImportanceSamplerVk::run(const RadianceImage& probe, const ImportanceSa
   return set;
 }
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -7,7 +7,7 @@
 
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::lights {
 
 namespace {
 
@@ -145,4 +145,4 @@ ColorImage light_preview(const RadianceImage& probe, const ProbeGeometry& geomet
   return image;
 }
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-namespace relight {
+namespace relight::lights {
 
 Eigen::Vector3d irradiance(const LightSet& set, const Eigen::Vector3d& normal) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
@@ -50,4 +50,4 @@ LightSet cluster_lights(const LightSet& set, double radius) {
   return clustered;
 }
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-namespace relight {
+namespace relight::lights {
 
 LightSet smooth_lights(const LightSet& current, const LightSet* previous, const LightSmoothingOptions& options) {
   if (!previous || previous->lights.size() != current.lights.size()) return current;
@@ -39,4 +39,4 @@ void LightSmoothingStage::run(StageContext& context) {
   context.get(output_) = std::move(smoothed);
 }
 
-}  // namespace relight
+}  // namespace relight::lights

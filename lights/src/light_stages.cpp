@@ -2,7 +2,7 @@
 
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::lights {
 
 LightExtractionStage::LightExtractionStage(LightExtractionOptions options, LightExtractionBuffers buffers,
                                            vk::VulkanContext* context)
@@ -48,4 +48,4 @@ LightSet extract_lights(const RadianceImage& probe, const LightExtractionOptions
   return sample_importance(probe, geometry, {options.lights, options.seed});
 }
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -10,7 +10,7 @@
 #include "relight/core/error.h"
 #include "relight/lights/importance_sampling.h"
 
-namespace relight {
+namespace relight::lights {
 
 namespace {
 
@@ -155,4 +155,4 @@ LightSet median_cut(const RadianceImage& probe, const ProbeGeometry& geometry, c
   return set;
 }
 
-}  // namespace relight
+}  // namespace relight::lights

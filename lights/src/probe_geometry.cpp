@@ -6,7 +6,7 @@
 
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::lights {
 
 namespace {
 
@@ -114,4 +114,4 @@ RadianceImage equirectangular_to_fisheye(const RadianceImage& latlong, const Eig
   return out;
 }
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -13,7 +13,7 @@
 #include "relight/vk/timer.h"
 #include "relight/vk/transfer.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 static_assert(sizeof(Float3) == 3 * sizeof(float), "the shader indexes Float3 maps as 3 packed floats");
 
@@ -110,4 +110,4 @@ std::unique_ptr<Stage> make_normals_from_positions_stage(Backend backend, vk::Vu
       backend, context, "make_normals_from_positions_stage", options);
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -5,7 +5,7 @@
 #include "relight/core/error.h"
 #include "relight/reconstruct/depth_box_filter.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 namespace {
 
@@ -53,4 +53,4 @@ void DepthBoxFilterCpuStage::run(StageContext& context) {
   depth_box_filter(context.get(input_), context.get(output_));
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -11,7 +11,7 @@
 #include "relight/vk/timer.h"
 #include "relight/vk/transfer.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 struct DepthBoxFilterVk::Pipeline {
   explicit Pipeline(vk::VulkanContext& context)
@@ -86,4 +86,4 @@ std::unique_ptr<Stage> make_depth_box_filter_stage(Backend backend, vk::VulkanCo
                                                                                "make_depth_box_filter_stage", buffers);
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -16,7 +16,7 @@
 #include "relight/reconstruct/buffers.h"
 #include "relight/reconstruct/depth_warp_merge.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 namespace {
 
@@ -575,4 +575,4 @@ void DepthWarpMergeCpuStage::run(StageContext& context) {
   merge_depth(depth, warped_, warped_weight_, options(), context.get(filtered_), context.get(weight_));
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -14,7 +14,7 @@
 #include "relight/vk/timer.h"
 #include "relight/vk/transfer.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 struct DepthWarpMergeVk::Pipelines {
   explicit Pipelines(vk::VulkanContext& context)
@@ -142,4 +142,4 @@ std::unique_ptr<Stage> make_depth_warp_merge_stage(Backend backend, vk::VulkanCo
                                                                                "make_depth_warp_merge_stage", options);
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -5,7 +5,7 @@
 #include <numbers>
 #include <vector>
 
-namespace relight {
+namespace relight::reconstruct {
 
 AngularError angular_error(const NormalMap& estimate, const NormalMap& truth, const Mask* region) {
   AngularError error;
@@ -87,4 +87,4 @@ DepthError depth_rmse(const DepthMap& estimate, const DepthMap& truth, const Mas
   return error;
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -11,7 +11,7 @@
 
 #include "relight/core/parallel.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 namespace {
 
@@ -193,4 +193,4 @@ void NormalsFromPositionsCpuStage::run(StageContext& context) {
   normals_from_positions(positions, context.get(normals_), options_);
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

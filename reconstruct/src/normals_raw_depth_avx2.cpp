@@ -16,7 +16,7 @@
 
 #define RELIGHT_AVX2 __attribute__((target("avx2")))
 
-namespace relight::method1 {
+namespace relight::reconstruct::method1 {
 
 namespace {
 
@@ -483,11 +483,11 @@ RELIGHT_AVX2 void pass2_row_avx2(const Pass2& in, int r) {
   for (int c = vector_end; c < width; ++c) pass2_pixel(in, r, c);
 }
 
-}  // namespace relight::method1
+}  // namespace relight::reconstruct::method1
 
 #else  // not x86: the scalar loops only
 
-namespace relight::method1 {
+namespace relight::reconstruct::method1 {
 
 bool avx2_available() { return false; }
 void level0_row_avx2(const Float3* previous, int width, int height, int hr, Pyramid& out, int out_row) {
@@ -503,6 +503,6 @@ void pass2_row_avx2(const Pass2& in, int r) {
   for (int c = 0; c < in.k.width; ++c) pass2_pixel(in, r, c);
 }
 
-}  // namespace relight::method1
+}  // namespace relight::reconstruct::method1
 
 #endif

@@ -14,7 +14,7 @@
 #include "relight/core/parallel.h"
 #include "relight/reconstruct/normals_raw_depth.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 namespace method1 {
 /// What NormalsRawDepthCpu keeps between frames.
@@ -359,4 +359,4 @@ void NormalsRawDepthCpuStage::run(StageContext& context) {
               history ? &*history : nullptr, options(), context.get(positions_), context.get(normals_));
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -15,7 +15,7 @@
 
 #include "relight/core/pixel.h"
 
-namespace relight::method1 {
+namespace relight::reconstruct::method1 {
 
 /// Everything a row of pass 2 needs besides the images, in float as the loops use it.
 struct Constants {
@@ -325,4 +325,4 @@ void resolve_row_avx2(const Pyramid& p, const Constants& k, int r, History& out,
 /// (gather indices).
 void pass2_row_avx2(const Pass2& in, int r);
 
-}  // namespace relight::method1
+}  // namespace relight::reconstruct::method1

@@ -13,7 +13,7 @@
 #include "relight/vk/timer.h"
 #include "relight/vk/transfer.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 struct NormalsRawDepthVk::Pipelines {
   explicit Pipelines(vk::VulkanContext& context)
@@ -189,4 +189,4 @@ std::unique_ptr<Stage> make_normals_raw_depth_stage(Backend backend, vk::VulkanC
       backend, context, "make_normals_raw_depth_stage", options, input);
 }
 
-}  // namespace relight
+}  // namespace relight::reconstruct

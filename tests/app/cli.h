@@ -12,10 +12,12 @@
 
 namespace relight::cli_test {
 
-inline CommandResult relight(const std::string& arguments) { return run_command(std::string(RELIGHT_BIN) + " " + arguments); }
+inline test::CommandResult relight(const std::string& arguments) {
+  return test::run_command(std::string(RELIGHT_BIN) + " " + arguments);
+}
 
 /// One line on stderr, "relight: error: ...", and the given exit code.
-inline void expect_one_line_error(const CommandResult& result, int exit_code) {
+inline void expect_one_line_error(const test::CommandResult& result, int exit_code) {
   EXPECT_EQ(result.exit_code, exit_code) << result.err;
   EXPECT_EQ(result.err.rfind("relight: error: ", 0), 0u) << result.err;
   EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
@@ -24,7 +26,7 @@ inline void expect_one_line_error(const CommandResult& result, int exit_code) {
 /// The sequence `relight synth --quiet <arguments>` writes, made once per test binary for each
 /// argument string and kept until it exits (synthesising costs more than most tests).
 inline const std::filesystem::path& synthetic_sequence(const std::string& arguments) {
-  static TempDir dir;
+  static test::TempDir dir;
   static std::map<std::string, std::filesystem::path> made;
   if (const auto found = made.find(arguments); found != made.end()) return found->second;
   const auto path = dir.path() / std::to_string(made.size());

@@ -10,7 +10,7 @@
 #include "cli.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 using cli_test::expect_one_line_error;
@@ -41,7 +41,7 @@ TEST(Cli, NoSubcommandOrUnknownFlagIsAUsageError) {
 
 // Geometry only (the main job's pebble: placement_cli_test.cpp).
 TEST(Cli, ReplayOfTheEmbeddedSampleWritesFramesReportAndGraph) {
-  TempDir dir;
+  test::TempDir dir;
   const auto result = relight("replay --quiet --no-object --out " + dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(result.err.empty()) << result.err;
@@ -75,9 +75,10 @@ TEST(Cli, ReplayOfTheEmbeddedSampleWritesFramesReportAndGraph) {
 }
 
 TEST(Cli, ReportListsTheGraphWhenGraphvizIsMissing) {
-  TempDir dir;
-  const auto result = run_command("PATH=/nonexistent " + std::string(RELIGHT_BIN) + " replay --quiet --no-object --frames 1 --no-frames --out " +
-                                  dir.path().string());
+  test::TempDir dir;
+  const auto result =
+      test::run_command("PATH=/nonexistent " + std::string(RELIGHT_BIN) +
+                        " replay --quiet --no-object --frames 1 --no-frames --out " + dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const std::string html = read_text_file(dir.path() / "report.html");
   EXPECT_NE(html.find("Graphviz (dot) is not installed"), std::string::npos);
@@ -86,13 +87,13 @@ TEST(Cli, ReportListsTheGraphWhenGraphvizIsMissing) {
 }
 
 TEST(Cli, FrameRangeLimitsTheRun) {
-  TempDir dir;
+  test::TempDir dir;
   ASSERT_EQ(relight("replay --quiet --no-object --frames 1:3 --out " + dir.path().string()).exit_code, 0);
   EXPECT_EQ(nlohmann::json::parse(read_text_file(dir.path() / "report.json"))["frames"], 2);
 }
 
 TEST(Cli, LoopPlaysTheRangeAgainAndReportsPeakMemory) {
-  TempDir dir;
+  test::TempDir dir;
   ASSERT_EQ(relight("replay --quiet --no-object --no-frames --frames 1:3 --loop 3 --out " + dir.path().string()).exit_code, 0);
   const auto report = nlohmann::json::parse(read_text_file(dir.path() / "report.json"));
   EXPECT_EQ(report["frames"], 6);
@@ -104,14 +105,14 @@ TEST(Cli, LoopPlaysTheRangeAgainAndReportsPeakMemory) {
 }
 
 TEST(Cli, BadInputGivesOneLineAndExitCodeOne) {
-  TempDir dir;
+  test::TempDir dir;
   expect_one_line_error(relight("replay /no/such/folder --out " + dir.path().string()), 1);
   expect_one_line_error(relight("replay --frames 3:1 --out " + dir.path().string()), 1);
   expect_one_line_error(relight("replay --frames x --out " + dir.path().string()), 1);
 }
 
 TEST(Cli, CorruptFrameMidSequenceFailsCleanlyWithoutPartialFiles) {
-  TempDir dir;
+  test::TempDir dir;
   const auto sequence = dir.path() / "seq";
   std::filesystem::copy(kSample, sequence, std::filesystem::copy_options::recursive);
   write_file_atomically(sequence / "depth" / "1305031229.596617.png", std::string_view("\x89PNG\r\n\x1a\nbroken"));
@@ -124,7 +125,7 @@ TEST(Cli, CorruptFrameMidSequenceFailsCleanlyWithoutPartialFiles) {
 }
 
 TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
-  TempDir dir;
+  test::TempDir dir;
   const auto cpu = dir.path() / "cpu", vulkan = dir.path() / "vulkan";
   ASSERT_EQ(relight("replay --quiet --no-object --frames 0:2 --backend cpu --out " + cpu.string()).exit_code, 0);
   const auto result = relight("replay --quiet --no-object --frames 0:2 --backend vulkan --out " + vulkan.string());
@@ -150,7 +151,7 @@ TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
 // both kinds of method-2 normals) report device time for each of their stages and work on the
 // graph's device buffers.
 TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
-  TempDir dir;
+  test::TempDir dir;
   const std::vector<std::pair<std::string, std::vector<std::string>>> runs = {
       {"--geometry method1", {"normals_raw_depth"}},
       {"--geometry method2", {"depth_warp_merge", "normals_filtered_depth"}},
@@ -178,21 +179,22 @@ TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
 }
 
 TEST(Cli, WithoutAnyVulkanDeviceReplayFallsBackToTheCpuAndSaysSoOnce) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string no_driver = "VK_ICD_FILENAMES=" + (dir.path() / "none.json").string() + " ";
-  const auto result = run_command(no_driver + kRelight + " replay --quiet --no-object --frames 0:1 --out " + dir.path().string());
+  const auto result =
+      test::run_command(no_driver + kRelight + " replay --quiet --no-object --frames 0:1 --out " + dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   std::size_t notes = 0;
   for (std::size_t at = 0; (at = result.err.find("no usable Vulkan device", at)) != std::string::npos; ++at) ++notes;
   EXPECT_EQ(notes, 1u) << result.err;
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "frames" / "000000_depth_smoothed.png"));
-  const auto forced = run_command(no_driver + kRelight + " replay --backend vulkan --out " + dir.path().string());
+  const auto forced = test::run_command(no_driver + kRelight + " replay --backend vulkan --out " + dir.path().string());
   EXPECT_EQ(forced.exit_code, 1);
   EXPECT_NE(forced.err.find("relight: error: the Vulkan backend was forced"), std::string::npos) << forced.err;
 }
 
 TEST(Cli, JsonConfigSuppliesOptionsAndTheCommandLineWins) {
-  TempDir dir;
+  test::TempDir dir;
   const auto config = dir.path() / "cfg.json";
   const auto out = dir.path() / "out";
   write_file_atomically(config, "{\"frames\": \"0:3\", \"quiet\": true, \"no-object\": true, \"out\": \"" + out.string() + "\"}");
@@ -244,7 +246,7 @@ TEST(Cli, GraphFollowsTheRenderingOptions) {
 }
 
 TEST(Cli, SynthWritesASequenceThatReplayReads) {
-  TempDir dir;
+  test::TempDir dir;
   const auto sequence = dir.path() / "synth";
   const auto made = relight("synth --quiet --frames 2 --trajectory static --out " + sequence.string());
   ASSERT_EQ(made.exit_code, 0) << made.err;
@@ -274,4 +276,4 @@ TEST(Cli, SynthWritesASequenceThatReplayReads) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app

@@ -10,18 +10,18 @@
 #include "run_command.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 const std::string kRelight = RELIGHT_BIN;
 const std::filesystem::path kProbe = std::filesystem::path(RELIGHT_TEST_DATA) / "probes" / "grace_latlong.hdr";
 
 TEST(LightsCli, RealProbeGivesTheRequestedLightsAndAPreview) {
-  TempDir dir;
+  test::TempDir dir;
   const auto json_file = dir.path() / "lights.json";
   const auto preview = dir.path() / "lights.png";
-  const auto result = run_command(kRelight + " lights " + kProbe.string() + " --n 32 --out " + json_file.string() +
-                                  " --preview " + preview.string());
+  const auto result = test::run_command(kRelight + " lights " + kProbe.string() + " --n 32 --out " +
+                                        json_file.string() + " --preview " + preview.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const auto json = nlohmann::json::parse(read_text_file(json_file));
   const std::string dump = json.dump();
@@ -39,16 +39,16 @@ TEST(LightsCli, RealProbeGivesTheRequestedLightsAndAPreview) {
 }
 
 TEST(LightsCli, BadInputIsOneLineAndNonZero) {
-  TempDir dir;
-  const auto missing = run_command(kRelight + " lights " + (dir.path() / "none.hdr").string() + " --out " +
-                                   (dir.path() / "l.json").string());
+  test::TempDir dir;
+  const auto missing = test::run_command(kRelight + " lights " + (dir.path() / "none.hdr").string() + " --out " +
+                                         (dir.path() / "l.json").string());
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_EQ(missing.err.rfind("relight: error: ", 0), 0u) << missing.err;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "l.json"));
-  const auto bad_method = run_command(kRelight + " lights " + kProbe.string() + " --method magic --out " +
-                                      (dir.path() / "l.json").string());
+  const auto bad_method = test::run_command(kRelight + " lights " + kProbe.string() + " --method magic --out " +
+                                            (dir.path() / "l.json").string());
   EXPECT_EQ(bad_method.exit_code, 2);
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app

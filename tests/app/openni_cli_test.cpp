@@ -18,16 +18,16 @@
 #include "run_command.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 const std::string kRelight = RELIGHT_BIN;
 // 320x240 keeps the synthetic renderer fast (~45 ms a frame) and the tests short.
 const std::string kDevice = "'relight://synthetic?size=320x240'";
 
-CommandResult relight(const std::string& arguments) { return run_command(kRelight + " " + arguments); }
+test::CommandResult relight(const std::string& arguments) { return test::run_command(kRelight + " " + arguments); }
 
-void expect_one_line_error(const CommandResult& result, const std::string& part) {
+void expect_one_line_error(const test::CommandResult& result, const std::string& part) {
   EXPECT_EQ(result.exit_code, 1) << result.err;
   EXPECT_EQ(result.err.rfind("relight: error: ", 0), 0u) << result.err;
   EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
@@ -40,7 +40,7 @@ nlohmann::json read_report(const std::filesystem::path& folder) {
 
 std::vector<std::uint16_t> to_mm(const DepthMap& depth) {
   std::vector<std::uint16_t> mm(depth.size());
-  for (std::size_t i = 0; i < mm.size(); ++i) mm[i] = depth_to_millimetres(depth.data()[i]);
+  for (std::size_t i = 0; i < mm.size(); ++i) mm[i] = capture::depth_to_millimetres(depth.data()[i]);
   return mm;
 }
 
@@ -64,7 +64,7 @@ TEST(OpenNiCli, DevicesListsTheSyntheticDevice) {
 }
 
 TEST(OpenNiCli, LiveRunsTheReplayGraphForNFrames) {
-  TempDir dir;
+  test::TempDir dir;
   // The command as CI runs it: the default 640x480 device.
   const auto result = relight("live --quiet --device relight://synthetic --frames 2 --out " + dir.path().string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
@@ -82,7 +82,7 @@ TEST(OpenNiCli, LiveRunsTheReplayGraphForNFrames) {
 // live tracks the device's camera (no poses come from a device: auto is odometry) and writes its
 // trajectory; rendering without --lights names the device, not the embedded sample.
 TEST(OpenNiCli, LiveTracksTheCameraAndLightsAVirtualDeviceFromTheSceneItServes) {
-  TempDir dir;
+  test::TempDir dir;
   const auto result =
       relight("live --quiet --no-frames --markers none --device \"relight://synthetic?trajectory=orbit&size=320x240\" "
               "--frames 3 --out " + dir.path().string());
@@ -110,25 +110,25 @@ TEST(OpenNiCli, LiveTracksTheCameraAndLightsAVirtualDeviceFromTheSceneItServes) 
 }
 
 TEST(OpenNiCli, UnknownDeviceIsAClearError) {
-  TempDir dir;
+  test::TempDir dir;
   expect_one_line_error(relight("live --device relight://nowhere --out " + dir.path().string()), "relight://nowhere");
 }
 
 TEST(OpenNiCli, RecordReplayRoundTripKeepsDepthTimestampsAndFrameCount) {
-  TempDir dir;
+  test::TempDir dir;
   const auto oni = dir.path() / "take.oni";
   const auto recorded = relight("record --device " + kDevice + " --frames 4 --out " + oni.string());
   ASSERT_EQ(recorded.exit_code, 0) << recorded.err;
   ASSERT_TRUE(std::filesystem::exists(oni));
-  const OniRecordingSummary summary = inspect_oni(oni);
+  const capture::OniRecordingSummary summary = capture::inspect_oni(oni);
   // Every frame read after the recorder started (all but possibly the first) is in the file.
   EXPECT_GE(summary.depth_frames, 3);
   EXPECT_EQ(summary.depth_frames, summary.color_frames);
 
   // Played back, frame i is synthetic frame k0 + i, bit for bit, with the device's spacing.
-  OpenNiOptions options;
+  capture::OpenNiOptions options;
   options.uri = oni.string();
-  OpenNiSource playback(options);
+  capture::OpenNiSource playback(options);
   EXPECT_TRUE(playback.is_file());
   EXPECT_EQ(playback.size_hint(), summary.depth_frames);
   std::vector<RgbdFrame> frames;
@@ -158,11 +158,11 @@ TEST(OpenNiCli, RecordReplayRoundTripKeepsDepthTimestampsAndFrameCount) {
 }
 
 TEST(OpenNiCli, RecordToAFolderWritesATumSequence) {
-  TempDir dir;
+  test::TempDir dir;
   const auto folder = dir.path() / "take";
   const auto result = relight("record --quiet --device " + kDevice + " --frames 3 --out " + folder.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  const TumSequence sequence = TumSequence::open(folder);
+  const capture::TumSequence sequence = capture::TumSequence::open(folder);
   ASSERT_EQ(sequence.size(), 3u);
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     const auto k = std::llround((sequence.frame(i).depth_timestamp - 1.0) * 30.0);
@@ -171,4 +171,4 @@ TEST(OpenNiCli, RecordToAFolderWritesATumSequence) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app

@@ -18,7 +18,7 @@
 #include "relight/core/pose.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 using cli_test::expect_one_line_error;
@@ -78,7 +78,7 @@ int changed_pixels_near(const std::filesystem::path& frames, const std::string& 
 // embedded sample (its dominant support plane, at the free spot nearest the image centre), lit
 // by the shipped probe, and writes the composites and the video.
 TEST(ReplayPlacement, TheMainJobStandsThePebbleOnTheSamplesDesk) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "main";
   const auto result = relight("replay --quiet --out " + out.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
@@ -112,7 +112,7 @@ std::string render_into_synthetic(const std::string& placement, const std::files
 // --place-at: the pebble stands on the table top at the pixel that sees (-0.25, -0.15, 0.75)
 // (the synthetic table's top is z = 0.75), within a centimetre, its up along the table's normal.
 TEST(ReplayPlacement, PlaceAtStandsTheObjectOnTheSurfaceSeenAtThePixel) {
-  TempDir dir;
+  test::TempDir dir;
   const Eigen::Vector3d target(-0.25, -0.15, 0.75);
   const Pose world_to_camera = first_pose(synthetic_sequence() / "groundtruth.txt").inverse();
   const PinholeIntrinsics intrinsics;  // relight synth's camera: 525, 319.5, 239.5, 640x480
@@ -144,7 +144,7 @@ TEST(ReplayPlacement, PlaceAtStandsTheObjectOnTheSurfaceSeenAtThePixel) {
 }
 
 TEST(ReplayPlacement, PlacementsThatCannotBeResolvedAreOneLineErrors) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "out";
   const auto outside = relight(render_into_synthetic("--place-at 700,20", out));
   expect_one_line_error(outside, 1);
@@ -184,4 +184,4 @@ TEST(ReplayPlacement, PlacementsThatCannotBeResolvedAreOneLineErrors) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app

@@ -9,7 +9,7 @@
 #include "relight/core/image_io.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 using cli_test::expect_one_line_error;
@@ -21,7 +21,7 @@ const std::filesystem::path kData = RELIGHT_TEST_DATA;
 const std::filesystem::path& synthetic_sequence() { return cli_test::synthetic_sequence("--frames 1 --no-gt --noise none"); }
 
 TEST(RenderReferenceCli, WritesLrvLrCompositeAndSummary) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "nested" / "ref.exr";
   const auto result = relight("render-reference --quiet --sequence " + synthetic_sequence().string() + " --object " +
                               (kData / "models" / "glossy_pebble.gltf").string() +
@@ -43,7 +43,7 @@ TEST(RenderReferenceCli, WritesLrvLrCompositeAndSummary) {
 }
 
 TEST(RenderReferenceCli, VirtualLightBrightensOnlyLrv) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string common = "render-reference --quiet --sequence " + synthetic_sequence().string() + " --spp 1 --downsample 8";
   ASSERT_EQ(relight(common + " --out " + (dir.path() / "dark.exr").string()).exit_code, 0);
   const auto result = relight(common + " --virtual-light 0,0,1.5,2,1,0.5,0.2 --out " + (dir.path() / "lit.exr").string());
@@ -58,7 +58,7 @@ TEST(RenderReferenceCli, VirtualLightBrightensOnlyLrv) {
 }
 
 TEST(RenderReferenceCli, BadInputGivesOneLineErrors) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string seq = " --sequence " + synthetic_sequence().string();
   const std::string out = " --out " + (dir.path() / "ref.exr").string();
   expect_one_line_error(relight("render-reference --sequence /no/such/folder" + out), 1);
@@ -74,11 +74,11 @@ TEST(RenderReferenceCli, BadInputGivesOneLineErrors) {
 }
 
 TEST(ModelsCli, RegeneratesTheShippedModelsByteForByte) {
-  TempDir dir;
+  test::TempDir dir;
   ASSERT_EQ(relight("models --out " + dir.path().string()).exit_code, 0);
   for (const char* file : {"glossy_pebble.gltf", "matte_box.obj", "matte_box.mtl"})
     EXPECT_EQ(read_text_file(dir.path() / file), read_text_file(kData / "models" / file)) << file;
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app

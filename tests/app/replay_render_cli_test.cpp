@@ -10,7 +10,7 @@
 #include "relight/core/image_io.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 using cli_test::expect_one_line_error;
@@ -21,7 +21,7 @@ const std::filesystem::path kData = RELIGHT_TEST_DATA;
 const std::filesystem::path& two_frame_sequence() { return cli_test::synthetic_sequence("--frames 2 --no-gt"); }
 
 TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "out";
   const auto result = relight("replay --quiet " + two_frame_sequence().string() + " --object " +
                               (kData / "models" / "glossy_pebble.gltf").string() + " --vpls 32 --buffers --out " +
@@ -66,7 +66,7 @@ TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
 
 // Also runs two VPL bounces by the point-cone method, which this scene exercises nowhere else.
 TEST(ReplayRenderCli, ColormapNoneWritesOnlyTheUnmappedComposite) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "out";
   const auto result = relight("replay --quiet --frames 1 --no-video --colormap none " + two_frame_sequence().string() +
                               " --object " + (kData / "models" / "glossy_pebble.gltf").string() +
@@ -83,7 +83,7 @@ TEST(ReplayRenderCli, ColormapNoneWritesOnlyTheUnmappedComposite) {
 // sources, those in the footprint by 0.57 levels on average (26383, 8441 and 0.77 before the
 // edge-aware interleave merge).
 TEST(ReplayRenderCli, VirtualSpotLightWithRsmVplsLightsItsFootprint) {
-  TempDir dir;
+  test::TempDir dir;
   ColorImage composites[2];
   const char* sources[2] = {"rays", "rsm"};
   for (int s = 0; s < 2; ++s) {
@@ -120,7 +120,7 @@ TEST(ReplayRenderCli, VirtualSpotLightWithRsmVplsLightsItsFootprint) {
 // error, L1): pixel albedo 0.0091, cluster albedo 0.0473 (before the edge-aware interleave merge:
 // 0.0089 and 0.0453; 0.0072 without the 5 x 5 smoothing).
 TEST(ReplayRenderCli, RealOnlyRenderCarriesTheCamerasColoursWithPerPixelAlbedo) {
-  TempDir dir;
+  test::TempDir dir;
   double median_error[2] = {0, 0};
   const char* albedo[2] = {"pixel", "cluster"};
   for (int a = 0; a < 2; ++a) {
@@ -154,7 +154,7 @@ TEST(ReplayRenderCli, RealOnlyRenderCarriesTheCamerasColoursWithPerPixelAlbedo) 
 }
 
 TEST(ReplayRenderCli, WithoutVirtualContentNothingIsRendered) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "out";
   ASSERT_EQ(relight("replay --quiet --frames 1 " + two_frame_sequence().string() + " --out " + out.string()).exit_code, 0);
   EXPECT_FALSE(std::filesystem::exists(out / "frames" / "000000_composite.png"));
@@ -162,7 +162,7 @@ TEST(ReplayRenderCli, WithoutVirtualContentNothingIsRendered) {
 }
 
 TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string out = " --out " + (dir.path() / "out").string();
   const std::string seq = " " + two_frame_sequence().string();
   const std::string pebble = " --object " + (kData / "models" / "glossy_pebble.gltf").string();
@@ -187,9 +187,9 @@ TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 // With every stage that can on the Vulkan device, the main job (the pebble on the sample's desk)
@@ -197,7 +197,7 @@ namespace {
 // graph keeps history on the device, and buffers whose size changes every frame (the
 // reconstruction mesh, ISM points, K-means points) grow with headroom. report.json says so.
 TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "out";
   const auto result = relight("replay --quiet --backend vulkan --loop 3 --no-video --no-frames --out " + out.string());
   ASSERT_EQ(result.exit_code, 0) << result.err;
@@ -234,4 +234,4 @@ TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app

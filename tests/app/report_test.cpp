@@ -56,8 +56,8 @@ class CountingPictureStage final : public Stage {
   Write<ColorImage> picture_;
 };
 
-Light directional_light(const Eigen::Vector3d& direction, const Eigen::Vector3d& power) {
-  Light light;
+lights::Light directional_light(const Eigen::Vector3d& direction, const Eigen::Vector3d& power) {
+  lights::Light light;
   light.direction = direction;
   light.power = power;
   return light;
@@ -72,12 +72,12 @@ std::vector<std::int64_t> sheet_frames(const ReportContent& content) {
 ReportContent collect(std::int64_t frames, std::int64_t announced_total) {
   FrameGraph graph;
   graph.emplace<CountingPictureStage>(frames);
-  LightSet lights;
+  lights::LightSet lights;
   lights.lights.push_back(directional_light(Eigen::Vector3d::UnitZ(), {1, 0.5, 0.25}));
-  graph.emplace<ConstantStage<LightSet>>(kLights, lights);
+  graph.emplace<ConstantStage<lights::LightSet>>(lights::kLights, lights);
   auto stage = std::make_unique<ReportCollectorStage>(announced_total, 4, 16);
   stage->add_picture(kColor);  // before the stage joins the graph
-  stage->collect_lights(kLights);
+  stage->collect_lights(lights::kLights);
   const ReportCollectorStage& collector = *stage;
   graph.add(std::move(stage));
   graph.compile();
@@ -124,7 +124,7 @@ TEST(HtmlReport, PageIsSelfContainedAndShowsEverySection) {
   ReportContent content;
   content.contact_sheet.push_back({0, {{"composite", std::string("\xff\xd8\xff\xe0", 4), 8, 6}}});
   content.materials = std::vector<brdf::MaterialParams>{{{{0.5f, 0.25f, 0.125f}, 0.3f, 40.f}, 1234, 0.01f}};
-  content.lights = LightSet{{directional_light({0, 0.6, 0.8}, {2, 2, 2})}};
+  content.lights = lights::LightSet{{directional_light({0, 0.6, 0.8}, {2, 2, 2})}};
   const std::string html = html_report("title", two_stage_timing(), content, "digraph {}", std::nullopt);
 
   // No resource leaves the page: the only URL is the SVG namespace name.

@@ -19,7 +19,7 @@
 #include "relight/core/image_io.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 using cli_test::expect_one_line_error;
@@ -44,7 +44,7 @@ nlohmann::json tracking_of(const std::filesystem::path& out) {
 }
 
 TEST(ReplayTracking, EveryRunWritesTheCameraTrajectoryOfItsPoseSource) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "auto";
   const auto result = relight("replay --quiet --no-object --no-frames --out " + out.string());  // embedded TUM sample
   ASSERT_EQ(result.exit_code, 0) << result.err;
@@ -55,7 +55,7 @@ TEST(ReplayTracking, EveryRunWritesTheCameraTrajectoryOfItsPoseSource) {
 // Measured: odometry ATE 0.08 cm, RPE 0.01 deg; marker+odometry ATE 0.4 cm (the marker's own
 // error sets its world frame), its per-frame marker correction at most 0.23 cm.
 TEST(ReplayTracking, OdometryAndMarkerOdometryFollowTheSyntheticOrbit) {
-  TempDir dir;
+  test::TempDir dir;
   for (const std::string pose : {"odometry", "marker+odometry"}) {
     const auto out = dir.path() / pose;
     const auto result =
@@ -95,7 +95,7 @@ TEST(ReplayTracking, GraphShowsTheTrackingStageOfThePoseOptions) {
 }
 
 TEST(ReplayTracking, PoseSourcesTheSequenceCannotGiveAreOneLineErrors) {
-  TempDir dir;
+  test::TempDir dir;
   // A copy of the orbit without its ground truth: --pose sequence has nothing to read.
   const auto copy = dir.path() / "no_truth";
   std::filesystem::copy(orbit_sequence(), copy, std::filesystem::copy_options::recursive);
@@ -116,7 +116,7 @@ TEST(ReplayTracking, PoseSourcesTheSequenceCannotGiveAreOneLineErrors) {
 // are the wrong ones: a copy of the orbit whose groundtruth.txt has every camera twice as far
 // from the first. The run stops with one line saying that layout and poses disagree.
 TEST(ReplayTracking, ATagLayoutThatContradictsTheSequencePosesIsAnError) {
-  TempDir dir;
+  test::TempDir dir;
   const auto copy = dir.path() / "stretched";
   std::filesystem::copy(orbit_sequence(), copy, std::filesystem::copy_options::recursive);
   std::istringstream truth(read_text_file(copy / "groundtruth.txt"));
@@ -169,7 +169,7 @@ std::map<long long, Eigen::Vector3d> positions_by_time(const std::filesystem::pa
 // error to the true pose stays bounded and does not grow. Measured: at most 2.1 cm on any frame
 // (1.5 cm over the first 100 frames, 2.0 over the last 100), ATE 0.95 cm.
 TEST(ReplayTracking, MarkerOdometryDriftStaysBoundedOver300Frames) {
-  TempDir dir;
+  test::TempDir dir;
   const auto sequence = cli_test::synthetic_sequence("--frames 300 --trajectory orbit --size 320x240 --no-gt");
   const auto out = dir.path() / "out";
   ASSERT_EQ(relight("replay --quiet --no-frames " + sequence.string() + " --pose marker+odometry --out " + out.string())
@@ -230,7 +230,7 @@ std::pair<double, std::size_t> pebble_overlap(const std::vector<bool>& a, const 
 // to about a centimetre; at 320x240 the same offset gave 0.945 to 0.966, depending on the frame
 // the marker anchored the world at).
 TEST(ReplayTracking, LiveOrbitDrawsThePebbleWhereAReplayWithTheTruePosesDoes) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string pebble = std::string(RELIGHT_TEST_DATA) + "/models/glossy_pebble.gltf";
   constexpr int kFps = 1;  // slow enough for the pipeline to take every frame, mostly
   const auto live = dir.path() / "live";
@@ -266,7 +266,7 @@ TEST(ReplayTracking, LiveOrbitDrawsThePebbleWhereAReplayWithTheTruePosesDoes) {
 // odometry's own world and the true one put it on the same spot) covers the pixels a replay with
 // the true poses gives it, frame after frame.
 TEST(ReplayTracking, OdometryKeepsThePebbleWhereTheTruePosesPutIt) {
-  TempDir dir;
+  test::TempDir dir;
   const std::string pebble = std::string(RELIGHT_TEST_DATA) + "/models/glossy_pebble.gltf";
   for (const std::string trajectory : {"orbit", "handheld"}) {
     const auto sequence =
@@ -291,4 +291,4 @@ TEST(ReplayTracking, OdometryKeepsThePebbleWhereTheTruePosesPutIt) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app

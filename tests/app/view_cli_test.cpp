@@ -19,7 +19,7 @@
 #include "relight/core/image_io.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::app {
 namespace {
 
 using cli_test::expect_one_line_error;
@@ -90,7 +90,7 @@ class VirtualDisplay {
   }
 
  private:
-  TempDir dir_;
+  test::TempDir dir_;
   std::string display_;
   int pid_ = 0;
 };
@@ -114,7 +114,7 @@ double mean_difference(const ColorImage& screen, int x, int y, const ColorImage&
 TEST(ViewCli, TheWindowShowsTheCompositeAsItIsMade) {
   VirtualDisplay screen;
   ASSERT_FALSE(screen.display().empty()) << "Xvfb (Debian package xvfb) did not start: " << screen.log();
-  TempDir dir;
+  test::TempDir dir;
   const auto sequence =
       cli_test::synthetic_sequence("--frames 2 --trajectory static --noise none --size 320x240 --no-gt");
   const auto out = dir.path() / "out";
@@ -166,12 +166,12 @@ TEST(ViewCli, TheWindowShowsTheCompositeAsItIsMade) {
 }
 
 TEST(ViewCli, ViewWithoutADisplayIsAOneLineError) {
-  TempDir dir;
-  const auto result = run_command("env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(RELIGHT_BIN) +
-                                  " replay --quiet --view --frames 0:1 --out " + (dir.path() / "out").string());
+  test::TempDir dir;
+  const auto result = test::run_command("env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(RELIGHT_BIN) +
+                                        " replay --quiet --view --frames 0:1 --out " + (dir.path() / "out").string());
   expect_one_line_error(result, 1);
   EXPECT_NE(result.err.find("--view needs a display"), std::string::npos) << result.err;
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::app

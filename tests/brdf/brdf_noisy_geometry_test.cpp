@@ -101,9 +101,9 @@ NoisyRun run_noisy_sequence(const View& v) {
   double ms = 0.0;
   for (int f = 0; f < kFrames; ++f) {
     const int cur = f % 2, prev = 1 - cur;
-    const NormalsHistory history{normals[prev], positions[prev], v.camera_to_world};
-    normals_raw_depth(noisy_depth(v, f), v.intrinsics, v.camera_to_world, f > 0 ? &history : nullptr, {},
-                      positions[cur], normals[cur]);
+    const reconstruct::NormalsHistory history{normals[prev], positions[prev], v.camera_to_world};
+    reconstruct::normals_raw_depth(noisy_depth(v, f), v.intrinsics, v.camera_to_world, f > 0 ? &history : nullptr, {},
+                                   positions[cur], normals[cur]);
     const auto start = std::chrono::steady_clock::now();
     estimate_brdf(v.color, positions[cur], normals[cur], v.lights, options, engine, tracker, *solver, run.estimate);
     ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -183,7 +183,7 @@ TEST(BrdfNoisyGeometry, KinectPositionsAloneKeepTheGlossySphereWithinTenPercent)
   // The last frame's noisy positions with the exact normals, through the whole estimation.
   const View& v = view();
   PositionMap positions;
-  positions_from_depth(noisy_depth(v, kFrames - 1), v.intrinsics, positions);
+  reconstruct::positions_from_depth(noisy_depth(v, kFrames - 1), v.intrinsics, positions);
   const BrdfOptions options = scene_options(v);
   KMeansCpu engine;
   KMeansTracker tracker(options.kmeans, options.seed);
@@ -202,8 +202,8 @@ TEST(BrdfNoisyGeometry, Method1NormalsOnKinectDepth) {
   const NoisyRun run = run_noisy_sequence(v);
   Mask sphere(v.intrinsics.width, v.intrinsics.height);
   for (std::size_t i = 0; i < sphere.size(); ++i) sphere.pixels()[i] = v.truth.material.pixels()[i] == sphere_id(v);
-  const AngularError on_sphere = angular_error(run.normals, v.truth.normals, &sphere);
-  const AngularError everywhere = angular_error(run.normals, v.truth.normals);
+  const reconstruct::AngularError on_sphere = reconstruct::angular_error(run.normals, v.truth.normals, &sphere);
+  const reconstruct::AngularError everywhere = reconstruct::angular_error(run.normals, v.truth.normals);
   std::printf("method 1 normals after %d frames: sphere mean %.2f deg (median %.2f), scene mean %.2f deg; "
               "estimate_brdf %.1f ms per frame\n",
               kFrames, on_sphere.mean_deg, on_sphere.median_deg, everywhere.mean_deg, run.ms_per_frame);
@@ -239,7 +239,7 @@ TEST(BrdfNoisyGeometry, NormalNoiseToleranceOfTheSpecularFit) {
   // Exact positions and the sphere's true k_d; exact normals with Gaussian angular noise.
   const View& v = view();
   PositionMap exact;
-  positions_from_depth(v.truth.depth, v.intrinsics, exact);
+  reconstruct::positions_from_depth(v.truth.depth, v.intrinsics, exact);
   ColorImage cleaned;
   Mask highlights;
   remove_highlights(v.color, {}, cleaned, highlights);

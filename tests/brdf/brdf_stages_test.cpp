@@ -25,7 +25,7 @@ class SceneSource final : public Stage {
     color_ = b.write<ColorImage>("color");
     positions_ = b.write<PositionMap>("positions");
     normals_ = b.write<NormalMap>("normals");
-    lights_ = b.write<LightSet>("lights");
+    lights_ = b.write<lights::LightSet>("lights");
     frame_ = b.write<FrameInfo>("frame");
   }
   void run(StageContext& ctx) override {
@@ -43,7 +43,7 @@ class SceneSource final : public Stage {
   Write<ColorImage> color_;
   Write<PositionMap> positions_;
   Write<NormalMap> normals_;
-  Write<LightSet> lights_;
+  Write<lights::LightSet> lights_;
   Write<FrameInfo> frame_;
 };
 

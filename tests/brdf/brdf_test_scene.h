@@ -29,11 +29,11 @@ struct BrdfScene {
   brdf::ShadingLights lights; ///< exact, camera frame, ambient = environment
 };
 
-inline LightSet light_set_of(const synth::Scene& scene) {
-  LightSet set;
+inline lights::LightSet light_set_of(const synth::Scene& scene) {
+  lights::LightSet set;
   for (const synth::PointLight& l : scene.lights) {
-    Light light;
-    light.kind = LightKind::Point;
+    lights::Light light;
+    light.kind = lights::LightKind::Point;
     light.position = l.position;
     light.power = l.colour * l.intensity;
     set.lights.push_back(light);

@@ -17,7 +17,7 @@
 #include "relight/synth/sequence.h"
 #include "relight/synth/trajectory.h"
 
-namespace relight {
+namespace relight::capture {
 namespace {
 
 struct Frame {
@@ -344,4 +344,4 @@ TEST(CameraTrackingStage, SequenceWithoutPosesAndMarkerWithoutLayoutAreErrors) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::capture

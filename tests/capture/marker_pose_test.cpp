@@ -14,7 +14,7 @@
 #include "relight/truth/tag_layout.h"
 #include "relight/synth/trajectory.h"
 
-namespace relight {
+namespace relight::capture {
 namespace {
 
 // The synthetic renderer shoots one ray per pixel, so tag edges alias; a real camera's optics
@@ -238,4 +238,4 @@ TEST(TagDetector, FindsTheReferenceTagsInRealPhotos) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::capture

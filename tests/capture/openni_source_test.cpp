@@ -17,7 +17,7 @@
 #include "relight/synth/sequence.h"
 #include "relight/synth/trajectory.h"
 
-namespace relight {
+namespace relight::capture {
 namespace {
 
 const std::filesystem::path kSample = std::filesystem::path(RELIGHT_TEST_DATA) / "tum_fr1_rpy";
@@ -249,4 +249,4 @@ TEST(OpenNiDriver, BadUrisAreClearErrors) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::capture

@@ -6,7 +6,7 @@
 #include "relight/capture/range_source.h"
 #include "relight/capture/tum_sequence.h"
 
-namespace relight {
+namespace relight::capture {
 namespace {
 
 TEST(SourceStage, FeedsTheGraphUntilTheSourceEnds) {
@@ -26,9 +26,9 @@ TEST(SourceStage, FeedsTheGraphUntilTheSourceEnds) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::capture
 
-namespace relight {
+namespace relight::capture {
 namespace {
 
 /// `count` empty frames at 30 fps from t = 10 s.
@@ -80,4 +80,4 @@ TEST(LoopingSource, PlaysAgainWithIndicesAndTimestampsThatKeepGrowing) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::capture

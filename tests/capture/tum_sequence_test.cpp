@@ -11,7 +11,7 @@
 #include "relight/core/image_io.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::capture {
 namespace {
 
 const std::filesystem::path kRealSlice = std::filesystem::path(RELIGHT_TEST_DATA) / "tum_fr1_rpy";
@@ -101,7 +101,7 @@ class DamagedSequence : public ::testing::Test {
     }
     return "";
   }
-  TempDir dir_;
+  test::TempDir dir_;
   std::filesystem::path folder_;
 };
 
@@ -238,4 +238,4 @@ TEST(TumSource, RangeSelectsFramesAndRejectsEmptyRanges) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::capture

@@ -6,11 +6,11 @@
 #include "relight/core/error.h"
 #include "temp_dir.h"
 
-namespace relight {
+namespace relight::capture {
 namespace {
 
 TEST(TumWriter, WrittenFolderReadsBackIdentically) {
-  TempDir dir;
+  test::TempDir dir;
   const auto folder = dir.path() / "seq";
   TumWriter writer(folder);
   std::vector<Pose> poses;
@@ -40,7 +40,7 @@ TEST(TumWriter, WrittenFolderReadsBackIdentically) {
 }
 
 TEST(TumWriter, RejectsNonIncreasingTimestamps) {
-  TempDir dir;
+  test::TempDir dir;
   TumWriter writer(dir.path() / "seq");
   writer.add(1.0, ColorImage(2, 2), DepthMap(2, 2));
   EXPECT_THROW(writer.add(1.0, ColorImage(2, 2), DepthMap(2, 2)), Error);
@@ -49,4 +49,4 @@ TEST(TumWriter, RejectsNonIncreasingTimestamps) {
 TEST(TumWriter, FileNamesUseSixDecimals) { EXPECT_EQ(TumWriter::file_name(1.0 + 1.0 / 30.0), "1.033333.png"); }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::capture

@@ -9,7 +9,7 @@ namespace relight {
 namespace {
 
 TEST(AtomicFile, WritesAndReplacesWithoutLeavingTemporaries) {
-  TempDir dir;
+  test::TempDir dir;
   const auto path = dir.path() / "out.txt";
   write_file_atomically(path, std::string_view("first"));
   write_file_atomically(path, std::string_view("second"));
@@ -18,7 +18,7 @@ TEST(AtomicFile, WritesAndReplacesWithoutLeavingTemporaries) {
 }
 
 TEST(AtomicFile, FailureNamesThePathAndLeavesNothing) {
-  TempDir dir;
+  test::TempDir dir;
   const auto path = dir.path() / "missing-folder" / "out.txt";
   try {
     write_file_atomically(path, std::string_view("x"));

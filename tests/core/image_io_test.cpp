@@ -13,7 +13,7 @@ namespace relight {
 namespace {
 
 TEST(ImageIo, DepthPngRoundTripAtScale5000) {
-  TempDir dir;
+  test::TempDir dir;
   DepthMap depth(16, 8);
   for (int r = 0; r < 8; ++r)
     for (int c = 0; c < 16; ++c) depth(r, c) = 0.5f + 0.1f * static_cast<float>(r * 16 + c) / 7.f;
@@ -31,7 +31,7 @@ TEST(ImageIo, DepthPngRoundTripAtScale5000) {
 }
 
 TEST(ImageIo, ColorRoundTripKeepsChannelOrder) {
-  TempDir dir;
+  test::TempDir dir;
   ColorImage image(3, 2);
   image(0, 0) = {255, 0, 0};
   image(1, 2) = {10, 200, 30};
@@ -41,7 +41,7 @@ TEST(ImageIo, ColorRoundTripKeepsChannelOrder) {
 }
 
 TEST(ImageIo, RadianceHdrRoundTripWithinRgbePrecision) {
-  TempDir dir;
+  test::TempDir dir;
   RadianceImage image(4, 4, Float3{0.25f, 1.5f, 40.f});
   image(3, 3) = {1000.f, 0.01f, 0.5f};
   write_radiance(dir.path() / "r.hdr", image);
@@ -60,7 +60,7 @@ TEST(ImageIo, RadianceHdrRoundTripWithinRgbePrecision) {
 }
 
 TEST(ImageIo, ExrRoundTripIsExactForHalfRepresentableValues) {
-  TempDir dir;
+  test::TempDir dir;
   RadianceImage image(5, 3, Float3{0.5f, 2.f, 1024.f});
   write_radiance(dir.path() / "r.exr", image);
   const RadianceImage back = read_radiance(dir.path() / "r.exr");
@@ -68,7 +68,7 @@ TEST(ImageIo, ExrRoundTripIsExactForHalfRepresentableValues) {
 }
 
 TEST(ImageIo, NonFiniteRadianceIsRejectedWithTheFileAndPixel) {
-  TempDir dir;
+  test::TempDir dir;
   RadianceImage image(5, 3, Float3{0.5f, 2.f, 1024.f});
   image(2, 4).y = std::numeric_limits<float>::quiet_NaN();
   write_radiance(dir.path() / "nan.exr", image);
@@ -81,7 +81,7 @@ TEST(ImageIo, NonFiniteRadianceIsRejectedWithTheFileAndPixel) {
 }
 
 TEST(ImageIo, EightBitDepthIsRejectedWithTheFileName) {
-  TempDir dir;
+  test::TempDir dir;
   const auto path = dir.path() / "eight.png";
   write_color(path, ColorImage(4, 4));
   try {
@@ -95,7 +95,7 @@ TEST(ImageIo, EightBitDepthIsRejectedWithTheFileName) {
 }
 
 TEST(ImageIo, MissingAndCorruptFilesAreErrors) {
-  TempDir dir;
+  test::TempDir dir;
   EXPECT_THROW((void)read_color(dir.path() / "nope.png"), Error);
   write_file_atomically(dir.path() / "corrupt.png", std::string_view("\x89PNG\r\n\x1a\n garbage"));
   EXPECT_THROW((void)read_color(dir.path() / "corrupt.png"), Error);
@@ -105,7 +105,7 @@ TEST(ImageIo, MissingAndCorruptFilesAreErrors) {
 // Found by fuzzing (fuzz/depth_png_fuzzer.cpp): this file, 134 bytes with a DICOM signature
 // named depth.png, was handed by OpenCV to GDCM, which aborted the process.
 TEST(ImageIo, FilesOfAnotherFormatAreRefusedBeforeDecoding) {
-  TempDir dir;
+  test::TempDir dir;
   const auto dicom = dir.path() / "depth.png";
   write_file_atomically(dicom, std::string(128, '\xa4') + "DICM1\x01");
   for (const auto& read : {+[](const std::filesystem::path& p) { (void)read_depth_png(p, 5000.0); },
@@ -142,7 +142,7 @@ TEST(ImageIo, PreviewsMarkInvalidPixelsBlack) {
 }
 
 TEST(ImageIo, DepthExrRoundTripIsExactFloat) {
-  TempDir dir;
+  test::TempDir dir;
   DepthMap depth(7, 5);
   for (int r = 0; r < 5; ++r)
     for (int c = 0; c < 7; ++c) depth(r, c) = 0.4f + 0.0001234f * static_cast<float>(r * 7 + c) + 3.f * static_cast<float>(c);
@@ -156,7 +156,7 @@ TEST(ImageIo, DepthExrRoundTripIsExactFloat) {
 }
 
 TEST(ImageIo, LabelPngKeepsSixteenBitValues) {
-  TempDir dir;
+  test::TempDir dir;
   LabelImage labels(4, 3);
   labels(0, 0) = 1;
   labels(1, 2) = 300;

@@ -3,7 +3,7 @@
 #include "probes.h"
 #include "relight/lights/probe_geometry.h"
 
-namespace relight {
+namespace relight::lights {
 namespace {
 
 using namespace test;
@@ -54,4 +54,4 @@ TEST(EquirectToFisheye, ResampledRadianceFollowsTheSourceDirections) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::lights

@@ -8,7 +8,7 @@
 #include "probes.h"
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::lights {
 namespace {
 
 using test::angle_between;
@@ -139,4 +139,4 @@ TEST(ImportanceSampling, BadInputIsAnError) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::lights

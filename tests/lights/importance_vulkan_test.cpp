@@ -6,7 +6,7 @@
 #include "relight/vk/context.h"
 #include "support/vulkan_test_env.h"
 
-namespace relight {
+namespace relight::lights {
 namespace {
 
 class ImportanceVulkan : public test::VulkanTest {
@@ -50,4 +50,4 @@ TEST_F(ImportanceVulkan, LatLongNonSquareProbeSameSamplesAsCpu) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::lights

@@ -4,7 +4,7 @@
 
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::lights {
 namespace {
 
 TEST(LightOutput, JsonRoundTripKeepsEveryLight) {
@@ -44,4 +44,4 @@ TEST(LightOutput, MalformedJsonNamesTheSourceAndTheLight) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::lights

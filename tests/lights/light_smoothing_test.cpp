@@ -9,7 +9,7 @@
 #include "relight/core/frame_graph.h"
 #include "relight/lights/light_stages.h"
 
-namespace relight {
+namespace relight::lights {
 namespace {
 
 using test::angle_between;
@@ -132,4 +132,4 @@ TEST(LightSmoothing, SensorNoiseFlickersLessAfterSmoothing) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::lights

@@ -6,7 +6,7 @@
 #include "probes.h"
 #include "relight/core/error.h"
 
-namespace relight {
+namespace relight::lights {
 namespace {
 
 using test::angle_between;
@@ -65,4 +65,4 @@ TEST(MedianCut, BlackProbeIsAnError) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::lights

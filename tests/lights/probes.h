@@ -23,7 +23,7 @@ inline Eigen::Vector3d spherical(double theta, double phi) {
 
 /// Every pixel of `geometry` (supersampled s x s) set to radiance(direction).
 template <class Radiance>
-RadianceImage analytic_probe(const ProbeGeometry& geometry, Radiance radiance, int s = 3) {
+RadianceImage analytic_probe(const lights::ProbeGeometry& geometry, Radiance radiance, int s = 3) {
   RadianceImage image(geometry.width(), geometry.height());
   for (int row = 0; row < image.height(); ++row) {
     for (int col = 0; col < image.width(); ++col) {
@@ -44,15 +44,15 @@ RadianceImage analytic_probe(const ProbeGeometry& geometry, Radiance radiance, i
 
 /// A dim uniform sky of radiance 0.05 with one disc emitter of `radius` around `direction`
 /// whose radiance is `peak` (so it carries almost all the energy).
-inline RadianceImage emitter_probe(const ProbeGeometry& geometry, const Eigen::Vector3d& direction, double radius,
-                                   double peak = 20000.0) {
+inline RadianceImage emitter_probe(const lights::ProbeGeometry& geometry, const Eigen::Vector3d& direction,
+                                   double radius, double peak = 20000.0) {
   return analytic_probe(geometry, [&](const Eigen::Vector3d& d) -> Eigen::Vector3d {
     return angle_between(d, direction) < radius ? Eigen::Vector3d::Constant(peak) : Eigen::Vector3d::Constant(0.05);
   });
 }
 
 /// Irradiance on a surface of normal n by direct integration over the probe's pixels.
-inline Eigen::Vector3d probe_irradiance(const RadianceImage& probe, const ProbeGeometry& geometry,
+inline Eigen::Vector3d probe_irradiance(const RadianceImage& probe, const lights::ProbeGeometry& geometry,
                                         const Eigen::Vector3d& normal) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (int row = 0; row < probe.height(); ++row) {
@@ -70,7 +70,7 @@ struct SynthProbe {
   synth::Scene scene;
   synth::LightProbe probe;
   RadianceImage image;
-  ProbeGeometry geometry;
+  lights::ProbeGeometry geometry;
 };
 
 /// The synthetic scene's probe at 256 x 256 (0.7 degrees per pixel; the emitters are ~3 pixels
@@ -85,10 +85,10 @@ SynthProbe render_synth_probe(Edit edit) {
   s.probe.camera.cx = s.probe.camera.cy = 127.5;
   s.probe.camera.radius = 128.0;
   s.image = synth::render_probe(s.scene, s.probe);
-  ProbeCalibration calibration;
+  lights::ProbeCalibration calibration;
   calibration.fisheye = s.probe.camera;
   calibration.probe_to_world = s.probe.probe_to_world;
-  s.geometry = ProbeGeometry(calibration, 256, 256);
+  s.geometry = lights::ProbeGeometry(calibration, 256, 256);
   return s;
 }
 

@@ -26,7 +26,7 @@
 #include "synthetic_sequence.h"
 #include "support/vulkan_test_env.h"
 
-namespace relight {
+namespace relight::reconstruct {
 namespace {
 
 // How far the Vulkan maps are from the CPU maps.
@@ -251,4 +251,4 @@ TEST(NormalsRawDepthBlend, RejectsMismatchedShapes) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -13,7 +13,7 @@
 #include "relight/vk/transfer.h"
 #include "support/vulkan_test_env.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 // Readable parameter values in test output ("Vulkan", not "4-byte object <01-00 00-00>").
 void PrintTo(Backend backend, std::ostream* out) { *out << to_string(backend); }
@@ -252,4 +252,4 @@ TEST(DepthBoxFilterStageFactory, VulkanWithoutContextIsALogicError) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -13,7 +13,7 @@
 #include "relight/reconstruct/normals_raw_depth.h"
 #include "synthetic_sequence.h"
 
-namespace relight {
+namespace relight::reconstruct {
 namespace {
 
 PinholeIntrinsics small_camera() { return {.fx = 100, .fy = 100, .cx = 39.5, .cy = 29.5, .width = 80, .height = 60}; }
@@ -309,4 +309,4 @@ TEST(DepthWarpMergeStage, FilteredNormalsStageEstimatesFromTheMergedDepth) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -14,7 +14,7 @@
 #include "synthetic_sequence.h"
 #include "support/vulkan_test_env.h"
 
-namespace relight {
+namespace relight::reconstruct {
 namespace {
 
 using DepthWarpMergeVkTest = test::VulkanTest;
@@ -112,4 +112,4 @@ TEST_F(DepthWarpMergeVkTest, ASteadyRunAllocatesNoDeviceMemory) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -16,7 +16,7 @@
 #include "relight/reconstruct/normals_from_positions.h"
 #include "synthetic_sequence.h"
 
-namespace relight {
+namespace relight::reconstruct {
 namespace {
 
 // Exact plane z = z0 + a x (tilted about the camera's y axis) seen by a pinhole camera.
@@ -460,4 +460,4 @@ TEST(NormalsRawDepthStage, GraphRunEqualsDirectCallsWithHistory) {
 }
 
 }  // namespace
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -64,7 +64,7 @@ TEST(ProceduralModels, PebbleIsClosedSmoothAndStandsOnItsBase) {
 }
 
 TEST(ModelIo, ObjAndGltfRoundTripGeometryAndPhongMaterials) {
-  const TempDir dir;
+  const test::TempDir dir;
   for (const VirtualModel& model : {make_glossy_pebble(24), make_matte_box()}) {
     save_obj(dir.path() / (model.name + ".obj"), model);
     save_gltf(dir.path() / (model.name + ".gltf"), model);
@@ -78,7 +78,7 @@ TEST(ModelIo, ObjAndGltfRoundTripGeometryAndPhongMaterials) {
 }
 
 TEST(ModelIo, EmissiveMaterialSurvivesGltf) {
-  const TempDir dir;
+  const test::TempDir dir;
   VirtualModel lamp = make_matte_box();
   lamp.materials[0].emission = {4.f, 3.f, 2.f};
   save_gltf(dir.path() / "lamp.gltf", lamp);
@@ -96,7 +96,7 @@ TEST(ModelIo, ShippedModelsAreTheProceduralOnes) {
 }
 
 TEST(ModelIo, BadFilesGiveOneLineErrorsNamingTheFile) {
-  const TempDir dir;
+  const test::TempDir dir;
   const auto expect_error = [](const std::filesystem::path& path) {
     try {
       (void)load_model(path);

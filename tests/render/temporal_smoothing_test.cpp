@@ -112,12 +112,13 @@ double flicker(vk::VulkanContext& context, bool smoothing, Geometry geometry, co
       break;
     case Geometry::Method1:
       graph.emplace<test::SyntheticFrameStage>(intrinsics, poses, 0.0015f, Output::Depth);
-      graph.emplace<NormalsRawDepthCpuStage>();
+      graph.emplace<reconstruct::NormalsRawDepthCpuStage>();
       break;
     case Geometry::Method2:
       graph.emplace<test::SyntheticFrameStage>(intrinsics, poses, 0.0015f, Output::Depth);
-      graph.emplace<DepthWarpMergeCpuStage>();
-      graph.emplace<NormalsRawDepthCpuStage>(NormalsRawDepthOptions{}, NormalsDepthInput::Filtered);
+      graph.emplace<reconstruct::DepthWarpMergeCpuStage>();
+      graph.emplace<reconstruct::NormalsRawDepthCpuStage>(reconstruct::NormalsRawDepthOptions{},
+                                                          reconstruct::NormalsDepthInput::Filtered);
       break;
   }
   DirSceneContent content;

@@ -63,7 +63,7 @@ inline std::vector<char*> pointers(std::vector<std::string>& strings) {
 }  // namespace detail
 
 inline RunOutcome run_relight(const BoundedRun& run) {
-  TempDir capture;
+  test::TempDir capture;
   const std::string out_file = (capture.path() / "out").string(), err_file = (capture.path() / "err").string();
   std::vector<std::string> argv_strings{RELIGHT_BIN};
   argv_strings.insert(argv_strings.end(), run.arguments.begin(), run.arguments.end());

@@ -15,7 +15,7 @@ class ConfigRobustness : public ::testing::Test {
     write_file_atomically(config, text);
     return run_relight({"replay", "--config", config.string(), "--out", out.string()});
   }
-  TempDir dir;
+  test::TempDir dir;
   const std::filesystem::path config = dir.path() / "cfg.json";
   const std::filesystem::path out = dir.path() / "out";
 };

@@ -18,7 +18,7 @@ namespace {
 const std::string kDevice = "relight://synthetic?size=320x240";
 
 TEST(DeviceRobustness, NoVulkanDriverRendersOnTheCpuWithOneWarning) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "out";
   BoundedRun run;
   run.arguments = {"replay", "--quiet", synthetic_sequence().string(), "--object",
@@ -48,7 +48,7 @@ std::optional<std::filesystem::path> temporary_recording(const std::filesystem::
 // The device goes away after 2 frames: what was processed is finalised (report.json, frames),
 // then one error line, exit 1.
 TEST(DeviceRobustness, DeviceUnpluggedDuringLive) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "out";
   const auto run = run_relight({"live", "--quiet", "--device", kDevice + "&disconnect_after=2", "--frames", "10",
                                 "--out", out.string()});
@@ -64,26 +64,26 @@ TEST(DeviceRobustness, DeviceUnpluggedDuringLive) {
 
 // The same while recording: the .oni holds the frames read before, under its final name.
 TEST(DeviceRobustness, DeviceUnpluggedDuringRecord) {
-  TempDir dir;
+  test::TempDir dir;
   const auto oni = dir.path() / "take.oni";
   const auto run = run_relight({"record", "--quiet", "--device", kDevice + "&disconnect_after=3", "--frames", "10",
                                 "--out", oni.string()});
   expect_clean_error(run, 1, "disconnected", dir.path());
-  EXPECT_GE(inspect_oni(oni).depth_frames, 2);
+  EXPECT_GE(capture::inspect_oni(oni).depth_frames, 2);
   const auto folder = dir.path() / "take";
   const auto to_folder = run_relight({"record", "--quiet", "--device", kDevice + "&disconnect_after=3", "--frames", "10",
                                       "--out", folder.string()});
   expect_clean_error(to_folder, 1, "disconnected", folder);
   // The device serves 3 frames on its own clock; a recorder slowed down by a loaded machine may
   // miss one (OpenNI keeps only the newest frame), but it keeps what it received.
-  const std::size_t recorded = TumSequence::open(folder).size();
+  const std::size_t recorded = capture::TumSequence::open(folder).size();
   EXPECT_GE(recorded, 2u);
   EXPECT_LE(recorded, 3u);
 }
 
 // Ctrl-C once frame 1 is written: outputs finalised, no error, exit 0 (live runs until stopped).
 TEST(DeviceRobustness, CtrlCDuringLive) {
-  TempDir dir;
+  test::TempDir dir;
   const auto out = dir.path() / "out";
   BoundedRun live;
   live.arguments = {"live", "--quiet", "--device", kDevice, "--frames", "3000", "--out", out.string()};
@@ -100,7 +100,7 @@ TEST(DeviceRobustness, CtrlCDuringLive) {
 
 // Ctrl-C while the recorder writes: the file is completed and renamed, nothing else is left.
 TEST(DeviceRobustness, CtrlCDuringRecord) {
-  TempDir dir;
+  test::TempDir dir;
   const auto oni = dir.path() / "take.oni";
   BoundedRun record;
   record.arguments = {"record", "--quiet", "--device", kDevice, "--frames", "3000", "--out", oni.string()};
@@ -113,12 +113,12 @@ TEST(DeviceRobustness, CtrlCDuringRecord) {
   ASSERT_TRUE(run.interrupted) << describe(run);
   expect_clean_success(run, dir.path());
   EXPECT_EQ(run.err, "");
-  EXPECT_GE(inspect_oni(oni).depth_frames, 1);
+  EXPECT_GE(capture::inspect_oni(oni).depth_frames, 1);
   EXPECT_FALSE(temporary_recording(dir.path()));
 }
 
 TEST(DeviceRobustness, CutOrEmptyRecording) {
-  TempDir dir;
+  test::TempDir dir;
   const auto oni = dir.path() / "take.oni";
   ASSERT_EQ(run_relight({"record", "--quiet", "--device", kDevice, "--frames", "4", "--out", oni.string()}).exit_code, 0);
   const std::string bytes = read_text_file(oni);

@@ -33,7 +33,7 @@ inline std::vector<std::filesystem::path> sample_files(const std::filesystem::pa
 /// A 2-frame `relight synth` sequence (static camera, exact depth, with probe.hdr, scene.json and
 /// its AprilTag), made once; tests copy it before changing anything.
 inline const std::filesystem::path& synthetic_sequence() {
-  static TempDir dir;
+  static test::TempDir dir;
   static const std::filesystem::path sequence = [] {
     const auto path = dir.path() / "synth";
     const auto made = run_relight(

@@ -26,7 +26,7 @@ class ModelRobustness : public ::testing::Test {
     write_file_atomically(dir.path() / name, text);
     return dir.path() / name;
   }
-  TempDir dir;
+  test::TempDir dir;
   const std::filesystem::path out = dir.path() / "out";
 };
 

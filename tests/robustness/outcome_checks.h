@@ -46,7 +46,7 @@ inline std::string why_unfinished(const std::filesystem::path& file) {
     if (ext == ".png" && cv::imread(file.string(), cv::IMREAD_UNCHANGED).empty()) return "PNG does not decode";
     if (ext == ".exr" || ext == ".hdr") (void)read_radiance(file);
     if (ext == ".json" && !nlohmann::json::accept(read_text_file(file))) return "JSON does not parse";
-    if (ext == ".oni" && inspect_oni(file).depth_frames < 1) return "recording without frames";
+    if (ext == ".oni" && capture::inspect_oni(file).depth_frames < 1) return "recording without frames";
     if (ext == ".mp4") {
       cv::VideoCapture video(file.string());
       cv::Mat frame;

@@ -45,7 +45,7 @@ class ProbeRobustness : public ::testing::Test {
     write_color(file, ColorImage(96, 96, Rgb8{value, value, value}));
     return file;
   }
-  TempDir dir;
+  test::TempDir dir;
   const std::filesystem::path out = dir.path() / "out";
   void SetUp() override { std::filesystem::create_directories(out); }
 };

@@ -31,7 +31,7 @@ void expect_interrupted_replay(const RunOutcome& run, const std::filesystem::pat
 }
 
 TEST(ReplayRunRobustness, CtrlCDuringReplayOfATumFolder) {
-  TempDir dir;
+  test::TempDir dir;
   const auto sequence = copy_of_sample(dir.path() / "seq");
   loop_sequence(sequence, 400);
   const auto out = dir.path() / "out";
@@ -43,7 +43,7 @@ TEST(ReplayRunRobustness, CtrlCDuringReplayOfATumFolder) {
 
 // With virtual content composite.mp4 is being written when the signal comes: it must be complete.
 TEST(ReplayRunRobustness, CtrlCDuringReplayWithRendering) {
-  TempDir dir;
+  test::TempDir dir;
   const auto sequence = copy_of_synthetic(dir.path() / "seq");
   loop_sequence(sequence, 200);
   const auto out = dir.path() / "out";
@@ -57,7 +57,7 @@ TEST(ReplayRunRobustness, CtrlCDuringReplayWithRendering) {
 }
 
 TEST(ReplayRunRobustness, TagLayoutWithNoTagInView) {
-  TempDir dir;
+  test::TempDir dir;
   const auto layout = dir.path() / "layout.json";
   write_file_atomically(layout, std::string_view(R"({"family": "tag36h11", "tags": [{"id": 7, "size": 0.16,
     "corners_world": [[0, 0, 0], [0.16, 0, 0], [0.16, 0.16, 0], [0, 0.16, 0]]}]})"));
@@ -77,7 +77,7 @@ TEST(ReplayRunRobustness, TagLayoutWithNoTagInView) {
 }
 
 TEST(ReplayRunRobustness, MalformedTagLayout) {
-  TempDir dir;
+  test::TempDir dir;
   const auto layout = dir.path() / "layout.json";
   write_file_atomically(layout, std::string_view(R"({"family": "tag36h11", "tags": [{"id": 7}]})"));
   const auto out = dir.path() / "out";

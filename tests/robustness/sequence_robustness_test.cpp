@@ -19,7 +19,7 @@ RunOutcome replay(const std::filesystem::path& sequence, const std::filesystem::
 
 class SequenceRobustness : public ::testing::Test {
  protected:
-  TempDir dir;
+  test::TempDir dir;
   const std::filesystem::path out = dir.path() / "out";
 };
 

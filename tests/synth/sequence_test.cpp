@@ -41,7 +41,7 @@ std::map<std::string, std::string> folder_contents(const fs::path& folder) {
 Vector3d vec(const Json& j) { return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()}; }
 
 TEST(Sequence, WritesATumFolderWithGroundTruthThatTheReaderUnderstands) {
-  TempDir dir;
+  test::TempDir dir;
   SynthOptions options = small_options();
   options.trajectory = Trajectory::Handheld;
   options.seed = 5;
@@ -52,7 +52,7 @@ TEST(Sequence, WritesATumFolderWithGroundTruthThatTheReaderUnderstands) {
   });
   EXPECT_EQ(progress_calls, 2);
 
-  const TumSequence sequence = TumSequence::open(dir.path());
+  const capture::TumSequence sequence = capture::TumSequence::open(dir.path());
   ASSERT_EQ(sequence.size(), 2u);
   EXPECT_EQ(sequence.intrinsics(), synth_intrinsics(options));
   EXPECT_DOUBLE_EQ(sequence.depth_scale(), 5000.0);
@@ -61,7 +61,7 @@ TEST(Sequence, WritesATumFolderWithGroundTruthThatTheReaderUnderstands) {
   ASSERT_TRUE(sequence.frame(1).camera_to_world);
   EXPECT_LT((sequence.frame(1).camera_to_world->translation() - poses[1].translation()).norm(), 1e-5);
 
-  const std::string stem = fs::path(TumWriter::file_name(frame_timestamp(1))).stem().string();
+  const std::string stem = fs::path(capture::TumWriter::file_name(frame_timestamp(1))).stem().string();
   const RenderedFrame truth = render_frame(scene, synth_intrinsics(options), poses[1], 1);
   EXPECT_TRUE(read_depth_exr(dir.path() / "gt" / "depth" / (stem + ".exr")) == truth.depth);
   EXPECT_TRUE(read_label_png(dir.path() / "gt" / "material" / (stem + ".png")) == truth.material);
@@ -73,7 +73,8 @@ TEST(Sequence, WritesATumFolderWithGroundTruthThatTheReaderUnderstands) {
   EXPECT_NEAR(probe(256, 256).y, scene.environment.y(), scene.environment.y() / 64.0);  // RGBE precision
 
   // Noisy depth stays close to the truth where it exists.
-  const DepthMap noisy = read_depth_png(dir.path() / "depth" / TumWriter::file_name(frame_timestamp(1)), 5000.0);
+  const DepthMap noisy =
+      read_depth_png(dir.path() / "depth" / capture::TumWriter::file_name(frame_timestamp(1)), 5000.0);
   int close = 0, valid = 0;
   for (std::size_t i = 0; i < noisy.size(); ++i) {
     if (!is_valid_depth(noisy.pixels()[i])) continue;
@@ -86,7 +87,7 @@ TEST(Sequence, WritesATumFolderWithGroundTruthThatTheReaderUnderstands) {
 }
 
 TEST(Sequence, SceneJsonDescribesTheScene) {
-  TempDir dir;
+  test::TempDir dir;
   SynthOptions options = small_options();
   options.frames = 1;
   options.probe = false;
@@ -121,7 +122,7 @@ TEST(Sequence, SceneJsonDescribesTheScene) {
 }
 
 TEST(Sequence, SameSeedGivesIdenticalBytesAndAnotherSeedOtherNoise) {
-  TempDir a, b, c;
+  test::TempDir a, b, c;
   SynthOptions options = small_options();
   options.seed = 17;
   truth::write_sequence(options, a.path());
@@ -134,8 +135,8 @@ TEST(Sequence, SameSeedGivesIdenticalBytesAndAnotherSeedOtherNoise) {
   const auto files_c = folder_contents(c.path());
   EXPECT_GT(files_a.size(), 12u);
   EXPECT_TRUE(files_a == files_b);
-  const std::string depth = "depth/" + TumWriter::file_name(frame_timestamp(0));
-  const std::string rgb = "rgb/" + TumWriter::file_name(frame_timestamp(0));
+  const std::string depth = "depth/" + capture::TumWriter::file_name(frame_timestamp(0));
+  const std::string rgb = "rgb/" + capture::TumWriter::file_name(frame_timestamp(0));
   EXPECT_NE(files_a.at(depth), files_c.at(depth));
   EXPECT_EQ(files_a.at(rgb), files_c.at(rgb));  // the orbit does not depend on the seed
 }
@@ -143,7 +144,7 @@ TEST(Sequence, SameSeedGivesIdenticalBytesAndAnotherSeedOtherNoise) {
 double grey(const Rgb8& c) { return (c.r + c.g + c.b) / 3.0; }
 
 TEST(Sequence, TagCornersProjectWhereSceneJsonSays) {
-  TempDir dir;
+  test::TempDir dir;
   SynthOptions options;
   options.frames = 1;
   options.trajectory = Trajectory::Static;
@@ -155,7 +156,7 @@ TEST(Sequence, TagCornersProjectWhereSceneJsonSays) {
   const auto& k = json["intrinsics"];
   const PinholeIntrinsics intrinsics{k["fx"].get<double>(), k["fy"].get<double>(), k["cx"].get<double>(),
                                      k["cy"].get<double>(), k["width"].get<int>(),   k["height"].get<int>()};
-  const TumSequence sequence = TumSequence::open(dir.path());
+  const capture::TumSequence sequence = capture::TumSequence::open(dir.path());
   const Pose world_to_camera = sequence.frame(0).camera_to_world->inverse();
   const ColorImage rgb = read_color(sequence.frame(0).color_file);
   const auto& m = json["tag"]["pose"]["matrix"];
@@ -193,7 +194,7 @@ TEST(Sequence, RenderedTagDecodesToTag36h11Id0) {
 }
 
 TEST(Sequence, RejectsBadOptions) {
-  TempDir dir;
+  test::TempDir dir;
   SynthOptions options = small_options();
   options.frames = -1;
   EXPECT_THROW(truth::write_sequence(options, dir.path()), Error);

@@ -21,7 +21,7 @@ RadianceImage as_radiance_image(const NormalMap& normals) {
 }
 
 void write_ground_truth(const fs::path& out, Timestamp timestamp, const synth::RenderedFrame& frame) {
-  const std::string stem = fs::path(TumWriter::file_name(timestamp)).stem().string();
+  const std::string stem = fs::path(capture::TumWriter::file_name(timestamp)).stem().string();
   write_depth_exr(out / "gt" / "depth" / (stem + ".exr"), frame.depth);
   write_radiance(out / "gt" / "normals" / (stem + ".exr"), as_radiance_image(frame.normals));
   write_color(out / "gt" / "albedo" / (stem + ".png"), synth::encode_albedo(frame.albedo));
@@ -49,7 +49,7 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
   create_folders(out, options.ground_truth);
   const PinholeIntrinsics intrinsics = synth::synth_intrinsics(options);
   const std::vector<Pose> poses = synth::make_trajectory(options.trajectory, options.frames, options.seed, scene);
-  TumWriter writer(out, synth::kSynthDepthScale);
+  capture::TumWriter writer(out, synth::kSynthDepthScale);
   for (int i = 0; i < options.frames; ++i) {
     const synth::RenderedFrame frame = synth::render_frame(scene, intrinsics, poses[static_cast<std::size_t>(i)], options.threads);
     const DepthMap depth = options.noise == synth::NoiseModel::None

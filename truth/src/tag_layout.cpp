@@ -2,10 +2,10 @@
 
 namespace relight::truth {
 
-TagLayout tag_layout(const synth::Scene& scene) {
-  TagLayout layout;
+capture::TagLayout tag_layout(const synth::Scene& scene) {
+  capture::TagLayout layout;
   for (const auto& decal : scene.tags) {
-    TagLayout::Tag tag;
+    capture::TagLayout::Tag tag;
     tag.id = decal.id;
     tag.size = decal.size;
     const auto corners = decal.corners_world();

@@ -2,10 +2,10 @@
 
 namespace relight::render {
 
-void add_lights(MrScene& scene, const LightSet& lights) {
-  for (const Light& light : lights.lights) {
+void add_lights(MrScene& scene, const lights::LightSet& lights) {
+  for (const lights::Light& light : lights.lights) {
     MrLight out;
-    out.kind = light.kind == relight::LightKind::Directional ? LightKind::Directional : LightKind::Point;
+    out.kind = light.kind == relight::lights::LightKind::Directional ? LightKind::Directional : LightKind::Point;
     out.direction = light.direction.normalized().cast<float>();
     out.position = light.position.cast<float>();
     out.intensity = light.power.cast<float>();

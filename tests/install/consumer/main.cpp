@@ -31,7 +31,7 @@ class StepDepthSource final : public relight::Stage {
 int main() {
   relight::FrameGraph graph;
   graph.emplace<StepDepthSource>();
-  graph.add(relight::make_depth_box_filter_stage(relight::Backend::Cpu, nullptr));
+  graph.add(relight::reconstruct::make_depth_box_filter_stage(relight::Backend::Cpu, nullptr));
   graph.keep(relight::kDepthSmoothed);
   graph.compile();
   if (!graph.run_frame()) return 1;

@@ -34,7 +34,7 @@ class BrdfPreviewStage final : public Stage {
   Read<Materials> materials_;
   Read<PositionMap> positions_;
   Read<NormalMap> normals_;
-  Read<LightSet> lights_;
+  Read<lights::LightSet> lights_;
   Read<FrameInfo> frame_;
   Write<ColorImage> preview_;
 };

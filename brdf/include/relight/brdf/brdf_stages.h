@@ -30,12 +30,11 @@
 #include "relight/lights/buffers.h"
 #include "relight/lights/light_set.h"
 
-namespace relight {
-namespace vk {
+namespace relight::vk {
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
 
-namespace brdf {
+namespace relight::brdf {
 
 class SpecularObjectiveVk;
 
@@ -43,7 +42,7 @@ struct BrdfBuffers {
   BufferName<ColorImage> color = kColor;
   BufferName<PositionMap> positions = kPositions;
   BufferName<NormalMap> normals = kNormals;
-  BufferName<LightSet> lights = kLights;
+  BufferName<lights::LightSet> lights = lights::kLights;
   BufferName<FrameInfo> frame = kFrame;
   BufferName<ColorImage> color_diffuse = kColorDiffuse;
   BufferName<Mask> highlight_mask = kHighlightMask;
@@ -101,7 +100,7 @@ class DiffuseStage final : public Stage {
   Read<ColorImage> color_;
   Read<PositionMap> positions_;
   Read<NormalMap> normals_;
-  Read<LightSet> lights_;
+  Read<lights::LightSet> lights_;
   Read<FrameInfo> frame_;
   Write<RadianceImage> kd_;
   Write<Mask> valid_;
@@ -158,7 +157,7 @@ class SpecularFitStage final : public Stage {
   Read<Mask> highlights_;
   Read<PositionMap> positions_;
   Read<NormalMap> normals_;
-  Read<LightSet> lights_;
+  Read<lights::LightSet> lights_;
   Read<FrameInfo> frame_;
   Write<Materials> materials_;
 };
@@ -202,5 +201,4 @@ std::size_t gather_points(const RadianceImage& kd, const Mask& valid, std::vecto
 [[nodiscard]] RadianceImage render_materials(const Materials& materials, const PositionMap& positions,
                                              const NormalMap& normals, const ShadingLights& lights);
 
-}  // namespace brdf
-}  // namespace relight
+}  // namespace relight::brdf

@@ -11,12 +11,11 @@
 
 #include "relight/brdf/kmeans.h"
 
-namespace relight {
-namespace vk {
+namespace relight::vk {
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
 
-namespace brdf {
+namespace relight::brdf {
 
 class KMeansVk final : public KMeansEngine {
  public:
@@ -45,5 +44,4 @@ class KMeansVk final : public KMeansEngine {
   std::optional<double> gpu_ms_;
 };
 
-}  // namespace brdf
-}  // namespace relight
+}  // namespace relight::brdf

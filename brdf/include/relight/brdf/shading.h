@@ -42,7 +42,7 @@ struct ShadingLights {
 
 /// Moves a world-frame LightSet into the camera frame of `camera_to_world`; only lights with
 /// `real` set take part (virtual objects' lights do not light the real surfaces' colours).
-[[nodiscard]] ShadingLights to_camera_frame(const LightSet& set, const Pose& camera_to_world,
+[[nodiscard]] ShadingLights to_camera_frame(const lights::LightSet& set, const Pose& camera_to_world,
                                             const Eigen::Vector3f& ambient = Eigen::Vector3f::Zero());
 
 /// Unit direction towards light `light` from camera-frame point `position` and the irradiance

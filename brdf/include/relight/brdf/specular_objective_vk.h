@@ -19,12 +19,11 @@
 
 #include "relight/brdf/specular_fit.h"
 
-namespace relight {
-namespace vk {
+namespace relight::vk {
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
 
-namespace brdf {
+namespace relight::brdf {
 
 struct SpecularCandidate {
   float ks = 0.f;
@@ -67,5 +66,4 @@ class SpecularObjectiveVk {
 [[nodiscard]] SpecularStart best_grid_start(SpecularObjectiveVk& objective, const SpecularProblem& problem,
                                             const SpecularOptions& options, int exponents = 24, int strengths = 16);
 
-}  // namespace brdf
-}  // namespace relight
+}  // namespace relight::brdf

@@ -4,9 +4,9 @@
 #include "relight/capture/camera_pose.h"
 #include "relight/core/buffer_name.h"
 
-namespace relight {
+namespace relight::capture {
 
 inline constexpr BufferName<CameraPose> kCameraPose{"camera_pose"};  ///< the tracked camera (camera_tracking_stage.h)
 inline constexpr BufferName<CameraPose> kMarkerPose{"marker_pose"};  ///< from the AprilTags (marker_pose.h)
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -8,7 +8,7 @@
 #include "relight/core/named_values.h"
 #include "relight/core/pose.h"
 
-namespace relight {
+namespace relight::capture {
 
 /// Where a frame's camera pose comes from (`--pose`).
 enum class PoseSource {
@@ -46,4 +46,4 @@ struct CameraPose {
   static constexpr const char* type_name = "CameraPose";
 };
 
-}  // namespace relight
+}  // namespace relight::capture

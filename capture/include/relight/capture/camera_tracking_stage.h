@@ -31,7 +31,7 @@
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
 
-namespace relight {
+namespace relight::capture {
 
 struct CameraTrackingOptions {
   /// nullopt: auto, decided at the first frame: the sequence's own poses when it has them, else
@@ -71,4 +71,4 @@ class CameraTrackingStage final : public Stage {
   Write<CameraPose> pose_;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

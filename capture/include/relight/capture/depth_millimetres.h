@@ -7,7 +7,7 @@
 
 #include "relight/core/pixel.h"
 
-namespace relight {
+namespace relight::capture {
 
 /// Nearest millimetre; invalid or non-positive depth -> 0; beyond 65.535 m -> 0 (out of range).
 [[nodiscard]] inline std::uint16_t depth_to_millimetres(float metres) {
@@ -18,4 +18,4 @@ namespace relight {
 
 [[nodiscard]] inline float millimetres_to_depth(std::uint16_t mm) { return static_cast<float>(mm) / 1000.0f; }
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -7,7 +7,7 @@
 
 #include "relight/core/rgbd_frame.h"
 
-namespace relight {
+namespace relight::capture {
 
 class FrameSource {
  public:
@@ -20,4 +20,4 @@ class FrameSource {
   [[nodiscard]] virtual std::string describe() const = 0;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

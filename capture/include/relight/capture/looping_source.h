@@ -8,7 +8,7 @@
 
 #include "relight/capture/frame_source.h"
 
-namespace relight {
+namespace relight::capture {
 
 class LoopingSource final : public FrameSource {
  public:
@@ -42,4 +42,4 @@ class LoopingSource final : public FrameSource {
   double first_timestamp_ = 0, last_timestamp_ = 0;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

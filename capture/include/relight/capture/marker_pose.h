@@ -26,7 +26,7 @@
 #include "relight/core/pose.h"
 #include "relight/core/rgbd_frame.h"
 
-namespace relight {
+namespace relight::capture {
 
 struct MarkerPose {
   Pose camera_to_world = Pose::Identity();
@@ -64,4 +64,4 @@ class MarkerPoseStage final : public Stage {
   Write<CameraPose> pose_;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -21,7 +21,7 @@
 
 #include "relight/capture/frame_source.h"
 
-namespace relight {
+namespace relight::capture {
 
 struct OpenNiOptions {
   /// Device URI (as `relight devices` lists), a .oni file, or empty for the first device found.
@@ -91,4 +91,4 @@ class OpenNiSource final : public FrameSource {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -8,7 +8,7 @@
 
 #include "relight/capture/frame_source.h"
 
-namespace relight {
+namespace relight::capture {
 
 class RangeSource final : public FrameSource {
  public:
@@ -37,4 +37,4 @@ class RangeSource final : public FrameSource {
   std::size_t position_ = 0;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

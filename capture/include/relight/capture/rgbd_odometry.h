@@ -43,7 +43,7 @@
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
 
-namespace relight {
+namespace relight::capture {
 
 struct RgbdOdometryOptions {
   int levels = 4;         ///< pyramid levels below and including the input (640 -> 80 px wide)
@@ -134,4 +134,4 @@ class RgbdOdometry {
   std::unique_ptr<State> state_;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -11,7 +11,7 @@
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 
-namespace relight {
+namespace relight::capture {
 
 class SourceStage final : public Stage {
  public:
@@ -31,4 +31,4 @@ class SourceStage final : public Stage {
   Write<FrameInfo> frame_;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -15,7 +15,7 @@
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
 
-namespace relight {
+namespace relight::capture {
 
 struct Plane {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit, pointing to the camera's side
@@ -74,4 +74,4 @@ struct LocalPlaneOptions {
 /// normal, x along the camera's x projected onto the plane, origin at the camera's foot on it.
 [[nodiscard]] Pose world_from_support_plane(const Plane& plane);
 
-}  // namespace relight
+}  // namespace relight::capture

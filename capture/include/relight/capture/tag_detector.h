@@ -8,7 +8,7 @@
 
 #include "relight/core/image.h"
 
-namespace relight {
+namespace relight::capture {
 
 struct TagDetection {
   int id = 0;
@@ -51,4 +51,4 @@ class TagDetector {
 /// Rec. 601 luma of an sRGB image, as 8-bit grey.
 [[nodiscard]] Image<std::uint8_t> to_grey(const ColorImage& image);
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace relight {
+namespace relight::capture {
 
 struct TagLayout {
   struct Tag {
@@ -34,4 +34,4 @@ struct TagLayout {
 /// Reads a layout file or a scene.json. Throws relight::Error naming the file.
 [[nodiscard]] TagLayout read_tag_layout(const std::filesystem::path& file);
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -5,7 +5,7 @@
 
 #include "relight/core/pose.h"
 
-namespace relight {
+namespace relight::capture {
 
 /// Absolute trajectory error: RMSE (metres) of the positions after the rigid alignment
 /// (Horn / Umeyama, no scale) of `estimate` onto `truth`; the vectors are paired by index.
@@ -18,5 +18,4 @@ struct RelativePoseError {
 };
 [[nodiscard]] RelativePoseError relative_pose_error(const std::vector<Pose>& estimate, const std::vector<Pose>& truth);
 
-
-}  // namespace relight
+}  // namespace relight::capture

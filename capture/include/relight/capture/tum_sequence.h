@@ -25,7 +25,7 @@
 #include "relight/core/camera.h"
 #include "relight/core/pose.h"
 
-namespace relight {
+namespace relight::capture {
 
 struct TumOptions {
   double max_time_difference = 0.02;           ///< seconds, as TUM's associate.py
@@ -99,4 +99,4 @@ class TumSource final : public FrameSource {
   std::size_t next_;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

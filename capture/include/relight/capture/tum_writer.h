@@ -11,7 +11,7 @@
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
 
-namespace relight {
+namespace relight::capture {
 
 class TumWriter {
  public:
@@ -39,4 +39,4 @@ class TumWriter {
   std::vector<Line> lines_;
 };
 
-}  // namespace relight
+}  // namespace relight::capture

@@ -16,13 +16,12 @@
 
 #include "relight/colormap/statistics_transfer.h"
 
-namespace relight {
-namespace vk {
+namespace relight::vk {
 class VulkanBuffer;
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
 
-namespace colormap {
+namespace relight::colormap {
 
 class StatisticsColorMapVk {
  public:
@@ -56,5 +55,4 @@ class StatisticsColorMapVk {
   std::optional<double> last_gpu_ms_;
 };
 
-}  // namespace colormap
-}  // namespace relight
+}  // namespace relight::colormap

@@ -3,9 +3,9 @@
 #include "relight/core/buffer_name.h"
 #include "relight/lights/light_set.h"
 
-namespace relight {
+namespace relight::lights {
 
 inline constexpr BufferName<LightSet> kLightsRaw{"lights_raw"};  ///< this frame's extracted lights
 inline constexpr BufferName<LightSet> kLights{"lights"};         ///< the real lights every stage uses
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -28,11 +28,11 @@
 #include "relight/lights/light_set.h"
 #include "relight/lights/probe_geometry.h"
 
-namespace relight {
-
-namespace vk {
+namespace relight::vk {
 class VulkanContext;
-}
+}  // namespace relight::vk
+
+namespace relight::lights {
 
 struct ImportanceSamplingOptions {
   int samples = 64;        ///< N
@@ -113,4 +113,4 @@ class ImportanceSamplerVk {
   std::optional<double> last_gpu_ms_;
 };
 
-}  // namespace relight
+}  // namespace relight::lights

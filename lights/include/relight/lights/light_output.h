@@ -6,7 +6,7 @@
 #include "relight/lights/light_set.h"
 #include "relight/lights/probe_geometry.h"
 
-namespace relight {
+namespace relight::lights {
 
 /// {"lights": [{"type": "directional", "direction": [x,y,z], "power": [r,g,b], "real": true}, ...],
 ///  "count": N, "total_power": [r,g,b], "irradiance_up": [r,g,b]} (irradiance on a surface facing
@@ -23,4 +23,4 @@ namespace relight {
 /// square root of its share of the power; the strongest 10 % in red, the others in green.
 [[nodiscard]] ColorImage light_preview(const RadianceImage& probe, const ProbeGeometry& geometry, const LightSet& set);
 
-}  // namespace relight
+}  // namespace relight::lights

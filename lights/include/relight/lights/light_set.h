@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-namespace relight {
+namespace relight::lights {
 
 enum class LightKind { Directional, Point };
 
@@ -44,4 +44,4 @@ struct LightSet {
 /// direction the power-weighted mean), strongest cluster first. Point lights pass unchanged.
 [[nodiscard]] LightSet cluster_lights(const LightSet& set, double radius);
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -16,7 +16,7 @@
 #include "relight/lights/buffers.h"
 #include "relight/lights/light_set.h"
 
-namespace relight {
+namespace relight::lights {
 
 struct LightSmoothingOptions {
   double blend = 0.5;                                  ///< weight of the new frame, (0, 1]
@@ -50,4 +50,4 @@ class LightSmoothingStage final : public Stage {
   Write<LightSet> output_;
 };
 
-}  // namespace relight
+}  // namespace relight::lights

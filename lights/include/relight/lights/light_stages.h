@@ -16,7 +16,7 @@
 #include "relight/lights/importance_sampling.h"
 #include "relight/lights/median_cut.h"
 
-namespace relight {
+namespace relight::lights {
 
 enum class LightMethod { Importance, MedianCut };
 inline constexpr std::array<NamedValue<LightMethod>, 2> kLightMethodNames{
@@ -66,4 +66,4 @@ class LightExtractionStage final : public Stage {
 /// Runs the chosen method once on a probe (what the stage does per frame).
 [[nodiscard]] LightSet extract_lights(const RadianceImage& probe, const LightExtractionOptions& options);
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -15,7 +15,7 @@
 #include "relight/lights/light_set.h"
 #include "relight/lights/probe_geometry.h"
 
-namespace relight {
+namespace relight::lights {
 
 struct MedianCutOptions {
   int lights = 64;  ///< N
@@ -26,4 +26,4 @@ struct MedianCutOptions {
 [[nodiscard]] LightSet median_cut(const RadianceImage& probe, const ProbeGeometry& geometry,
                                   const MedianCutOptions& options);
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -19,7 +19,7 @@
 #include "relight/core/camera.h"
 #include "relight/core/image.h"
 
-namespace relight {
+namespace relight::lights {
 
 enum class ProbeProjection { Fisheye, Equirectangular };
 
@@ -74,4 +74,4 @@ class ProbeGeometry {
                                                        const FisheyeCamera& fisheye,
                                                        const Eigen::Matrix3d& fisheye_to_world, int samples = 2);
 
-}  // namespace relight
+}  // namespace relight::lights

@@ -4,8 +4,8 @@
 #include "relight/core/buffer_name.h"
 #include "relight/reconstruct/depth_warp_merge.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 inline constexpr BufferName<DepthWeightMap> kDepthWeight{"depth_weight"};  ///< method 2's merge weights
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -25,12 +25,12 @@
 #include "relight/core/rgbd_frame.h"
 #include "relight/reconstruct/normals_from_positions.h"
 
-namespace relight {
-
-namespace vk {
+namespace relight::vk {
 class VulkanBuffer;
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
+
+namespace relight::reconstruct {
 
 /// Holds the compute pipeline: create once, reuse every frame.
 class CrossNormalsVk {
@@ -82,4 +82,4 @@ class NormalsFromPositionsVkStage final : public Stage {
   Write<NormalMap> normals_;
 };
 
-}  // namespace relight
+}  // namespace relight::reconstruct

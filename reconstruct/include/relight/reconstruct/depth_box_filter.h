@@ -25,12 +25,12 @@
 #include "relight/core/frame_graph.h"
 #include "relight/core/image.h"
 
-namespace relight {
-
-namespace vk {
+namespace relight::vk {
 class VulkanBuffer;
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
+
+namespace relight::reconstruct {
 
 /// CPU reference. Writes `smoothed` (resized to depth's shape); `smoothed` must not be `depth`.
 void depth_box_filter(const DepthMap& depth, DepthMap& smoothed);
@@ -102,4 +102,4 @@ class DepthBoxFilterVkStage final : public Stage {
 [[nodiscard]] std::unique_ptr<Stage> make_depth_box_filter_stage(Backend backend, vk::VulkanContext* context,
                                                                  DepthBoxFilterBuffers buffers = {});
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -34,7 +34,7 @@
 #include "relight/core/rgbd_frame.h"
 #include "relight/core/stage_backend.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 /// Per-pixel count of the frames averaged into "depth_filtered" (0 = no depth).
 struct DepthWeightMap : Image<float> {
@@ -100,4 +100,4 @@ class DepthWarpMergeCpuStage final : public DepthWarpMergeStageBase {
 [[nodiscard]] std::unique_ptr<Stage> make_depth_warp_merge_stage(Backend backend, vk::VulkanContext* context,
                                                                  DepthWarpMergeOptions options = {});
 
-}  // namespace relight
+}  // namespace relight::reconstruct

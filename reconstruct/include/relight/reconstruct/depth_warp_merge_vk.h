@@ -26,12 +26,12 @@
 #include "relight/core/pose.h"
 #include "relight/reconstruct/depth_warp_merge.h"
 
-namespace relight {
-
-namespace vk {
+namespace relight::vk {
 class VulkanBuffer;
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
+
+namespace relight::reconstruct {
 
 /// Holds the pipelines: create once, reuse every frame.
 class DepthWarpMergeVk {
@@ -77,4 +77,4 @@ class DepthWarpMergeVkStage final : public DepthWarpMergeStageBase {
   DepthWarpMergeVk method_;
 };
 
-}  // namespace relight
+}  // namespace relight::reconstruct

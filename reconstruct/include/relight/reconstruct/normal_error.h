@@ -5,7 +5,7 @@
 
 #include "relight/core/image.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 struct AngularError {
   double mean_deg = 0.0;      ///< mean angle between estimate and truth over `compared` pixels
@@ -33,4 +33,4 @@ struct DepthError {
 };
 [[nodiscard]] DepthError depth_rmse(const DepthMap& estimate, const DepthMap& truth, const Mask* region = nullptr);
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -29,7 +29,7 @@
 #include "relight/core/rgbd_frame.h"
 #include "relight/core/stage_backend.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 struct CrossNormalOptions {
   int stride = 1;              ///< s: pixel distance of the difference vectors
@@ -76,4 +76,4 @@ class NormalsFromPositionsCpuStage final : public Stage {
 [[nodiscard]] std::unique_ptr<Stage> make_normals_from_positions_stage(Backend backend, vk::VulkanContext* context,
                                                                        CrossNormalOptions options = {});
 
-}  // namespace relight
+}  // namespace relight::reconstruct

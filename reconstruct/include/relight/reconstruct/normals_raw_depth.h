@@ -60,7 +60,7 @@
 #include "relight/core/stage_backend.h"
 #include "relight/reconstruct/normals_from_positions.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 struct NormalsRawDepthOptions {
   int stride = 4;                 ///< pixel distance of the cross-product differences (eq. 4.4–4.5)
@@ -181,4 +181,4 @@ class NormalsRawDepthCpuStage final : public NormalsRawDepthStageBase {
                                                                   NormalsRawDepthOptions options = {},
                                                                   NormalsDepthInput input = NormalsDepthInput::Raw);
 
-}  // namespace relight
+}  // namespace relight::reconstruct

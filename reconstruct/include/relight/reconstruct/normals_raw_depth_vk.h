@@ -23,7 +23,7 @@
 #include "relight/reconstruct/cross_normals_vk.h"
 #include "relight/reconstruct/normals_raw_depth.h"
 
-namespace relight {
+namespace relight::reconstruct {
 
 /// The previous frame as the device version of method 1 reads it: normals on the host (pass 1's
 /// pyramid is built on the CPU), positions on the device (`positions` >= width*height Float3).
@@ -85,4 +85,4 @@ class NormalsRawDepthVkStage final : public NormalsRawDepthStageBase {
   NormalsRawDepthVk method_;
 };
 
-}  // namespace relight
+}  // namespace relight::reconstruct

@@ -6,6 +6,6 @@
 
 namespace relight::truth {
 
-[[nodiscard]] TagLayout tag_layout(const synth::Scene& scene);
+[[nodiscard]] capture::TagLayout tag_layout(const synth::Scene& scene);
 
 }  // namespace relight::truth

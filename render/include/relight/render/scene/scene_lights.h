@@ -7,6 +7,6 @@
 
 namespace relight::render {
 
-void add_lights(MrScene& scene, const LightSet& lights);
+void add_lights(MrScene& scene, const lights::LightSet& lights);
 
 }  // namespace relight::render

@@ -14,12 +14,11 @@
 
 #include "relight/render/vpl/cone_search.h"
 
-namespace relight {
-namespace vk {
+namespace relight::vk {
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
 
-namespace render {
+namespace relight::render {
 
 /// Holds the pipeline, and the point buffer between searches over the same points.
 class ConeSearchVk {
@@ -43,5 +42,4 @@ class ConeSearchVk {
   std::unique_ptr<State> state_;
 };
 
-}  // namespace render
-}  // namespace relight
+}  // namespace relight::render

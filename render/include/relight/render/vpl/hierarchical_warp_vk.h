@@ -16,13 +16,12 @@
 
 #include "relight/render/vpl/hierarchical_warp.h"
 
-namespace relight {
-namespace vk {
+namespace relight::vk {
 class VulkanBuffer;
 class VulkanContext;
-}  // namespace vk
+}  // namespace relight::vk
 
-namespace render {
+namespace relight::render {
 
 /// Holds the pipelines and the pyramid buffer: create once, reuse every frame.
 class HierarchicalWarpVk {
@@ -52,5 +51,4 @@ class HierarchicalWarpVk {
   std::unique_ptr<Pipelines> pipelines_;
 };
 
-}  // namespace render
-}  // namespace relight
+}  // namespace relight::render
