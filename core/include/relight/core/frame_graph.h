@@ -11,7 +11,9 @@
 //
 // Vulkan stages get device copies of buffers through StageContext::device_read/device_write; the
 // graph moves the bytes between host and device when the other side holds newer data, so stages
-// never transfer anything themselves.
+// never transfer a graph buffer themselves. (A stage that dispatches from host buffers - DIR,
+// K-means - uploads only what it derives from them: meshes, gathered points. StageTimings'
+// device_buffers tells the two kinds apart.)
 #include <chrono>
 #include <cstdint>
 #include <functional>
