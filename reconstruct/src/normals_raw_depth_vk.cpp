@@ -34,7 +34,7 @@ struct NormalsRawDepthVk::Pipelines {
 /// Device buffers kept across frames, remade only when a size changes: a steady run allocates
 /// no device memory. The first group serves the device path, the second the host convenience.
 struct NormalsRawDepthVk::Scratch {
-  std::optional<vk::VulkanBuffer> fresh_normals, blended, pyramid, curvature;
+  std::optional<vk::VulkanBuffer> unfilled, pyramid, curvature;
   std::optional<vk::VulkanBuffer> depth, positions, normals, previous_positions;
 };
 
@@ -67,20 +67,21 @@ std::optional<double> NormalsRawDepthVk::run(const vk::VulkanBuffer& depth, int 
     throw LogicError("NormalsRawDepthVk::run: output buffers smaller than width*height Float3");
   }
   Scratch& scratch = *scratch_;
-  vk::VulkanBuffer& fresh_normals = vk::buffer_of_size(scratch.fresh_normals, context_, map_bytes);
-  std::optional<double> total =
-      cross_.run(depth, positions, fresh_normals, width, height, intrinsics, cross_normal_options(options));
-
   const bool usable_history = previous && previous->normals.width() == width && previous->normals.height() == height &&
                               previous->positions.size_bytes() >= map_bytes;
-  // Without history the blend is the identity: the fill pass reads the fresh normals directly.
-  const vk::VulkanBuffer* fill_input = &fresh_normals;
+  // One scratch map, `unfilled`, holds the normals before hole filling, which reads it and writes
+  // the output. With history the cross products go to the output first and the blend writes
+  // `unfilled`; without, the blend is the identity and the cross products go to `unfilled`
+  // directly. (Three maps in flight, not four: on a CPU device the cache footprint is the cost.)
+  vk::VulkanBuffer& unfilled = vk::buffer_of_size(scratch.unfilled, context_, map_bytes);
+  std::optional<double> total = cross_.run(depth, positions, usable_history ? normals : unfilled, width, height,
+                                           intrinsics, cross_normal_options(options));
   if (usable_history) {
     const std::vector<NormalsPyramidLevel> pyramid =
         normals_history_pyramid(previous->normals, options.mip_levels, options.threads);
     std::vector<Float3> texels;
-    for (const auto& level : pyramid) texels.insert(texels.end(), level.normal.pixels().begin(), level.normal.pixels().end());
-    vk::VulkanBuffer& blended = vk::buffer_of_size(scratch.blended, context_, map_bytes);
+    for (const auto& level : pyramid)
+      texels.insert(texels.end(), level.normal.pixels().begin(), level.normal.pixels().end());
     vk::VulkanBuffer& pyramid_buffer = vk::buffer_of_size(scratch.pyramid, context_, texels.size() * sizeof(Float3));
     vk::VulkanBuffer& curvature_buffer =
         vk::buffer_of_size(scratch.curvature, context_, pyramid.front().curvature.bytes().size());
@@ -107,7 +108,7 @@ std::optional<double> NormalsRawDepthVk::run(const vk::VulkanBuffer& depth, int 
     params.levels = static_cast<gpu::uint>(pyramid.size());
     constexpr std::uint32_t local = RELIGHT_NORMALS_BLEND_LOCAL_SIZE;
     const auto set = pipelines_->blend.bind(
-        {&positions, &fresh_normals, &previous->positions, &pyramid_buffer, &curvature_buffer, &blended});
+        {&positions, &normals, &previous->positions, &pyramid_buffer, &curvature_buffer, &unfilled});
     context_.submit([&](VkCommandBuffer cmd) {
       pipelines_->timer.start(cmd);
       pipelines_->blend.dispatch(cmd, set, params, vk::ComputePipeline::group_count(params.width, local),
@@ -115,13 +116,12 @@ std::optional<double> NormalsRawDepthVk::run(const vk::VulkanBuffer& depth, int 
       pipelines_->timer.stop(cmd);
     });
     add_ms(total, pipelines_->timer.elapsed_ms());
-    fill_input = &blended;
   }
 
-  // Fill reads fill_input and writes the output, so no pixel sees a neighbour's fill.
+  // Fill reads `unfilled` and writes the output, so no pixel sees a neighbour's fill.
   const gpu::NormalsFillParams fill_params{static_cast<gpu::uint>(width), static_cast<gpu::uint>(height)};
   constexpr std::uint32_t local = RELIGHT_NORMALS_BLEND_LOCAL_SIZE;
-  const auto fill_set = pipelines_->fill.bind({&positions, fill_input, &normals});
+  const auto fill_set = pipelines_->fill.bind({&positions, &unfilled, &normals});
   context_.submit([&](VkCommandBuffer cmd) {
     pipelines_->timer.start(cmd);
     pipelines_->fill.dispatch(cmd, fill_set, fill_params, vk::ComputePipeline::group_count(fill_params.width, local),
