@@ -207,8 +207,10 @@ void SpecularFitStage::run(StageContext& context) {
   Materials& out = context.get(materials_);
   out = context.get(clusters_);
   const ShadingLights lights = camera_lights(context.get(lights_), context.get(frame_), options_.ambient);
+  if (gpu_start_) gpu_start_->reset_gpu_ms();
   fit_materials(context.get(color_), &context.get(highlights_), context.get(positions_), context.get(normals_), lights,
                 options_, *solver_, out, gpu_start_.get());
+  if (const auto gpu_ms = gpu_start_ ? gpu_start_->gpu_ms() : std::nullopt) context.report_device_ms(*gpu_ms);
 }
 
 void add_brdf_stages(FrameGraph& graph, const BrdfOptions& options, Backend backend, vk::VulkanContext* context,

@@ -94,6 +94,17 @@ TEST(ReplayRenderCli, VirtualSpotLightWithRsmVplsLightsItsFootprint) {
     ASSERT_EQ(result.exit_code, 0) << result.err;
     composites[s] = read_color(out / "frames" / "000000_composite.png");
   }
+  // The RSMs are rasterised on the device: the VPL stage says so and reports their GPU time.
+  const auto report = nlohmann::json::parse(read_text_file(dir.path() / "rsm" / "report.json"));
+  bool vpl_stage = false;
+  for (const auto& stage : report["stages"]) {
+    if (stage["stage"] != "vpls") continue;
+    vpl_stage = true;
+    EXPECT_EQ(stage["backend"], "Vulkan");
+    ASSERT_TRUE(stage.contains("device_median_ms")) << stage.dump();
+    EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0);
+  }
+  EXPECT_TRUE(vpl_stage);
   const ColorImage camera = read_color(dir.path() / "rsm" / "frames" / "000000_color.png");
   const auto sum = [](Rgb8 c) { return c.r + c.g + c.b; };
   int lit = 0, differ = 0;
@@ -208,7 +219,8 @@ TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
   EXPECT_EQ(report["device_memory"]["allocations_after_frame_2"].get<int>(), 0);
   // Every stage that dispatches on the device says so and reports its GPU time (lavapipe has
   // timestamps); where its buffers live is its own row (the per-pixel ones on the device).
-  for (const char* name : {"depth_box_filter", "normals_raw_depth", "kmeans", "dir", "colormap_statistics"}) {
+  for (const char* name :
+       {"depth_box_filter", "normals_raw_depth", "kmeans", "specular_fit", "dir", "colormap_statistics"}) {
     bool found = false;
     for (const auto& stage : report["stages"]) {
       if (stage["stage"] != name) continue;
@@ -216,7 +228,8 @@ TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
       EXPECT_EQ(stage["backend"], "Vulkan") << name;
       ASSERT_TRUE(stage.contains("device_median_ms")) << name;
       EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0) << name;
-      const bool host_buffers = std::string(name) == "kmeans" || std::string(name) == "dir";
+      const bool host_buffers =
+          std::string(name) == "kmeans" || std::string(name) == "specular_fit" || std::string(name) == "dir";
       EXPECT_EQ(stage["buffers"], host_buffers ? "host" : "device") << name;
     }
     EXPECT_TRUE(found) << name;

@@ -124,6 +124,10 @@ void VplStage::run(StageContext& context) {
   context.get(vpls_).vpls = generate_vpls(scene, RayTracer(scene, RayTracer::Build::Fast), options_,
                                           {.cone_search = cone_search_.get(),
                                            .reflective_shadow_maps = reflective_shadow_maps_.get()});
+  // The GPU time of this frame's searches and RSM passes (the helpers count since the last take).
+  const double gpu_ms = (cone_search_ ? cone_search_->take_gpu_ms() : 0.0) +
+                        (reflective_shadow_maps_ ? reflective_shadow_maps_->take_gpu_ms() : 0.0);
+  if (gpu_ms > 0.0) context.report_device_ms(gpu_ms);
 }
 
 // ---- dir ---------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <utility>
 
 #include "relight/core/error.h"
 #include "relight/render/vpl/cone_search_shared.h"
@@ -27,6 +28,7 @@ struct ConeSearchVk::State {
   std::unique_ptr<vk::VulkanBuffer> points;
   std::uint32_t point_count = 0;
   std::optional<double> gpu_ms;
+  double untaken_ms = 0.0;  // every search's GPU time since the last take_gpu_ms()
 };
 
 ConeSearchVk::ConeSearchVk(vk::VulkanContext& context)
@@ -72,6 +74,7 @@ std::vector<ConeHit> ConeSearchVk::search(std::span<const ConeQuery> queries, fl
     s.timer.stop(cmd);
   });
   s.gpu_ms = s.timer.elapsed_ms();
+  if (s.gpu_ms) s.untaken_ms += *s.gpu_ms;
   std::vector<std::uint32_t> words(queries.size() * 2);
   transfer.download(hit_buffer, std::as_writable_bytes(std::span(words)));
   for (std::size_t q = 0; q < queries.size(); ++q) {
@@ -82,5 +85,7 @@ std::vector<ConeHit> ConeSearchVk::search(std::span<const ConeQuery> queries, fl
 }
 
 std::optional<double> ConeSearchVk::last_gpu_ms() const { return state_->gpu_ms; }
+
+double ConeSearchVk::take_gpu_ms() { return std::exchange(state_->untaken_ms, 0.0); }
 
 }  // namespace relight::render

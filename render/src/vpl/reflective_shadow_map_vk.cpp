@@ -3,6 +3,7 @@
 
 #include <array>
 #include <optional>
+#include <utility>
 
 #include "relight/core/error.h"
 #include "relight/render/dir/gbuffer_vk.h"
@@ -55,6 +56,7 @@ struct ReflectiveShadowMapsVk::Impl {
   explicit Impl(vk::VulkanContext& context) : context(context) {}
   vk::VulkanContext& context;
   int size = 0;
+  double untaken_ms = 0.0;  // every pass's GPU time since the last take_gpu_ms()
   std::array<std::unique_ptr<GBufferVk>, kPassCount> passes;
   std::array<bool, kPassCount> uploaded{};
   double gpu_ms = 0.0;
@@ -73,6 +75,7 @@ struct ReflectiveShadowMapsVk::Impl {
     GBufferVk& g = pass(which, scene);
     GBuffer out = g.render(camera);
     gpu_ms += g.last_gpu_ms();
+    untaken_ms += g.last_gpu_ms();
     return out;
   }
 };
@@ -85,6 +88,8 @@ ReflectiveShadowMapsVk::ReflectiveShadowMapsVk(vk::VulkanContext& context) : imp
 ReflectiveShadowMapsVk::~ReflectiveShadowMapsVk() = default;
 
 double ReflectiveShadowMapsVk::last_gpu_ms() const { return impl_->gpu_ms; }
+
+double ReflectiveShadowMapsVk::take_gpu_ms() { return std::exchange(impl_->untaken_ms, 0.0); }
 
 void ReflectiveShadowMapsVk::set_scene(const MrScene& scene) {
   impl_->uploaded.fill(false);

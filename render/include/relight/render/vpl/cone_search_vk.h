@@ -35,6 +35,9 @@ class ConeSearchVk {
   [[nodiscard]] std::vector<ConeHit> search(std::span<const ConeQuery> queries, float half_angle_deg);
   /// GPU milliseconds of the last search, when the device has timestamps.
   [[nodiscard]] std::optional<double> last_gpu_ms() const;
+  /// The GPU milliseconds of every search since the last call (0 without timestamps): what a
+  /// stage that searches several times per frame reports.
+  double take_gpu_ms();
 
  private:
   struct State;

@@ -39,6 +39,9 @@ class ReflectiveShadowMapsVk {
   [[nodiscard]] std::vector<ReflectiveShadowMap> render(const MrScene& scene, std::size_t light, int size);
   /// GPU time of the last render's passes, milliseconds (0 without timestamp support).
   [[nodiscard]] double last_gpu_ms() const;
+  /// The GPU milliseconds of every render since the last call: what a stage that renders the
+  /// RSMs of several lights per frame reports.
+  double take_gpu_ms();
 
  private:
   struct Impl;
