@@ -25,7 +25,8 @@ struct ConeSearchVk::State {
         timer(context) {}
   vk::ComputePipeline pipeline;
   vk::GpuTimer timer;
-  std::unique_ptr<vk::VulkanBuffer> points;
+  // Kept across frames and grown with headroom: the point and query counts change every frame.
+  std::optional<vk::VulkanBuffer> points, queries, hits;
   std::uint32_t point_count = 0;
   std::optional<double> gpu_ms;
   double untaken_ms = 0.0;  // every search's GPU time since the last take_gpu_ms()
@@ -43,7 +44,7 @@ void ConeSearchVk::set_points(std::span<const IsmPoint> points) {
     packed.insert(packed.end(), {p.position.x(), p.position.y(), p.position.z(), p.half_size, p.normal.x(),
                                  p.normal.y(), p.normal.z(), 0.f});
   if (packed.empty()) packed.assign(RELIGHT_CONE_POINT_FLOATS, 0.f);  // a buffer may not be empty
-  state_->points = std::make_unique<vk::VulkanBuffer>(context_, packed.size() * sizeof(float));
+  vk::reserve_with_headroom(state_->points, context_, packed.size() * sizeof(float));
   context_.transfer().upload(std::as_bytes(std::span<const float>(packed)), *state_->points);
   state_->point_count = static_cast<std::uint32_t>(points.size());
 }
@@ -60,14 +61,16 @@ std::vector<ConeHit> ConeSearchVk::search(std::span<const ConeQuery> queries, fl
     packed.insert(packed.end(), {q.origin.x(), q.origin.y(), q.origin.z(), q.max_t, q.normal.x(), q.normal.y(),
                                  q.normal.z(), 0.f, q.direction.x(), q.direction.y(), q.direction.z(), 0.f});
   vk::VulkanTransfer& transfer = context_.transfer();
-  vk::VulkanBuffer query_buffer(context_, packed.size() * sizeof(float));
-  vk::VulkanBuffer hit_buffer(context_, queries.size() * 2 * sizeof(std::uint32_t));
+  vk::reserve_with_headroom(state_->queries, context_, packed.size() * sizeof(float));
+  vk::reserve_with_headroom(state_->hits, context_, queries.size() * 2 * sizeof(std::uint32_t));
+  vk::VulkanBuffer& query_buffer = *state_->queries;
+  vk::VulkanBuffer& hit_buffer = *state_->hits;
   transfer.upload(std::as_bytes(std::span<const float>(packed)), query_buffer);
   const ConeShape cone(half_angle_deg);
   const gpu::ConeSearchParams params{state_->point_count, static_cast<gpu::uint>(queries.size()), cone.tan_half,
                                      cone.sin_half};
   State& s = *state_;
-  const auto set = s.pipeline.bind({s.points.get(), &query_buffer, &hit_buffer});
+  const auto set = s.pipeline.bind({&*s.points, &query_buffer, &hit_buffer});
   context_.submit([&](VkCommandBuffer cmd) {
     s.timer.start(cmd);
     s.pipeline.dispatch(cmd, set, params, static_cast<std::uint32_t>(queries.size()), 1);
