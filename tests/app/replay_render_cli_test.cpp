@@ -18,6 +18,18 @@ using cli_test::relight;
 
 const std::filesystem::path kData = RELIGHT_TEST_DATA;
 
+/// The report's row of stage `name` exists, says Vulkan and has a GPU time; returns the row.
+nlohmann::json expect_dispatches_on_the_device(const nlohmann::json& report, const std::string& name) {
+  for (const auto& stage : report["stages"]) {
+    if (stage["stage"] != name) continue;
+    EXPECT_EQ(stage["backend"], "Vulkan") << name;
+    EXPECT_GT(stage.value("device_median_ms", 0.0), 0.0) << name << ": " << stage.dump();
+    return stage;
+  }
+  ADD_FAILURE() << "no stage " << name << " in the report";
+  return {};
+}
+
 const std::filesystem::path& two_frame_sequence() { return cli_test::synthetic_sequence("--frames 2 --no-gt"); }
 
 TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
@@ -96,15 +108,7 @@ TEST(ReplayRenderCli, VirtualSpotLightWithRsmVplsLightsItsFootprint) {
   }
   // The RSMs are rasterised on the device: the VPL stage says so and reports their GPU time.
   const auto report = nlohmann::json::parse(read_text_file(dir.path() / "rsm" / "report.json"));
-  bool vpl_stage = false;
-  for (const auto& stage : report["stages"]) {
-    if (stage["stage"] != "vpls") continue;
-    vpl_stage = true;
-    EXPECT_EQ(stage["backend"], "Vulkan");
-    ASSERT_TRUE(stage.contains("device_median_ms")) << stage.dump();
-    EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0);
-  }
-  EXPECT_TRUE(vpl_stage);
+  expect_dispatches_on_the_device(report, "vpls");
   const ColorImage camera = read_color(dir.path() / "rsm" / "frames" / "000000_color.png");
   const auto sum = [](Rgb8 c) { return c.r + c.g + c.b; };
   int lit = 0, differ = 0;
@@ -221,18 +225,10 @@ TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
   // timestamps); where its buffers live is its own row (the per-pixel ones on the device).
   for (const char* name :
        {"depth_box_filter", "normals_raw_depth", "kmeans", "specular_fit", "dir", "colormap_statistics"}) {
-    bool found = false;
-    for (const auto& stage : report["stages"]) {
-      if (stage["stage"] != name) continue;
-      found = true;
-      EXPECT_EQ(stage["backend"], "Vulkan") << name;
-      ASSERT_TRUE(stage.contains("device_median_ms")) << name;
-      EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0) << name;
-      const bool host_buffers =
-          std::string(name) == "kmeans" || std::string(name) == "specular_fit" || std::string(name) == "dir";
-      EXPECT_EQ(stage["buffers"], host_buffers ? "host" : "device") << name;
-    }
-    EXPECT_TRUE(found) << name;
+    const nlohmann::json stage = expect_dispatches_on_the_device(report, name);
+    const bool host_buffers =
+        std::string(name) == "kmeans" || std::string(name) == "specular_fit" || std::string(name) == "dir";
+    EXPECT_EQ(stage.value("buffers", ""), host_buffers ? "host" : "device") << name;
   }
   // Method 2 on the device: warp and merge keep depth and weight as device history, and the
   // plain normals read the merged depth where it already is.
@@ -260,15 +256,7 @@ TEST(ReplayRenderCli, ASteadyVulkanRunAllocatesNoDeviceMemory) {
   }
   EXPECT_EQ(cone_report["frames"].get<int>(), 12);
   EXPECT_EQ(cone_allocations[1], cone_allocations[0]) << "4 frames against 12";
-  bool vpl_stage = false;
-  for (const auto& stage : cone_report["stages"]) {
-    if (stage["stage"] != "vpls") continue;
-    vpl_stage = true;
-    EXPECT_EQ(stage["backend"], "Vulkan");
-    ASSERT_TRUE(stage.contains("device_median_ms")) << stage.dump();
-    EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0);
-  }
-  EXPECT_TRUE(vpl_stage);
+  expect_dispatches_on_the_device(cone_report, "vpls");
 }
 
 }  // namespace
