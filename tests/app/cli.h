@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "run_command.h"
@@ -33,6 +34,18 @@ inline const std::filesystem::path& synthetic_sequence(const std::string& argume
   const auto result = relight("synth --quiet " + arguments + " --out " + path.string());
   EXPECT_EQ(result.exit_code, 0) << result.err;
   return made.emplace(arguments, path).first->second;
+}
+
+/// The report.json row of stage `name` exists, says Vulkan and has a GPU time; returns the row.
+inline nlohmann::json expect_dispatches_on_the_device(const nlohmann::json& report, const std::string& name) {
+  for (const auto& stage : report["stages"]) {
+    if (stage["stage"] != name) continue;
+    EXPECT_EQ(stage["backend"], "Vulkan") << name;
+    EXPECT_GT(stage.value("device_median_ms", 0.0), 0.0) << name << ": " << stage.dump();
+    return stage;
+  }
+  ADD_FAILURE() << "no stage " << name << " in the report";
+  return {};
 }
 
 }  // namespace relight::cli_test

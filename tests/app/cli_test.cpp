@@ -13,6 +13,7 @@
 namespace relight::app {
 namespace {
 
+using cli_test::expect_dispatches_on_the_device;
 using cli_test::expect_one_line_error;
 using cli_test::relight;
 
@@ -134,15 +135,7 @@ TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
     EXPECT_EQ(read_text_file(cpu / "frames" / file), read_text_file(vulkan / "frames" / file)) << file;
   }
   const auto report = nlohmann::json::parse(read_text_file(vulkan / "report.json"));
-  bool found = false;
-  for (const auto& stage : report["stages"]) {
-    if (stage["stage"] != "depth_box_filter") continue;
-    found = true;
-    EXPECT_EQ(stage["backend"], "Vulkan");
-    EXPECT_EQ(stage["buffers"], "device");
-    EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0);
-  }
-  EXPECT_TRUE(found);
+  EXPECT_EQ(expect_dispatches_on_the_device(report, "depth_box_filter").value("buffers", ""), "device");
   // Outside the option's choices: a usage error, as for every option with a fixed set of values.
   expect_one_line_error(relight("replay --backend quantum --out " + dir.path().string()), 2);
 }
@@ -164,16 +157,8 @@ TEST(Cli, VulkanBackendRunsBothGeometryMethodsOnTheDevice) {
     ASSERT_EQ(result.exit_code, 0) << result.err;
     const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
     for (const std::string& name : stages) {
-      bool found = false;
-      for (const auto& stage : report["stages"]) {
-        if (stage["stage"] != name) continue;
-        found = true;
-        EXPECT_GT(stage["device_median_ms"].get<double>(), 0.0) << name;
-        // The graph hands them device buffers: no stage transfers on its own.
-        EXPECT_EQ(stage["backend"], "Vulkan") << name;
-        EXPECT_EQ(stage["buffers"], "device") << name;
-      }
-      EXPECT_TRUE(found) << arguments << ": " << name;
+      // The graph hands them device buffers: no stage transfers on its own.
+      EXPECT_EQ(expect_dispatches_on_the_device(report, name).value("buffers", ""), "device") << arguments;
     }
   }
 }

@@ -13,22 +13,11 @@
 namespace relight::app {
 namespace {
 
+using cli_test::expect_dispatches_on_the_device;
 using cli_test::expect_one_line_error;
 using cli_test::relight;
 
 const std::filesystem::path kData = RELIGHT_TEST_DATA;
-
-/// The report's row of stage `name` exists, says Vulkan and has a GPU time; returns the row.
-nlohmann::json expect_dispatches_on_the_device(const nlohmann::json& report, const std::string& name) {
-  for (const auto& stage : report["stages"]) {
-    if (stage["stage"] != name) continue;
-    EXPECT_EQ(stage["backend"], "Vulkan") << name;
-    EXPECT_GT(stage.value("device_median_ms", 0.0), 0.0) << name << ": " << stage.dump();
-    return stage;
-  }
-  ADD_FAILURE() << "no stage " << name << " in the report";
-  return {};
-}
 
 const std::filesystem::path& two_frame_sequence() { return cli_test::synthetic_sequence("--frames 2 --no-gt"); }
 
