@@ -118,8 +118,8 @@ std::unique_ptr<Stage> make_color_map_stage(ColorMapMethod method, Backend backe
       if (backend == Backend::Cpu) {
         return std::make_unique<StatisticsColorMapCpuStage>(options.tone_map, std::move(buffers));
       }
-      if (!context) throw LogicError("make_color_map_stage: the Vulkan backend needs a VulkanContext");
-      return std::make_unique<StatisticsColorMapVkStage>(*context, options.tone_map, std::move(buffers));
+      return std::make_unique<StatisticsColorMapVkStage>(require_vulkan_context(context, "make_color_map_stage"),
+                                                         options.tone_map, buffers);
   }
   throw LogicError("make_color_map_stage: unknown method");
 }

@@ -21,6 +21,7 @@
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/named_values.h"
+#include "relight/core/stage_backend.h"
 
 namespace relight::colormap {
 
