@@ -73,7 +73,40 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
       ->expected(0, 1)
       ->default_str("")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
-  command.add_option("--lights", options.lights, "Lights JSON of `relight lights` (needed to render into a recorded sequence)");
+  command.add_option("--lights", options.lights,
+                     "Lights JSON of `relight lights`: constant real lights instead of a light probe");
+  command.add_option("--probe", options.probe,
+                     "Light probe the real lights are extracted from every frame: a folder with probe.txt "
+                     "(\"timestamp filename\" lines), such a list, one image (.hdr, .exr, or 8-bit .png/.jpg), a video "
+                     "file, or a camera (/dev/videoN or N). Default: the sequence's probe.txt or probe.hdr");
+  ProbeInputOptions& probe = options.probe_input;
+  command
+      .add_option("--probe-rotation", probe.rotation_degrees,
+                  "Probe-to-world rotation rx,ry,rz in degrees (x, then y, then z); default: the probe looks up "
+                  "along world +z with its image x along world x")
+      ->expected(3)
+      ->delimiter(',');
+  add_choice_option(command, "--probe-projection", probe.projection, kProbeProjectionNames,
+                    "The probe's projection: auto (lat-long when twice as wide as tall, else an equidistant fisheye "
+                    "whose image circle touches the borders), fisheye, latlong");
+  command.add_option("--probe-fov", probe.fov_degrees, "Fisheye probe: full field of view in degrees")
+      ->capture_default_str();
+  command.add_option("--probe-response", probe.response,
+                     "8-bit probes: response curve file, 256 lines \"r g b\" of linear radiance (default: sRGB)");
+  command
+      .add_option("--probe-exposure", probe.exposure,
+                  "8-bit probes: relative exposure (radiance = response / exposure)")
+      ->capture_default_str();
+  command
+      .add_option("--probe-tolerance", probe.tolerance_s,
+                  "Seconds a probe frame may be from its RGB-D frame; farther, the last probe is kept")
+      ->capture_default_str();
+  command
+      .add_option("--probe-offset", probe.offset_s,
+                  "Video probes: seconds from the first RGB-D frame to the video's first frame")
+      ->capture_default_str();
+  command.add_option("--probe-lights", probe.lights, "Real lights extracted from the probe every frame")
+      ->capture_default_str();
   command.add_option("--virtual-light", options.virtual_lights, "A virtual point light x,y,z,intensity[,r,g,b] (repeatable)");
   command.add_option("--virtual-spot", options.virtual_spots,
                      "A virtual spot light x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b] aimed at "

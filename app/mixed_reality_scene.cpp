@@ -61,29 +61,15 @@ render::MrLight parse_virtual_spot(const std::string& text) {
                             parse_intensity("--virtual-spot", text, v, 7), false);
 }
 
-lights::LightSet real_light_set(bool synthetic, const fs::path& sequence, const fs::path& lights_file) {
+lights::LightSet real_light_set(const fs::path& sequence, const fs::path& lights_file) {
   if (!lights_file.empty()) return lights::lights_from_json(read_text_file(lights_file), lights_file.string());
   const fs::path probe = sequence / "probe.hdr";
-  if (!synthetic || !fs::is_regular_file(probe))
+  if (!fs::is_regular_file(probe))
     throw Error(sequence.string() + " has no light probe: give its lights with --lights FILE (from `relight lights`)");
-  // The product's own path: lights importance-sampled from the sequence's probe (sky, walls and
-  // the lamps as directional lights), as `relight lights PROBE --n 8` would give.
   const RadianceImage image = read_radiance(probe);
   lights::LightExtractionOptions options;
   options.lights = 8;
   options.calibration = lights::ProbeCalibration::centred_fisheye(image.width(), image.height());
-  try {
-    return lights::extract_lights(image, options);
-  } catch (const Error& error) {
-    throw Error(probe.string() + ": " + error.what());
-  }
-}
-
-lights::LightSet lights_from_latlong_probe(const fs::path& probe, int count) {
-  const RadianceImage image = read_radiance(probe);
-  lights::LightExtractionOptions options;
-  options.lights = count;
-  options.calibration = lights::ProbeCalibration::equirectangular();
   try {
     return lights::extract_lights(image, options);
   } catch (const Error& error) {

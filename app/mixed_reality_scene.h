@@ -30,14 +30,10 @@ inline constexpr float kSpotInnerFraction = 0.8f;
 /// kSpotInnerFraction of it), intensity * (r,g,b) W/sr on its axis.
 [[nodiscard]] render::MrLight parse_virtual_spot(const std::string& text);
 
-/// The measured lights of a sequence: the lights JSON of `relight lights` when given, else for a
-/// synthetic sequence 8 lights extracted from its probe.hdr. Throws relight::Error when there
-/// is neither.
-[[nodiscard]] lights::LightSet real_light_set(bool synthetic, const std::filesystem::path& sequence,
+/// The measured lights of a recorded sequence: the lights JSON of `relight lights` when given,
+/// else 8 lights extracted from the sequence's probe.hdr (a centred 180-degree fisheye looking up,
+/// as `relight synth` writes it). Throws relight::Error when there is neither.
+[[nodiscard]] lights::LightSet real_light_set(const std::filesystem::path& sequence,
                                               const std::filesystem::path& lights_file);
-
-/// 8 lights importance-sampled from a lat-long (equirectangular) HDR probe, as `relight lights
-/// PROBE --n 8` gives them.
-[[nodiscard]] lights::LightSet lights_from_latlong_probe(const std::filesystem::path& probe, int count);
 
 }  // namespace relight::app

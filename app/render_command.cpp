@@ -60,7 +60,7 @@ MrScene real_scene(const RenderReferenceOptions& command, bool synthetic, const 
     return truth::scene_from_synth(synth::default_indoor_scene());
   }
   MrScene scene;
-  render::add_lights(scene, real_light_set(false, command.sequence, command.lights));
+  render::add_lights(scene, real_light_set(command.sequence, command.lights));
   render::DepthMeshMaterials materials;
   materials.material = scene.add_material({{{0.5f, 0.5f, 0.5f}, 0.f, 1.f}, "reconstruction", {0.f, 0.f, 0.f}});
   scene.meshes.push_back(render::mesh_from_positions(render::positions_from_depth(frame.depth, sequence.intrinsics()),

@@ -152,17 +152,11 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   if (!(options.exposure > 0.f)) throw Error("--exposure must be positive");
   const auto scene = scene_folder(options);
   const bool synthetic = scene && scene->extension() != ".oni" && is_synthetic(*scene);
-  if (!scene && options.lights.empty()) {
-    throw Error("the device " + options.live_device +
-                " serves no light probe: give its lights with --lights FILE (from `relight lights`)");
-  }
-  const lights::LightSet measured = options.lights.empty() && !options.latlong_probe.empty()
-                                        ? lights_from_latlong_probe(options.latlong_probe, 8)
-                                        : real_light_set(synthetic, scene.value_or(""), options.lights);
-  render::DirSceneContent content;
-  render::MrScene lights;
-  render::add_lights(lights, measured);
-  content.lights = lights.lights;
+  const RealLightSource real_lights =
+      real_light_source(options.lights, options.probe, scene,
+                        options.live_device.empty() ? scene.value_or("").string() + " has no light probe"
+                                                    : "the device " + options.live_device + " serves no light probe");
+  render::DirSceneContent content;  // the real lights come per frame from lights::kLights
   for (const std::string& light : options.virtual_lights) content.lights.push_back(parse_virtual_light(light));
   for (const std::string& spot : options.virtual_spots) content.lights.push_back(parse_virtual_spot(spot));
   auto requests = placement_requests(options.objects.size(), options.places, options.places_at,
@@ -180,7 +174,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   FrameGraph& graph = *pipeline.graph;
   if (!content.objects.empty())
     pipeline.placement = &graph.emplace<ObjectPlacementStage>(std::move(requests), std::move(names));
-  graph.emplace<ConstantStage<lights::LightSet>>(lights::kLights, measured);
+  pipeline.probe = add_real_light_stages(graph, real_lights, options.probe_input, per_pixel, pipeline.vulkan.get());
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
   graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
   render::DirStageOptions dir;
@@ -192,6 +186,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.source = options.vpl_source;
   dir.tone_map.exposure = options.exposure;
   dir.materials_buffer = brdf::kMaterials;
+  dir.real_lights_buffer = lights::kLights;
   if (pipeline.placement) dir.placements_buffer = render::kObjectPlacements;
   if (options.real_albedo == RealAlbedo::Pixel) dir.albedo_buffers = render::RealAlbedoBuffers{};
   // The measured lights are several soft directional lights (8 from a probe): 256 texels per view
@@ -273,6 +268,7 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
     std::cerr << pipeline.markers->no_tag_warning(marker_layout_name(options));
   }
   report["tracking"] = pipeline.trajectory->summary();
+  if (pipeline.probe) report["probe"] = pipeline.probe->summary();
   report["latency_ms"] = pipeline.latency->summary();
   if (pipeline.placement) {
     report["placements"] = pipeline.placement->summary();
@@ -288,7 +284,9 @@ ReplayOptions with_main_job_defaults(ReplayOptions options) {
   options.objects = {data_folder() / "models" / "glossy_pebble.gltf"};
   options.places_on_plane = {""};
   // The sample was recorded without a light probe: the shipped Grace Cathedral probe stands in.
-  if (options.lights.empty()) options.latlong_probe = data_folder() / "probes" / "grace_latlong.hdr";
+  if (options.lights.empty() && options.probe.empty()) {
+    options.probe = (data_folder() / "probes" / "grace_latlong.hdr").string();
+  }
   return options;
 }
 

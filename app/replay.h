@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "buffer_previews.h"
+#include "probe_input.h"
 #include "relight/capture/camera_pose.h"
 #include "relight/capture/frame_source.h"
 #include "relight/colormap/colormap_stages.h"
@@ -70,10 +71,12 @@ struct ReplayOptions {
   /// The main job (`relight replay` on the embedded sample with nothing to render) renders the
   /// shipped pebble on the sample's support plane, lit by the shipped probe; this turns it off.
   bool no_object = false;
-  std::filesystem::path lights;                ///< lights JSON of `relight lights` (recorded sequences)
-  /// A lat-long HDR probe the real lights are extracted from (8 lights) when there is no
-  /// `lights` file: the main job's stand-in for a sample recorded without a probe.
-  std::filesystem::path latlong_probe;
+  std::filesystem::path lights;  ///< lights JSON of `relight lights`: constant real lights
+  /// The light probe stream the real lights are extracted from every frame (app/probe_input.h):
+  /// a folder with probe.txt, a list, an image, a video or a camera; empty: the sequence's own
+  /// probe.txt or probe.hdr. The main job's sample, recorded without one, gets a stand-in.
+  std::string probe;
+  ProbeInputOptions probe_input;
   std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]
   std::vector<std::string> virtual_spots;      ///< x,y,z,tx,ty,tz,angle,intensity[,r,g,b]
   int vpls = 64;                               ///< first-bounce light samples per frame
@@ -113,6 +116,7 @@ struct ReplayPipeline {
   app::CameraTrajectoryStage* trajectory = nullptr;  ///< the tracked pose of every frame
   app::ObjectPlacementStage* placement = nullptr;  ///< set when there are virtual objects
   app::LatencyStage* latency = nullptr;           ///< capture to final picture, every frame
+  lights::ProbeStreamStage* probe = nullptr;      ///< set when the real lights come from a probe
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".

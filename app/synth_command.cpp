@@ -28,6 +28,7 @@ struct SynthCommandOptions {
   double exposure = 1.0;
   int threads = 0;
   ImageSize size = ImageSize::Vga;
+  synth::LightAnimationOptions light_animation;
   bool no_ground_truth = false;
   bool quiet = false;
 };
@@ -46,6 +47,7 @@ int run_synth(const SynthCommandOptions& command) {
     options.height = 240;
   }
   options.ground_truth = !command.no_ground_truth;
+  options.light_animation = command.light_animation;
 
   ProgressBar progress("synth", command.frames, command.quiet);
   const auto start = std::chrono::steady_clock::now();
@@ -80,6 +82,23 @@ void register_synth(CLI::App& app, Runners& runners) {
       ->capture_default_str();
   add_choice_option(*synth, "--size", options->size, kImageSizeNames,
                     "Image size: 640x480 (Kinect v1) or 320x240 (its QVGA mode, the intrinsics halved)");
+  add_choice_option(*synth, "--light-animation", options->light_animation.kind, synth::kLightAnimationNames,
+                    "Real light that changes: the key light switches on or off at --light-event-frame, dims to "
+                    "--light-dim-to, or orbits by --light-orbit-degrees; writes probe.txt + probe/ (the probe "
+                    "of every frame) and gt/lights/ (the true lights of every frame)");
+  synth
+      ->add_option("--light-event-frame", options->light_animation.event_frame,
+                   "Frame at which the light switches (default: half way)")
+      ->check(CLI::NonNegativeNumber);
+  synth
+      ->add_option("--light-dim-to", options->light_animation.dim_to,
+                   "Last frame's intensity factor of --light-animation dim")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  synth
+      ->add_option("--light-orbit-degrees", options->light_animation.orbit_degrees,
+                   "Turn of the light about the table's vertical axis over the sequence (--light-animation orbit)")
+      ->capture_default_str();
   synth->add_option("--threads", options->threads, "Render threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   synth->add_flag("--no-gt", options->no_ground_truth, "Skip the gt/ folder");
   synth->add_flag("--quiet", options->quiet, "No progress or summary on stderr");

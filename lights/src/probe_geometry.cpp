@@ -47,18 +47,27 @@ ProbeCalibration ProbeCalibration::equirectangular() {
 ProbeGeometry::ProbeGeometry(const ProbeCalibration& calibration, int width, int height)
     : calibration_(calibration), width_(width), height_(height) {
   if (width <= 0 || height <= 0) throw Error("light probe: empty image");
+  if (calibration_.projection == ProbeProjection::FromAspect) {
+    calibration_.projection = width == 2 * height ? ProbeProjection::Equirectangular : ProbeProjection::Fisheye;
+  }
+  if (calibration.centred_on_image) {
+    const ProbeCalibration centred = ProbeCalibration::centred_fisheye(width, height);
+    calibration_.fisheye.cx = centred.fisheye.cx;
+    calibration_.fisheye.cy = centred.fisheye.cy;
+    calibration_.fisheye.radius = centred.fisheye.radius;
+  }
   calibration_.fisheye.width = width;
   calibration_.fisheye.height = height;
-  if (calibration.projection == ProbeProjection::Fisheye &&
-      (!(calibration.fisheye.radius > 0.0) || !(calibration.fisheye.max_theta > 0.0) ||
-       calibration.fisheye.max_theta > kPi)) {
+  if (calibration_.projection == ProbeProjection::Fisheye &&
+      (!(calibration_.fisheye.radius > 0.0) || !(calibration_.fisheye.max_theta > 0.0) ||
+       calibration_.fisheye.max_theta > kPi)) {
     throw Error("light probe: fisheye radius and field of view must be positive (fov at most 360 degrees)");
   }
   solid_angle_.resize(static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
   for (int row = 0; row < height; ++row) {
     for (int col = 0; col < width; ++col) {
       double omega = 0.0;
-      if (calibration.projection == ProbeProjection::Fisheye) {
+      if (calibration_.projection == ProbeProjection::Fisheye) {
         omega = calibration_.fisheye.pixel_solid_angle(col, row);
       } else {
         const double theta = kPi * (row + 0.5) / height;

@@ -66,8 +66,14 @@ Json objects_json(const Scene& scene) {
 Json lights_json(const Scene& scene) {
   Json lights = Json::array();
   for (const PointLight& l : scene.lights) {
-    lights.push_back({{"type", "point"}, {"position", vec(l.position)}, {"direction", nullptr}, {"colour", vec(l.colour)},
-                      {"intensity", l.intensity}, {"units", "W/sr per unit colour"}, {"probe_radius", l.radius},
+    lights.push_back({{"type", "point"},
+                      {"position", vec(l.position)},
+                      {"direction", nullptr},
+                      {"colour", vec(l.colour)},
+                      {"intensity", l.intensity},
+                      {"power", vec(l.colour * l.intensity)},
+                      {"units", "W/sr per unit colour; power = colour * intensity"},
+                      {"probe_radius", l.radius},
                       {"real", true}});
   }
   return lights;
@@ -158,10 +164,26 @@ std::string scene_json(const Scene& scene, const SynthOptions& options) {
                {"environment", {{"type", "constant"}, {"radiance", vec(scene.environment)}}}};
   if (!scene.tags.empty()) json["tag"] = tag_json(scene.tags.front());
   json["probe"] = probe_json(default_probe(scene));
+  const LightAnimationOptions& animation = options.light_animation;
+  if (animation.kind != LightAnimation::None) {
+    json["light_animation"] = {{"kind", name_of(kLightAnimationNames, animation.kind)},
+                               {"light", animation.light},
+                               {"event_frame", light_event_frame(animation, options.frames)},
+                               {"dim_to", animation.dim_to},
+                               {"orbit_degrees", animation.orbit_degrees},
+                               {"probe_stream", "probe.txt"},
+                               {"lights_per_frame", "gt/lights/<timestamp>.json"}};
+  }
   json["ground_truth"] = {{"depth", "gt/depth/<timestamp>.exr"}, {"normals", "gt/normals/<timestamp>.exr"},
                           {"albedo", "gt/albedo/<timestamp>.png"}, {"material", "gt/material/<timestamp>.png"},
                           {"material_background", 0}};
   return json.dump(2) + "\n";
+}
+
+std::string frame_lights_json(const Scene& scene) {
+  return Json{{"lights", lights_json(scene)}, {"units", "point lights: power = radiant intensity, W/sr per channel"}}
+             .dump(2) +
+         "\n";
 }
 
 void validate_synth_options(const SynthOptions& options) {

@@ -44,6 +44,21 @@ inline const std::filesystem::path& synthetic_sequence() {
   return sequence;
 }
 
+/// A 3-frame `relight synth` sequence whose key light switches on at frame 1: with its probe
+/// stream (probe.txt, probe/*.hdr), made once; tests copy it before changing anything.
+inline const std::filesystem::path& animated_light_sequence() {
+  static test::TempDir dir;
+  static const std::filesystem::path sequence = [] {
+    const auto path = dir.path() / "animated";
+    const auto made = run_relight({"synth", "--quiet", "--frames", "3", "--size", "320x240", "--trajectory", "static",
+                                   "--noise", "none", "--no-gt", "--light-animation", "switch-on",
+                                   "--light-event-frame", "1", "--out", path.string()});
+    if (made.exit_code != 0) throw std::runtime_error("relight synth failed: " + made.err);
+    return path;
+  }();
+  return sequence;
+}
+
 inline std::filesystem::path copy_of_synthetic(const std::filesystem::path& folder) {
   std::filesystem::copy(synthetic_sequence(), folder, std::filesystem::copy_options::recursive);
   return folder;

@@ -1,11 +1,13 @@
 // Robustness matrix, light probes and lights: `relight lights` on a probe with NaN / inf pixels,
 // an all-black or all-saturated fisheye; a synthetic sequence whose own probe is black and a
 // broken lights JSON under replay --object. Each is one error line naming the file, exit 1, no
-// lights file and no preview.
+// lights file and no preview. The probe stream: an unsorted list or a listed file missing is one
+// error line; a black or saturated frame or an early end mid-stream is one warning and a finished run.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <limits>
+#include <sstream>
 
 #include "inputs.h"
 #include "outcome_checks.h"
@@ -88,6 +90,74 @@ TEST_F(ProbeRobustness, BlackSequenceProbeWhileRendering) {
                    (kData / "models" / "glossy_pebble.gltf").string(), "--vpls", "8", "--out", out.string()});
   expect_clean_error(run, 1, (sequence / "probe.hdr").string() + ": ", out);
   EXPECT_FALSE(std::filesystem::exists(out / "composite.mp4"));
+}
+
+// The probe stream (probe.txt beside the frames): a broken list is named before any frame runs;
+// a bad frame or an early end mid-stream keeps the last good probe, warns once and finishes.
+class ProbeStreamRobustness : public ProbeRobustness {
+ protected:
+  std::filesystem::path sequence() {
+    auto copy = dir.path() / "animated";
+    if (!std::filesystem::exists(copy)) {
+      std::filesystem::copy(animated_light_sequence(), copy, std::filesystem::copy_options::recursive);
+    }
+    return copy;
+  }
+  /// The listed probe files, in order.
+  std::vector<std::string> listed(const std::filesystem::path& folder) {
+    std::vector<std::string> lines;
+    std::istringstream in(read_text_file(folder / "probe.txt"));
+    for (std::string line; std::getline(in, line);)
+      if (!line.empty() && line[0] != '#') lines.push_back(line);
+    return lines;
+  }
+  RunOutcome replay(const std::filesystem::path& folder) {
+    return run_relight({"replay", "--quiet", folder.string(), "--object",
+                        (kData / "models" / "glossy_pebble.gltf").string(), "--vpls", "8", "--no-video", "--out",
+                        out.string()});
+  }
+  void expect_warned_once(const RunOutcome& run, const std::string& part) {
+    expect_clean_success(run, out);
+    EXPECT_EQ(count_lines_starting(run.err, "relight: warning: "), 1u) << describe(run);
+    EXPECT_NE(run.err.find(part), std::string::npos) << describe(run);
+    EXPECT_TRUE(std::filesystem::exists(out / "report.json"));
+  }
+};
+
+TEST_F(ProbeStreamRobustness, UnsortedList) {
+  const auto folder = sequence();
+  const auto lines = listed(folder);
+  write_file_atomically(folder / "probe.txt", lines[1] + "\n" + lines[0] + "\n" + lines[2] + "\n");
+  expect_clean_error(replay(folder), 1, (folder / "probe.txt").string() + " line 2", out);
+}
+
+TEST_F(ProbeStreamRobustness, ListedFileMissing) {
+  const auto folder = sequence();
+  const std::string missing = listed(folder)[2].substr(listed(folder)[2].find(' ') + 1);
+  std::filesystem::remove(folder / missing);
+  expect_clean_error(replay(folder), 1, missing, out);
+}
+
+TEST_F(ProbeStreamRobustness, BlackFrameMidStream) {
+  const auto folder = sequence();
+  const std::string second = listed(folder)[1].substr(listed(folder)[1].find(' ') + 1);
+  write_radiance(folder / second, RadianceImage(64, 64, Float3{0.f, 0.f, 0.f}));
+  expect_warned_once(replay(folder), "black");
+}
+
+TEST_F(ProbeStreamRobustness, AllClippedFrameMidStream) {
+  const auto folder = sequence();
+  const auto lines = listed(folder);
+  write_color(folder / "clipped.png", ColorImage(64, 64, Rgb8{255, 255, 255}));
+  const std::string timestamp = lines[1].substr(0, lines[1].find(' '));
+  write_file_atomically(folder / "probe.txt", lines[0] + "\n" + timestamp + " clipped.png\n" + lines[2] + "\n");
+  expect_warned_once(replay(folder), "saturated");
+}
+
+TEST_F(ProbeStreamRobustness, StreamEndsEarly) {
+  const auto folder = sequence();
+  write_file_atomically(folder / "probe.txt", listed(folder)[0] + "\n");
+  expect_warned_once(replay(folder), "ended");
 }
 
 // The lights of a recorded sequence come from a JSON file of `relight lights`: a broken one is

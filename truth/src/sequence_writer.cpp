@@ -20,20 +20,24 @@ RadianceImage as_radiance_image(const NormalMap& normals) {
   return image;
 }
 
+std::string stem_of(Timestamp timestamp) { return fs::path(capture::TumWriter::file_name(timestamp)).stem().string(); }
+
 void write_ground_truth(const fs::path& out, Timestamp timestamp, const synth::RenderedFrame& frame) {
-  const std::string stem = fs::path(capture::TumWriter::file_name(timestamp)).stem().string();
+  const std::string stem = stem_of(timestamp);
   write_depth_exr(out / "gt" / "depth" / (stem + ".exr"), frame.depth);
   write_radiance(out / "gt" / "normals" / (stem + ".exr"), as_radiance_image(frame.normals));
   write_color(out / "gt" / "albedo" / (stem + ".png"), synth::encode_albedo(frame.albedo));
   write_label_png(out / "gt" / "material" / (stem + ".png"), frame.material);
 }
 
-void create_folders(const fs::path& out, bool ground_truth) {
+void create_folders(const fs::path& out, const synth::SynthOptions& options, bool animated) {
   std::error_code ec;
   fs::create_directories(out, ec);
-  for (const char* sub : {"depth", "normals", "albedo", "material"}) {
-    if (ground_truth && !ec) fs::create_directories(out / "gt" / sub, ec);
+  for (const char* sub : {"depth", "normals", "albedo", "material", "lights"}) {
+    const bool wanted = options.ground_truth && (animated || std::string_view(sub) != "lights");
+    if (wanted && !ec) fs::create_directories(out / "gt" / sub, ec);
   }
+  if (animated && options.probe && !ec) fs::create_directories(out / "probe", ec);
   if (ec) throw Error("cannot create " + out.string() + ": " + ec.message());
 }
 
@@ -46,12 +50,17 @@ void write_sequence(const synth::SynthOptions& options, const fs::path& out, con
 void write_sequence(const synth::Scene& scene, const synth::SynthOptions& options, const fs::path& out,
                     const synth::SynthProgress& progress) {
   synth::validate_synth_options(options);
-  create_folders(out, options.ground_truth);
+  const bool animated = options.light_animation.kind != synth::LightAnimation::None;
+  if (animated && options.frames > 0) (void)synth::scene_at_frame(scene, options.light_animation, 0, options.frames);
+  create_folders(out, options, animated);
   const PinholeIntrinsics intrinsics = synth::synth_intrinsics(options);
   const std::vector<Pose> poses = synth::make_trajectory(options.trajectory, options.frames, options.seed, scene);
   capture::TumWriter writer(out, synth::kSynthDepthScale);
+  std::string probe_list = "# relight synth: the light probe of every frame (timestamp filename)\n";
   for (int i = 0; i < options.frames; ++i) {
-    const synth::RenderedFrame frame = synth::render_frame(scene, intrinsics, poses[static_cast<std::size_t>(i)], options.threads);
+    const synth::Scene frame_scene = synth::scene_at_frame(scene, options.light_animation, i, options.frames);
+    const synth::RenderedFrame frame =
+        synth::render_frame(frame_scene, intrinsics, poses[static_cast<std::size_t>(i)], options.threads);
     const DepthMap depth = options.noise == synth::NoiseModel::None
                                ? frame.depth
                                : synth::apply_kinect_noise(frame.depth, frame.normals, intrinsics, options.kinect,
@@ -59,10 +68,28 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
     const Timestamp timestamp = synth::frame_timestamp(i);
     writer.add(timestamp, synth::encode_color(frame.radiance, options.color), depth, poses[static_cast<std::size_t>(i)]);
     if (options.ground_truth) write_ground_truth(out, timestamp, frame);
+    if (animated) {
+      const std::string stem = stem_of(timestamp);
+      if (options.ground_truth) {
+        write_file_atomically(out / "gt" / "lights" / (stem + ".json"), synth::frame_lights_json(frame_scene));
+      }
+      if (options.probe) {
+        const std::string name = "probe/" + stem + ".hdr";
+        write_radiance(out / name,
+                       synth::render_probe(frame_scene, synth::default_probe(frame_scene), options.threads));
+        probe_list.append(stem).append(" ").append(name).append("\n");
+      }
+    }
     if (progress) progress(i + 1, options.frames);
   }
   writer.finish();
-  if (options.probe) write_radiance(out / "probe.hdr", synth::render_probe(scene, synth::default_probe(scene), options.threads));
+  if (options.probe) {
+    const synth::Scene first = animated && options.frames > 0
+                                   ? synth::scene_at_frame(scene, options.light_animation, 0, options.frames)
+                                   : scene;
+    write_radiance(out / "probe.hdr", synth::render_probe(first, synth::default_probe(first), options.threads));
+    if (animated) write_file_atomically(out / "probe.txt", probe_list);
+  }
   write_file_atomically(out / "scene.json", synth::scene_json(scene, options));
 }
 

@@ -4,6 +4,7 @@
 #include "relight/render/dir/camera_albedo.h"
 #include "relight/render/dir/composite.h"
 #include "relight/render/reference/ray_tracer.h"
+#include "relight/render/scene/scene_lights.h"
 
 namespace relight::render {
 
@@ -57,7 +58,8 @@ MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& optio
       mesh_(options.mesh),
       reconstruction_material_(options.reconstruction_material),
       materials_buffer_(options.materials_buffer),
-      placements_buffer_(options.placements_buffer) {}
+      placements_buffer_(options.placements_buffer),
+      real_lights_buffer_(options.real_lights_buffer) {}
 
 void MrSceneStage::declare(StageBuilder& builder) {
   frame_ = builder.read(kFrame);
@@ -65,6 +67,7 @@ void MrSceneStage::declare(StageBuilder& builder) {
   normals_ = builder.read(kNormals);
   if (materials_buffer_) materials_ = builder.read(*materials_buffer_);
   if (placements_buffer_) placements_ = builder.read(*placements_buffer_);
+  if (real_lights_buffer_) real_lights_ = builder.read(*real_lights_buffer_);
   scene_ = builder.write(kMrScene);
 }
 
@@ -83,7 +86,8 @@ void MrSceneStage::run(StageContext& context) {
   TriangleMesh mesh = mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, mesh_);
   mesh.name = "reconstruction";
   scene.meshes.push_back(std::move(mesh));
-  scene.lights = content_.lights;
+  if (real_lights_buffer_) add_lights(scene, context.get(real_lights_));
+  scene.lights.insert(scene.lights.end(), content_.lights.begin(), content_.lights.end());
   if (!placements_buffer_) {
     for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
     return;

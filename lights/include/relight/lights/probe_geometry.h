@@ -21,12 +21,17 @@
 
 namespace relight::lights {
 
-enum class ProbeProjection { Fisheye, Equirectangular };
+/// FromAspect: equirectangular when the image is twice as wide as tall, else fisheye (resolved
+/// by ProbeGeometry, whose calibration() is then one of the other two).
+enum class ProbeProjection { Fisheye, Equirectangular, FromAspect };
 
 struct ProbeCalibration {
   ProbeProjection projection = ProbeProjection::Fisheye;
   /// Fisheye only: centre, radius and field of view (width/height come from the image).
   FisheyeCamera fisheye{};
+  /// Fisheye only: the image circle touches the image's borders, whatever its size (centre and
+  /// radius of `fisheye` are then taken from the image, as centred_fisheye does).
+  bool centred_on_image = false;
   Eigen::Matrix3d probe_to_world = Eigen::Matrix3d::Identity();
 
   /// A 180-degree fisheye whose image circle touches the borders of a width x height image.

@@ -8,6 +8,8 @@
 //   gt/albedo/<t>.png    k_d, sRGB-encoded 8 bit
 //   gt/material/<t>.png  16-bit material index + 1 (0 = nothing hit; see scene.json)
 //   probe.hdr            the fisheye light probe (probe.h), linear radiance
+//   probe.txt, probe/<t>.hdr, gt/lights/<t>.json   with a light animation: the per-frame probe
+//                        stream and the true lights of each frame (SynthOptions::light_animation)
 //   scene.json           intrinsics, depth_scale, world_up, materials, objects, lights,
 //                        environment, tag (corners and pose), noise, seed, trajectory, probe
 // where <t> is TumWriter::file_name(timestamp) without its extension. Colour and depth come from
@@ -21,6 +23,7 @@
 
 #include "relight/core/camera.h"
 #include "relight/synth/kinect_noise.h"
+#include "relight/synth/light_animation.h"
 #include "relight/synth/probe.h"
 #include "relight/synth/raycast.h"
 #include "relight/synth/scene.h"
@@ -43,6 +46,10 @@ struct SynthOptions {
   int threads = 0;  ///< 0 = all hardware threads
   bool ground_truth = true;
   bool probe = true;
+  /// Real light that changes (light_animation.h). When animated, every frame also has its probe
+  /// (probe/<t>.hdr, listed in probe.txt as "timestamp filename") and its true lights
+  /// (gt/lights/<t>.json, relight's lights format); probe.hdr is frame 0's.
+  LightAnimationOptions light_animation;
 };
 
 /// Kinect v1 intrinsics (PinholeIntrinsics::kinect_v1) scaled to options.width x height.
@@ -50,6 +57,10 @@ struct SynthOptions {
 
 /// The text of scene.json for this scene and these options.
 [[nodiscard]] std::string scene_json(const Scene& scene, const SynthOptions& options);
+
+/// {"lights": [...]} of the scene's lights as scene.json has them, with "power" (colour *
+/// intensity): what lights::lights_from_json (and so `relight replay --lights`) reads.
+[[nodiscard]] std::string frame_lights_json(const Scene& scene);
 
 /// Throws relight::Error for options that cannot make a sequence (negative frames, size < 2x2,
 /// gains or exposure not positive).

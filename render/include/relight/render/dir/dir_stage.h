@@ -5,9 +5,11 @@
 //   mr_scene                 reads  FrameInfo "frame" (camera_to_world: identity when absent),
 //                                   PositionMap "positions" and NormalMap "normals" (camera frame,
 //                                   reconstruct/), brdf::Materials when `materials_buffer` is set,
-//                                   ObjectPlacements when `placements_buffer` is set
+//                                   ObjectPlacements when `placements_buffer` is set,
+//                                   lights::LightSet when `real_lights_buffer` is set
 //                            writes MrScene "mr_scene": the reconstruction's position map as the
-//                                   real mesh, the configured real and virtual lights, the
+//                                   real mesh, that frame's real lights (when set) and the
+//                                   configured real and virtual lights, the
 //                                   configured virtual objects (at the placements of that
 //                                   buffer when set, none while it is unresolved)
 //   vpls                     reads  MrScene "mr_scene"; with VplBudget::ByPreviousFlux also the
@@ -52,6 +54,7 @@
 #include "relight/core/frame_graph.h"
 #include "relight/core/rgbd_frame.h"
 #include "relight/core/stage_backend.h"
+#include "relight/lights/light_set.h"
 #include "relight/render/buffers.h"
 #include "relight/render/dir/dir_vk.h"
 #include "relight/render/dir/temporal_smoothing.h"
@@ -79,6 +82,9 @@ struct DirStageOptions {
   /// ObjectPlacements of the objects (virtual_model.h), e.g. resolved on a real surface at the
   /// first frame; none: the placements in DirSceneContent.
   std::optional<BufferName<ObjectPlacements>> placements_buffer;
+  /// The frame's real lights (e.g. lights::kLights, extracted from the probe every frame), put
+  /// before DirSceneContent::lights; none: DirSceneContent's lights alone.
+  std::optional<BufferName<lights::LightSet>> real_lights_buffer;
   /// Per-pixel k_d of the camera's real surfaces, modulating the cluster k_d of diffuse real
   /// surfaces (camera_albedo.h); none: the clusters' k_d alone.
   std::optional<RealAlbedoBuffers> albedo_buffers;
@@ -88,7 +94,7 @@ struct DirStageOptions {
 
 /// What the stages add to every frame's real geometry.
 struct DirSceneContent {
-  std::vector<MrLight> lights;  ///< real (measured) and virtual lights
+  std::vector<MrLight> lights;  ///< real lights that do not change, and virtual lights
   std::vector<std::pair<VirtualModel, Placement>> objects;
 };
 
@@ -111,11 +117,13 @@ class MrSceneStage final : public Stage {
   PhongMaterial reconstruction_material_;
   std::optional<BufferName<brdf::Materials>> materials_buffer_;
   std::optional<BufferName<ObjectPlacements>> placements_buffer_;
+  std::optional<BufferName<lights::LightSet>> real_lights_buffer_;
   Read<FrameInfo> frame_;
   Read<PositionMap> positions_;
   Read<NormalMap> normals_;
   Read<brdf::Materials> materials_;
   Read<ObjectPlacements> placements_;
+  Read<lights::LightSet> real_lights_;
   Write<MrScene> scene_;
 };
 

@@ -1,0 +1,81 @@
+#include "probe_input.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+
+#include "constant_stage.h"
+#include "relight/core/atomic_file.h"
+#include "relight/core/error.h"
+#include "relight/lights/light_output.h"
+#include "relight/lights/light_smoothing.h"
+#include "relight/lights/light_stages.h"
+#include "video_probe_stream.h"
+
+namespace relight::app {
+
+namespace fs = std::filesystem;
+
+lights::ProbeCalibration probe_calibration(const ProbeInputOptions& options) {
+  lights::ProbeCalibration calibration;
+  calibration.projection = options.projection;
+  calibration.centred_on_image = true;
+  if (!(options.fov_degrees > 0.0 && options.fov_degrees <= 360.0)) {
+    throw Error("--probe-fov must be in (0, 360] degrees");
+  }
+  calibration.fisheye.max_theta = 0.5 * options.fov_degrees * std::numbers::pi / 180.0;
+  if (!options.rotation_degrees.empty()) {
+    if (options.rotation_degrees.size() != 3) throw Error("--probe-rotation needs three angles rx,ry,rz in degrees");
+    const auto radians = [&](std::size_t i) { return options.rotation_degrees[i] * std::numbers::pi / 180.0; };
+    for (double angle : options.rotation_degrees) {
+      if (!std::isfinite(angle)) throw Error("--probe-rotation: the angles must be finite");
+    }
+    calibration.probe_to_world = (Eigen::AngleAxisd(radians(2), Eigen::Vector3d::UnitZ()) *
+                                  Eigen::AngleAxisd(radians(1), Eigen::Vector3d::UnitY()) *
+                                  Eigen::AngleAxisd(radians(0), Eigen::Vector3d::UnitX()))
+                                     .toRotationMatrix();
+  }
+  return calibration;
+}
+
+RealLightSource real_light_source(const fs::path& lights_file, const std::string& probe,
+                                  const std::optional<fs::path>& scene, const std::string& no_probe) {
+  if (!lights_file.empty()) return {lights_file, {}};
+  if (!probe.empty()) return {{}, probe};
+  std::error_code ec;
+  if (scene && scene->extension() != ".oni") {
+    if (fs::is_regular_file(*scene / "probe.txt", ec)) return {{}, (*scene / "probe.txt").string()};
+    if (fs::is_regular_file(*scene / "probe.hdr", ec)) return {{}, (*scene / "probe.hdr").string()};
+  }
+  throw Error(no_probe +
+              ": give one with --probe PATH|DEVICE or its lights with --lights FILE "
+              "(from `relight lights`)");
+}
+
+lights::ProbeStreamStage* add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
+                                                const ProbeInputOptions& options, Backend per_pixel,
+                                                vk::VulkanContext* context) {
+  if (!source.lights_file.empty()) {
+    graph.emplace<ConstantStage<lights::LightSet>>(
+        lights::kLights, lights::lights_from_json(read_text_file(source.lights_file), source.lights_file.string()));
+    return nullptr;
+  }
+  if (options.lights < 1 || options.lights > 4096) throw Error("--probe-lights must be 1 to 4096");
+  if (!(options.tolerance_s >= 0.0)) throw Error("--probe-tolerance must not be negative");
+  lights::ProbeResponse response =
+      options.response.empty() ? lights::ProbeResponse{} : lights::read_probe_response(options.response);
+  if (!(options.exposure > 0.0)) throw Error("--probe-exposure must be positive");
+  response.exposure = options.exposure;
+  lights::ProbeMatchOptions matching;
+  matching.tolerance_s = options.tolerance_s;
+  matching.offset_s = options.offset_s;
+  auto& probe = graph.emplace<lights::ProbeStreamStage>(open_probe_input(source.probe, response), matching);
+  lights::LightExtractionOptions extraction;
+  extraction.lights = options.lights;
+  extraction.calibration = probe_calibration(options);
+  graph.add(lights::make_light_extraction_stage(per_pixel, context, extraction));
+  graph.emplace<lights::LightSmoothingStage>();
+  return &probe;
+}
+
+}  // namespace relight::app

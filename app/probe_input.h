@@ -1,0 +1,58 @@
+#pragma once
+// The real lights of a `replay` or `live` run, as frame-graph stages: a constant set from a
+// lights file, or the light probe stream turned into lights every frame:
+//   probe_stream (lights/probe_stream_stage.h) -> light_extraction -> light_smoothing -> "lights"
+// (Knecht 2010 §6, dissertation §4.2: the lights follow a probe camera; the smoothing keeps a
+// static probe's lights identical and lets a switched lamp through at once).
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "relight/core/frame_graph.h"
+#include "relight/core/stage_backend.h"
+#include "relight/lights/probe_geometry.h"
+#include "relight/lights/probe_stream_stage.h"
+
+namespace relight::app {
+
+inline constexpr std::array<NamedValue<lights::ProbeProjection>, 3> kProbeProjectionNames{
+    {{"auto", lights::ProbeProjection::FromAspect},
+     {"fisheye", lights::ProbeProjection::Fisheye},
+     {"latlong", lights::ProbeProjection::Equirectangular}}};
+
+/// How the probe is read and where it looks (replay's --probe-* options).
+struct ProbeInputOptions {
+  /// Probe-to-world rotation, degrees about x, then y, then z (world = Rz Ry Rx probe); empty:
+  /// identity (a fisheye looking up along world +z with image x = world x, as `relight synth`'s).
+  std::vector<double> rotation_degrees;
+  lights::ProbeProjection projection = lights::ProbeProjection::FromAspect;
+  double fov_degrees = 180.0;      ///< fisheye: the image circle's full field of view
+  std::filesystem::path response;  ///< 8-bit probes: response curve file (empty: sRGB)
+  double exposure = 1.0;           ///< 8-bit probes: relative exposure
+  double tolerance_s = 0.05;       ///< timestamp matching (probe_stream.h)
+  double offset_s = 0.0;           ///< video probes: start relative to the first RGB-D frame
+  int lights = 8;                  ///< lights extracted per frame
+};
+
+/// The calibration the options describe; throws relight::Error on a bad rotation or field of view.
+[[nodiscard]] lights::ProbeCalibration probe_calibration(const ProbeInputOptions& options);
+
+/// Where the real lights of a run come from.
+struct RealLightSource {
+  std::filesystem::path lights_file;  ///< constant lights (`relight lights` JSON); else the probe
+  std::string probe;                  ///< probe spec (video_probe_stream.h: open_probe_input)
+};
+
+/// --lights, else --probe, else `scene`'s probe.txt, else its probe.hdr; when there is none,
+/// throws relight::Error("<no_probe>: give one with --probe ... or its lights with --lights ...").
+[[nodiscard]] RealLightSource real_light_source(const std::filesystem::path& lights_file, const std::string& probe,
+                                                const std::optional<std::filesystem::path>& scene,
+                                                const std::string& no_probe);
+
+/// Adds the stages that write lights::kLights; returns the probe stage (nullptr for a lights file).
+lights::ProbeStreamStage* add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
+                                                const ProbeInputOptions& options, Backend per_pixel,
+                                                vk::VulkanContext* context);
+
+}  // namespace relight::app
