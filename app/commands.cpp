@@ -111,15 +111,20 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--virtual-spot", options.virtual_spots,
                      "A virtual spot light x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b] aimed at "
                      "the target, with that cone half-angle (repeatable)");
+  command.add_option("--real-spot", options.real_spots,
+                     "A real spot light - a lamp of the real scene - as --virtual-spot: it lights real and virtual "
+                     "surfaces alike, and the virtual objects cast its shadows onto the real ones (repeatable)");
   command.add_option("--vpls", options.vpls, "Light samples for virtual point lights per frame")
       ->check(CLI::Range(0, 4096))
       ->capture_default_str();
   add_choice_option(command, "--vpl-budget", options.vpl_budget, render::kVplBudgetNames,
                     "How the VPL samples are shared among the lights: equal, power (emitted power), weights "
                     "(--vpl-weights) or flux (the flux each light's VPLs carried last frame)");
-  command.add_option("--vpl-weights", options.vpl_weights,
-                     "With --vpl-budget weights: one weight per light, comma-separated (the lights file's order, "
-                     "then the --virtual-light ones, then the --virtual-spot ones; missing weights are 1)")
+  command
+      .add_option("--vpl-weights", options.vpl_weights,
+                  "With --vpl-budget weights: one weight per light, comma-separated (the real lights' order - "
+                  "the lights file's, or the probe's --probe-lights - then the --virtual-light ones, the "
+                  "--real-spot ones, the --virtual-spot ones; missing weights are 1)")
       ->delimiter(',')
       ->check(CLI::NonNegativeNumber);
   command.add_option("--vpl-bounces", options.vpl_bounces,

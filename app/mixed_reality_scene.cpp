@@ -49,16 +49,17 @@ render::MrLight parse_virtual_light(const std::string& text) {
   return light;
 }
 
-render::MrLight parse_virtual_spot(const std::string& text) {
-  const std::vector<float> v = parse_number_list<float>("--virtual-spot", text);
+render::MrLight parse_spot(const std::string& option, const std::string& text, bool real) {
+  const std::vector<float> v = parse_number_list<float>(option.c_str(), text);
+  const std::string what = option + " '" + text + "'";
   if (v.size() != 8 && v.size() != 11)
-    throw Error("--virtual-spot '" + text + "' needs x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b]");
+    throw Error(what + " needs x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b]");
   const Eigen::Vector3f position(v[0], v[1], v[2]);
   const Eigen::Vector3f axis = Eigen::Vector3f(v[3], v[4], v[5]) - position;
-  if (!(axis.norm() > 1e-6f)) throw Error("--virtual-spot '" + text + "': the target is the light's position");
-  if (!(v[6] > 0.f && v[6] < 90.f)) throw Error("--virtual-spot '" + text + "': the angle must be in (0, 90) degrees");
+  if (!(axis.norm() > 1e-6f)) throw Error(what + ": the target is the light's position");
+  if (!(v[6] > 0.f && v[6] < 90.f)) throw Error(what + ": the angle must be in (0, 90) degrees");
   return render::spot_light(position, axis.normalized(), v[6], kSpotInnerFraction * v[6],
-                            parse_intensity("--virtual-spot", text, v, 7), false);
+                            parse_intensity(option.c_str(), text, v, 7), real);
 }
 
 lights::LightSet real_light_set(const fs::path& sequence, const fs::path& lights_file) {

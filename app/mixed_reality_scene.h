@@ -25,10 +25,15 @@ inline constexpr const char* kDefaultSynthPlacement = "0.35,-0.2,0.75,30";
 
 /// A spot's light fades out between this fraction of its angle and the whole angle.
 inline constexpr float kSpotInnerFraction = 0.8f;
-/// "x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b]": a virtual spot light at
-/// (x, y, z) aimed at the target, its cone's half-angle in (0, 90) degrees (full intensity within
-/// kSpotInnerFraction of it), intensity * (r,g,b) W/sr on its axis.
-[[nodiscard]] render::MrLight parse_virtual_spot(const std::string& text);
+/// "x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b]": a spot light at (x, y, z)
+/// aimed at the target, its cone's half-angle in (0, 90) degrees (full intensity within
+/// kSpotInnerFraction of it), intensity * (r,g,b) W/sr on its axis. `option` names it in errors
+/// (--virtual-spot, --real-spot); `real`: a lamp of the real scene (it lights both worlds of
+/// differential rendering and its RSMs are split by layer, reflective_shadow_map.h).
+[[nodiscard]] render::MrLight parse_spot(const std::string& option, const std::string& text, bool real);
+[[nodiscard]] inline render::MrLight parse_virtual_spot(const std::string& text) {
+  return parse_spot("--virtual-spot", text, false);
+}
 
 /// The measured lights of a recorded sequence: the lights JSON of `relight lights` when given,
 /// else 8 lights extracted from the sequence's probe.hdr (a centred 180-degree fisheye looking up,

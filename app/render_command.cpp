@@ -38,6 +38,7 @@ struct RenderReferenceOptions {
   fs::path lights;
   std::vector<std::string> virtual_lights;
   std::vector<std::string> virtual_spots;
+  std::vector<std::string> real_spots;
   int spp = 256;
   double time_budget = 0.0;
   int max_bounces = 4;
@@ -121,6 +122,7 @@ int run_render_reference(const RenderReferenceOptions& command) {
     render::add_virtual_model(scene, render::load_model(command.object), render::Placement::parse(placement_text));
   }
   for (const std::string& light : command.virtual_lights) scene.lights.push_back(parse_virtual_light(light));
+  for (const std::string& spot : command.real_spots) scene.lights.push_back(parse_spot("--real-spot", spot, true));
   for (const std::string& spot : command.virtual_spots) scene.lights.push_back(parse_virtual_spot(spot));
   const render::MrCamera camera{downsampled(sequence.intrinsics(), command.downsample), *frame.info.camera_to_world};
   render::PathTracerOptions options;
@@ -187,6 +189,8 @@ void register_render_reference(CLI::App& app, Runners& runners) {
   command->add_option("--virtual-spot", options->virtual_spots,
                       "A virtual spot light x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b] "
                       "(W/sr on its axis; repeat for more)");
+  command->add_option("--real-spot", options->real_spots,
+                      "A real spot light (a lamp of the real scene), as --virtual-spot (repeat for more)");
   command->add_option("--spp", options->spp, "Samples per pixel")->check(CLI::Range(1, 1 << 20))->capture_default_str();
   command->add_option("--time-budget", options->time_budget, "Stop after this many seconds (0 = no limit)")
       ->check(CLI::NonNegativeNumber);

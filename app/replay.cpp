@@ -158,6 +158,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
                                                     : "the device " + options.live_device + " serves no light probe");
   render::DirSceneContent content;  // the real lights come per frame from lights::kLights
   for (const std::string& light : options.virtual_lights) content.lights.push_back(parse_virtual_light(light));
+  for (const std::string& spot : options.real_spots) content.lights.push_back(parse_spot("--real-spot", spot, true));
   for (const std::string& spot : options.virtual_spots) content.lights.push_back(parse_virtual_spot(spot));
   auto requests = placement_requests(options.objects.size(), options.places, options.places_at,
                                      options.places_on_plane, kDefaultSynthPlacement, synthetic);

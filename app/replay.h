@@ -79,6 +79,7 @@ struct ReplayOptions {
   ProbeInputOptions probe_input;
   std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]
   std::vector<std::string> virtual_spots;      ///< x,y,z,tx,ty,tz,angle,intensity[,r,g,b]
+  std::vector<std::string> real_spots;         ///< the same, for lamps of the real scene
   int vpls = 64;                               ///< first-bounce light samples per frame
   render::VplBudget vpl_budget = render::VplBudget::ByPower;  ///< render/vpl/vpl.h
   std::vector<float> vpl_weights;              ///< per light (lights file order, then virtual lights)

@@ -131,6 +131,34 @@ TEST(DynamicLightCli, ALightSwitchedOffLeavesTheRenderWithinTwoFrames) {
   expect_light_follows_the_switch(run);
 }
 
+// A real lamp (--real-spot) beside the pebble: it lights the real table in both worlds (L_r
+// grows) and the pebble casts its shadow onto the table (L_r - L_rv grows), with the first VPLs
+// traced or taken from its two reflective shadow maps (real layer, virtual layer).
+TEST(DynamicLightCli, ARealSpotLightsTheTableAndThePebbleCastsItsShadow) {
+  test::TempDir dir;
+  const auto& sequence = cli_test::synthetic_sequence("--frames 2 --size 320x240 --trajectory static --no-gt");
+  const auto run = [&](const std::string& name, const std::string& extra) {
+    const auto out = dir.path() / name;
+    const auto result = relight("replay --quiet " + sequence.string() + " --object " +
+                                (kData / "models" / "glossy_pebble.gltf").string() + " --buffers --no-video --out " +
+                                out.string() + " " + extra);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    return result.exit_code == 0 ? frame_light(out / "frames", 1) : FrameLight{};
+  };
+  const FrameLight without = run("without", "");
+  for (const std::string source : {"rays", "rsm"}) {
+    SCOPED_TRACE(source);
+    const FrameLight with =
+        run("with_" + source, "--real-spot 0.95,-0.2,1.35,0.35,-0.2,0.75,30,3 --vpl-source " + source);
+    EXPECT_GT(with.real_light, 1.05 * without.real_light);
+    EXPECT_GT(with.shadow, 1.2 * without.shadow) << "the pebble's shadow of the lamp";
+  }
+  expect_one_line_error(relight("replay --quiet " + sequence.string() + " --object " +
+                                (kData / "models" / "glossy_pebble.gltf").string() +
+                                " --real-spot 0,0,1,0,0,1,30,1 --out " + (dir.path() / "bad").string()),
+                        1);
+}
+
 TEST(DynamicLightCli, ProbeInputErrorsAreOneLine) {
   test::TempDir dir;
   const auto& sequence = cli_test::synthetic_sequence("--frames 2 --size 320x240 --trajectory static --no-gt");
