@@ -1,6 +1,7 @@
 // `relight render-reference`: the differential path tracer's ground truth for one frame of a
 // sequence with a virtual object (render/path_tracer.h), and `relight models`: writes the
 // procedural virtual objects shipped in data/models/.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <iostream>
@@ -15,13 +16,14 @@
 #include "relight/core/error.h"
 #include "relight/core/image_io.h"
 #include "relight/core/progress.h"
-#include "relight/render/reference/path_tracer.h"
 #include "relight/render/dir/composite.h"
+#include "relight/render/reference/path_tracer.h"
 #include "relight/render/scene/depth_mesh.h"
 #include "relight/render/scene/model_io.h"
 #include "relight/render/scene/procedural_models.h"
-#include "relight/truth/scene_from_synth.h"
 #include "relight/render/scene/scene_lights.h"
+#include "relight/synth/light_animation.h"
+#include "relight/truth/scene_from_synth.h"
 
 namespace relight::app {
 
@@ -58,7 +60,12 @@ MrScene real_scene(const RenderReferenceOptions& command, bool synthetic, const 
     // The path tracer gets the synthetic scene's exact lights and sky.
     if (!command.lights.empty())
       throw Error("--lights applies to recorded sequences; a synthetic sequence brings its own lights");
-    return truth::scene_from_synth(synth::default_indoor_scene());
+    // With a light animation, the lights of this frame (synth/light_animation.h).
+    const fs::path scene_json = command.sequence / "scene.json";
+    const synth::SequenceLightAnimation animated =
+        synth::light_animation_of_scene_json(read_text_file(scene_json), scene_json.string());
+    return truth::scene_from_synth(synth::scene_at_frame(synth::default_indoor_scene(), animated.animation,
+                                                         command.frame, std::max(animated.frames, command.frame + 1)));
   }
   MrScene scene;
   render::add_lights(scene, real_light_set(command.sequence, command.lights));

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <string>
 
@@ -11,6 +12,28 @@ namespace relight::synth {
 
 int light_event_frame(const LightAnimationOptions& animation, int frames) {
   return animation.event_frame >= 0 ? animation.event_frame : frames / 2;
+}
+
+SequenceLightAnimation light_animation_of_scene_json(const std::string& text, const std::string& source) {
+  const nlohmann::json json = nlohmann::json::parse(text, nullptr, false);
+  if (json.is_discarded() || !json.is_object()) throw Error(source + ": not valid JSON");
+  SequenceLightAnimation out;
+  out.frames = json.value("frames", 0);
+  if (!json.contains("light_animation")) return out;
+  const nlohmann::json& section = json["light_animation"];
+  try {
+    out.animation.kind =
+        parse_named(kLightAnimationNames, "light_animation.kind", section.at("kind").get<std::string>());
+    out.animation.light = section.at("light").get<int>();
+    out.animation.event_frame = section.at("event_frame").get<int>();
+    out.animation.dim_to = section.at("dim_to").get<double>();
+    out.animation.orbit_degrees = section.at("orbit_degrees").get<double>();
+  } catch (const nlohmann::json::exception& error) {
+    throw Error(source + ": light_animation: " + error.what());
+  } catch (const Error& error) {
+    throw Error(source + ": " + error.what());
+  }
+  return out;
 }
 
 Scene scene_at_frame(const Scene& scene, const LightAnimationOptions& animation, int frame, int frames) {

@@ -102,6 +102,15 @@ TEST(LightAnimation, SequenceWritesTheProbeStreamAndTheTrueLightsOfEveryFrame) {
   const auto scene = nlohmann::json::parse(read_text_file(dir.path() / "scene.json"));
   EXPECT_EQ(scene["light_animation"]["kind"], "switch-on");
   EXPECT_EQ(scene["light_animation"]["event_frame"], 1);
+  // What render-reference reads back to light each frame as the sequence did.
+  const SequenceLightAnimation read =
+      light_animation_of_scene_json(read_text_file(dir.path() / "scene.json"), "scene.json");
+  EXPECT_EQ(read.animation.kind, LightAnimation::SwitchOn);
+  EXPECT_EQ(read.animation.event_frame, 1);
+  EXPECT_EQ(read.frames, 3);
+  EXPECT_EQ(light_animation_of_scene_json(R"({"frames": 4})", "s").animation.kind, LightAnimation::None);
+  EXPECT_THROW((void)light_animation_of_scene_json(R"({"light_animation": {"kind": "blink"}})", "s"), Error);
+  EXPECT_THROW((void)light_animation_of_scene_json("{", "s"), Error);
 }
 
 }  // namespace

@@ -36,6 +36,15 @@ struct LightAnimationOptions {
 /// no light of the scene or make no sense (dim_to outside [0, 1], a switch frame past the end).
 [[nodiscard]] Scene scene_at_frame(const Scene& scene, const LightAnimationOptions& animation, int frame, int frames);
 
+/// The light animation scene.json describes (its "light_animation" section, none when absent) and
+/// the sequence's frame count: what a reader needs for scene_at_frame. Throws relight::Error
+/// naming `source` on malformed JSON or an unknown animation.
+struct SequenceLightAnimation {
+  LightAnimationOptions animation;
+  int frames = 0;
+};
+[[nodiscard]] SequenceLightAnimation light_animation_of_scene_json(const std::string& text, const std::string& source);
+
 /// The switch frame k the options mean for `frames` frames.
 [[nodiscard]] int light_event_frame(const LightAnimationOptions& animation, int frames);
 
