@@ -107,6 +107,8 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
       ->capture_default_str();
   command.add_option("--probe-lights", probe.lights, "Real lights extracted from the probe every frame")
       ->capture_default_str();
+  command.add_flag("!--no-light-smoothing", probe.smoothing,
+                   "Use each frame's extracted lights as they are (no temporal smoothing, lights/light_smoothing.h)");
   command.add_option("--virtual-light", options.virtual_lights, "A virtual point light x,y,z,intensity[,r,g,b] (repeatable)");
   command.add_option("--virtual-spot", options.virtual_spots,
                      "A virtual spot light x,y,z,target_x,target_y,target_z,angle_degrees,intensity[,r,g,b] aimed at "

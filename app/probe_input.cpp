@@ -73,8 +73,10 @@ lights::ProbeStreamStage* add_real_light_stages(FrameGraph& graph, const RealLig
   lights::LightExtractionOptions extraction;
   extraction.lights = options.lights;
   extraction.calibration = probe_calibration(options);
-  graph.add(lights::make_light_extraction_stage(per_pixel, context, extraction));
-  graph.emplace<lights::LightSmoothingStage>();
+  // Without smoothing the extracted lights are the lights (for comparisons: the flicker it removes).
+  const lights::LightExtractionBuffers buffers{kProbe, options.smoothing ? lights::kLightsRaw : lights::kLights};
+  graph.add(lights::make_light_extraction_stage(per_pixel, context, extraction, buffers));
+  if (options.smoothing) graph.emplace<lights::LightSmoothingStage>();
   return &probe;
 }
 

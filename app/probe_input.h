@@ -33,6 +33,7 @@ struct ProbeInputOptions {
   double tolerance_s = 0.05;       ///< timestamp matching (probe_stream.h)
   double offset_s = 0.0;           ///< video probes: start relative to the first RGB-D frame
   int lights = 8;                  ///< lights extracted per frame
+  bool smoothing = true;           ///< light_smoothing between extraction and the lights
 };
 
 /// The calibration the options describe; throws relight::Error on a bad rotation or field of view.

@@ -29,6 +29,7 @@ struct SynthCommandOptions {
   int threads = 0;
   ImageSize size = ImageSize::Vga;
   synth::LightAnimationOptions light_animation;
+  double probe_noise = 0.0;
   bool no_ground_truth = false;
   bool quiet = false;
 };
@@ -48,6 +49,7 @@ int run_synth(const SynthCommandOptions& command) {
   }
   options.ground_truth = !command.no_ground_truth;
   options.light_animation = command.light_animation;
+  options.probe_noise = command.probe_noise;
 
   ProgressBar progress("synth", command.frames, command.quiet);
   const auto start = std::chrono::steady_clock::now();
@@ -98,6 +100,12 @@ void register_synth(CLI::App& app, Runners& runners) {
   synth
       ->add_option("--light-orbit-degrees", options->light_animation.orbit_degrees,
                    "Turn of the light about the table's vertical axis over the sequence (--light-animation orbit)")
+      ->capture_default_str();
+  synth
+      ->add_option("--probe-noise", options->probe_noise,
+                   "The probe camera's sensor noise: relative standard deviation per pixel, new every frame "
+                   "(writes probe.txt + probe/ with each frame's probe)")
+      ->check(CLI::Range(0.0, 0.99))
       ->capture_default_str();
   synth->add_option("--threads", options->threads, "Render threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   synth->add_flag("--no-gt", options->no_ground_truth, "Skip the gt/ folder");

@@ -4,6 +4,7 @@
 #include <limits>
 #include <numbers>
 
+#include "random.h"
 #include "relight/core/parallel.h"
 
 namespace relight::synth {
@@ -64,6 +65,16 @@ RadianceImage render_probe(const Scene& scene, const LightProbe& probe, int thre
     for (int col = 0; col < image.width(); ++col) image(row, col) = probe_pixel(scene, probe, row, col);
   });
   return image;
+}
+
+RadianceImage add_probe_noise(RadianceImage probe, double sigma, std::uint64_t seed, std::uint64_t frame) {
+  if (!(sigma > 0.0)) return probe;
+  std::mt19937_64 rng(detail::stream_seed(seed, 0x9b0be, frame));  // a stream of its own: not the depth noise's
+  const auto noisy = [&](float v) {
+    return std::max(0.f, v * static_cast<float>(1.0 + sigma * detail::gaussian(rng)));
+  };
+  for (Float3& p : probe.pixels()) p = {noisy(p.x), noisy(p.y), noisy(p.z)};
+  return probe;
 }
 
 }  // namespace relight::synth

@@ -193,6 +193,7 @@ void validate_synth_options(const SynthOptions& options) {
     if (!(g > 0.0)) throw Error("synth: white-balance gains must be positive");
   }
   if (!(options.color.exposure > 0.0)) throw Error("synth: exposure must be positive");
+  if (!(options.probe_noise >= 0.0 && options.probe_noise < 1.0)) throw Error("synth: probe noise must be in [0, 1)");
 }
 
 }  // namespace relight::synth

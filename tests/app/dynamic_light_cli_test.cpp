@@ -159,6 +159,52 @@ TEST(DynamicLightCli, ARealSpotLightsTheTableAndThePebbleCastsItsShadow) {
                         1);
 }
 
+// Sensor noise on a static probe (static camera and light): the temporal smoothing of the lights
+// makes the rendered light flicker less than half as much as the lights extracted frame by frame.
+TEST(DynamicLightCli, LightSmoothingHalvesTheFlickerOfANoisyProbe) {
+  test::TempDir dir;
+  const auto& sequence =
+      cli_test::synthetic_sequence("--frames 8 --size 320x240 --trajectory static --noise none --probe-noise 0.3");
+  const auto flicker = [&](const std::string& name, const std::string& extra) {
+    const auto out = dir.path() / name;
+    const auto result = relight("replay --quiet " + sequence.string() + " --object " +
+                                (kData / "models" / "glossy_pebble.gltf").string() + " --buffers --no-video --out " +
+                                out.string() + " " + extra);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    // Mean absolute change between consecutive frames, after the first two (warm-up), of what
+    // the composite adds to the camera image: the object and its light and shadow, L_rv - L_r.
+    const auto delta = [&](int frame) {
+      char rv[24], r[24];
+      std::snprintf(rv, sizeof rv, "%06d_L_rv.exr", frame);
+      std::snprintf(r, sizeof r, "%06d_L_r.exr", frame);
+      RadianceImage difference = read_radiance(out / "frames" / rv);
+      const RadianceImage real = read_radiance(out / "frames" / r);
+      for (std::size_t i = 0; i < difference.size(); ++i) {
+        Float3& d = difference.pixels()[i];
+        d = {d.x - real.pixels()[i].x, d.y - real.pixels()[i].y, d.z - real.pixels()[i].z};
+      }
+      return difference;
+    };
+    double sum = 0.0;
+    int count = 0;
+    RadianceImage previous = delta(2);
+    for (int frame = 3; frame < 8; ++frame) {
+      const RadianceImage current = delta(frame);
+      for (std::size_t i = 0; i < current.size(); ++i) {
+        const Float3 p = previous.pixels()[i], c = current.pixels()[i];
+        sum += std::abs(c.x - p.x) + std::abs(c.y - p.y) + std::abs(c.z - p.z);
+        ++count;
+      }
+      previous = current;
+    }
+    return sum / count;
+  };
+  const double smoothed = flicker("smoothed", "");
+  const double raw = flicker("raw", "--no-light-smoothing");
+  EXPECT_GT(raw, 0.0) << "the noisy probe moves the extracted lights";
+  EXPECT_LT(smoothed, 0.5 * raw) << "smoothed " << smoothed << ", raw " << raw;
+}
+
 TEST(DynamicLightCli, ProbeInputErrorsAreOneLine) {
   test::TempDir dir;
   const auto& sequence = cli_test::synthetic_sequence("--frames 2 --size 320x240 --trajectory static --no-gt");

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 
 namespace relight::synth {
@@ -78,6 +79,26 @@ TEST(Probe, ZenithShowsTheEnvironmentAndOutsideTheCircleIsZero) {
   EXPECT_FLOAT_EQ(zenith.x, static_cast<float>(f.scene.environment.x()));
   EXPECT_EQ(f.image(0, 0), Float3{});
   EXPECT_EQ(f.image(511, 511), Float3{});
+}
+
+TEST(ProbeNoise, IsNewEveryFrameReproducibleAndUnbiased) {
+  RadianceImage clean(64, 64, Float3{1.f, 0.5f, 0.25f});
+  const auto same = [](const RadianceImage& x, const RadianceImage& y) {
+    return std::ranges::equal(x.pixels(), y.pixels());
+  };
+  const RadianceImage a = add_probe_noise(clean, 0.2, 7, 3);
+  EXPECT_TRUE(same(a, add_probe_noise(clean, 0.2, 7, 3)));   // same seed and frame
+  EXPECT_FALSE(same(a, add_probe_noise(clean, 0.2, 7, 4)));  // a new frame, new noise
+  EXPECT_TRUE(same(add_probe_noise(clean, 0.0, 7, 3), clean));
+  double sum = 0.0, square = 0.0;
+  for (const Float3& p : a.pixels()) {
+    sum += p.x;
+    square += p.x * p.x;
+  }
+  const double n = static_cast<double>(a.size());
+  const double mean = sum / n;
+  EXPECT_NEAR(mean, 1.0, 0.01);
+  EXPECT_NEAR(std::sqrt(square / n - mean * mean), 0.2, 0.01);
 }
 
 }  // namespace

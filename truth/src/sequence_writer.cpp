@@ -2,6 +2,7 @@
 #include "relight/truth/sequence_writer.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "relight/capture/tum_writer.h"
 #include "relight/core/atomic_file.h"
@@ -30,14 +31,14 @@ void write_ground_truth(const fs::path& out, Timestamp timestamp, const synth::R
   write_label_png(out / "gt" / "material" / (stem + ".png"), frame.material);
 }
 
-void create_folders(const fs::path& out, const synth::SynthOptions& options, bool animated) {
+void create_folders(const fs::path& out, const synth::SynthOptions& options, bool animated, bool per_frame_probes) {
   std::error_code ec;
   fs::create_directories(out, ec);
   for (const char* sub : {"depth", "normals", "albedo", "material", "lights"}) {
     const bool wanted = options.ground_truth && (animated || std::string_view(sub) != "lights");
     if (wanted && !ec) fs::create_directories(out / "gt" / sub, ec);
   }
-  if (animated && options.probe && !ec) fs::create_directories(out / "probe", ec);
+  if (per_frame_probes && !ec) fs::create_directories(out / "probe", ec);
   if (ec) throw Error("cannot create " + out.string() + ": " + ec.message());
 }
 
@@ -52,7 +53,10 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
   synth::validate_synth_options(options);
   const bool animated = options.light_animation.kind != synth::LightAnimation::None;
   if (animated && options.frames > 0) (void)synth::scene_at_frame(scene, options.light_animation, 0, options.frames);
-  create_folders(out, options, animated);
+  // Every frame has its own probe when the light changes or the probe camera is noisy.
+  const bool per_frame_probes = options.probe && (animated || options.probe_noise > 0.0);
+  create_folders(out, options, animated, per_frame_probes);
+  std::optional<RadianceImage> still_probe;  // not animated: rendered once, noisy per frame
   const PinholeIntrinsics intrinsics = synth::synth_intrinsics(options);
   const std::vector<Pose> poses = synth::make_trajectory(options.trajectory, options.frames, options.seed, scene);
   capture::TumWriter writer(out, synth::kSynthDepthScale);
@@ -68,17 +72,18 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
     const Timestamp timestamp = synth::frame_timestamp(i);
     writer.add(timestamp, synth::encode_color(frame.radiance, options.color), depth, poses[static_cast<std::size_t>(i)]);
     if (options.ground_truth) write_ground_truth(out, timestamp, frame);
-    if (animated) {
-      const std::string stem = stem_of(timestamp);
-      if (options.ground_truth) {
-        write_file_atomically(out / "gt" / "lights" / (stem + ".json"), synth::frame_lights_json(frame_scene));
+    const std::string stem = stem_of(timestamp);
+    if (animated && options.ground_truth) {
+      write_file_atomically(out / "gt" / "lights" / (stem + ".json"), synth::frame_lights_json(frame_scene));
+    }
+    if (per_frame_probes) {
+      const std::string name = "probe/" + stem + ".hdr";
+      if (animated || !still_probe) {
+        still_probe = synth::render_probe(frame_scene, synth::default_probe(frame_scene), options.threads);
       }
-      if (options.probe) {
-        const std::string name = "probe/" + stem + ".hdr";
-        write_radiance(out / name,
-                       synth::render_probe(frame_scene, synth::default_probe(frame_scene), options.threads));
-        probe_list.append(stem).append(" ").append(name).append("\n");
-      }
+      write_radiance(out / name, synth::add_probe_noise(*still_probe, options.probe_noise, options.seed,
+                                                        static_cast<std::uint64_t>(i)));
+      probe_list.append(stem).append(" ").append(name).append("\n");
     }
     if (progress) progress(i + 1, options.frames);
   }
@@ -88,7 +93,7 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
                                    ? synth::scene_at_frame(scene, options.light_animation, 0, options.frames)
                                    : scene;
     write_radiance(out / "probe.hdr", synth::render_probe(first, synth::default_probe(first), options.threads));
-    if (animated) write_file_atomically(out / "probe.txt", probe_list);
+    if (per_frame_probes) write_file_atomically(out / "probe.txt", probe_list);
   }
   write_file_atomically(out / "scene.json", synth::scene_json(scene, options));
 }

@@ -28,6 +28,10 @@ struct LightProbe {
 /// Linear radiance arriving along a ray: emitters, then geometry (shaded), then the sky.
 [[nodiscard]] Eigen::Vector3d incoming_radiance(const Scene& scene, const Ray& ray);
 
+/// The probe camera's sensor noise: every pixel channel scaled by (1 + sigma * N(0, 1)) (clamped
+/// at 0), independently per frame; the same (seed, frame) give the same noise.
+[[nodiscard]] RadianceImage add_probe_noise(RadianceImage probe, double sigma, std::uint64_t seed, std::uint64_t frame);
+
 /// Renders the probe image; pixels outside the image circle are 0. threads = 0: all hardware.
 [[nodiscard]] RadianceImage render_probe(const Scene& scene, const LightProbe& probe, int threads = 0);
 

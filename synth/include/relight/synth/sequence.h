@@ -9,7 +9,8 @@
 //   gt/material/<t>.png  16-bit material index + 1 (0 = nothing hit; see scene.json)
 //   probe.hdr            the fisheye light probe (probe.h), linear radiance
 //   probe.txt, probe/<t>.hdr, gt/lights/<t>.json   with a light animation: the per-frame probe
-//                        stream and the true lights of each frame (SynthOptions::light_animation)
+//                        stream and the true lights of each frame (SynthOptions::light_animation);
+//                        with probe noise, probe.txt and probe/ (each frame's noisy probe)
 //   scene.json           intrinsics, depth_scale, world_up, materials, objects, lights,
 //                        environment, tag (corners and pose), noise, seed, trajectory, probe
 // where <t> is TumWriter::file_name(timestamp) without its extension. Colour and depth come from
@@ -50,6 +51,9 @@ struct SynthOptions {
   /// (probe/<t>.hdr, listed in probe.txt as "timestamp filename") and its true lights
   /// (gt/lights/<t>.json, relight's lights format); probe.hdr is frame 0's.
   LightAnimationOptions light_animation;
+  /// The probe camera's sensor noise (add_probe_noise; 0 = none). With noise, every frame has its
+  /// own probe in probe.txt as with a light animation.
+  double probe_noise = 0.0;
 };
 
 /// Kinect v1 intrinsics (PinholeIntrinsics::kinect_v1) scaled to options.width x height.
