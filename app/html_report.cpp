@@ -13,6 +13,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "relight/lights/light_output.h"
+
 extern char** environ;
 
 namespace relight::app {
@@ -215,8 +217,7 @@ void lights_section(std::ostringstream& html, const lights::LightSet& set) {
   for (std::size_t i = 0; i < set.lights.size(); ++i) {
     const auto& light = set.lights[i];
     const auto& where = light.kind == lights::LightKind::Directional ? light.direction : light.position;
-    html << "<tr><td>" << i + 1 << "<td class=l>"
-         << (light.kind == lights::LightKind::Directional ? "directional" : "point") << "<td class=l>"
+    html << "<tr><td>" << i + 1 << "<td class=l>" << lights::light_kind_name(light.kind) << "<td class=l>"
          << format("%.3f", where.x()) << ", " << format("%.3f", where.y()) << ", " << format("%.3f", where.z())
          << "<td class=l>" << format("%.4g", light.power.x()) << ", " << format("%.4g", light.power.y()) << ", "
          << format("%.4g", light.power.z()) << "<td class=l>" << (light.real ? "real" : "virtual") << "\n";

@@ -16,10 +16,14 @@ ShadingLights to_camera_frame(const lights::LightSet& set, const Pose& camera_to
   for (const lights::Light& light : set.lights) {
     if (!light.real) continue;
     ShadingLight l;
-    l.point = light.kind == lights::LightKind::Point;
+    l.point = light.kind != lights::LightKind::Directional;
     l.vector = l.point ? (world_to_camera * light.position).cast<float>()
                        : (world_to_camera.linear() * light.direction).normalized().cast<float>();
     l.power = light.power.cast<float>();
+    if (light.kind == lights::LightKind::Spot) {
+      l.spot = light;
+      l.spot.axis = world_to_camera.linear() * light.axis;
+    }
     out.lights.push_back(l);
   }
   return out;
@@ -29,7 +33,9 @@ LightAtPoint light_at(const ShadingLight& light, const Eigen::Vector3f& position
   if (!light.point) return {light.vector, light.power};
   const Eigen::Vector3f offset = light.vector - position;
   const float distance2 = offset.squaredNorm();
-  return {offset / std::sqrt(distance2), light.power / distance2};
+  const Eigen::Vector3f direction = offset / std::sqrt(distance2);
+  const auto falloff = static_cast<float>(lights::spot_falloff(light.spot, -direction.cast<double>()));
+  return {direction, light.power * (falloff / distance2)};
 }
 
 Eigen::Vector3f diffuse_shading(const ShadingLights& lights, const Eigen::Vector3f& position,

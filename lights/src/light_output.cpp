@@ -46,13 +46,27 @@ void draw_ring(ColorImage& image, double u, double v, double radius, Rgb8 colour
 
 }  // namespace
 
+const char* light_kind_name(LightKind kind) {
+  switch (kind) {
+    case LightKind::Directional: return "directional";
+    case LightKind::Point: return "point";
+    case LightKind::Spot: return "spot";
+  }
+  return "unknown";
+}
+
 std::string lights_to_json(const LightSet& set) {
   nlohmann::ordered_json lights = nlohmann::ordered_json::array();
   for (const Light& light : set.lights) {
     nlohmann::ordered_json entry;
-    entry["type"] = light.kind == LightKind::Directional ? "directional" : "point";
+    entry["type"] = std::string(light_kind_name(light.kind));
     if (light.kind == LightKind::Directional) entry["direction"] = vec(light.direction);
     else entry["position"] = vec(light.position);
+    if (light.kind == LightKind::Spot) {
+      entry["axis"] = vec(light.axis);
+      entry["cone_degrees"] = light.cone_degrees;
+      entry["inner_degrees"] = light.inner_degrees;
+    }
     entry["power"] = vec(light.power);
     entry["real"] = light.real;
     lights.push_back(entry);
@@ -91,19 +105,35 @@ LightSet lights_from_json(const std::string& text, const std::string& source) {
     const nlohmann::json& entry = root["lights"][i];
     const std::string where = source + ": light " + std::to_string(i);
     if (!entry.is_object() || !entry.contains("type") || !entry["type"].is_string())
-      throw Error(where + ": needs a \"type\" of \"directional\" or \"point\"");
+      throw Error(where + ": needs a \"type\" of \"directional\", \"point\" or \"spot\"");
     Light light;
-    const std::string type = entry["type"].get<std::string>();
+    std::string type = entry["type"].get<std::string>();
     if (type == "directional") {
       light.kind = LightKind::Directional;
       light.direction = read_vec3(entry, "direction", where);
       if (light.direction.norm() < 1e-9) throw Error(where + ": the direction must not be zero");
       light.direction.normalize();
-    } else if (type == "point") {
-      light.kind = LightKind::Point;
+    } else if (type == "point" || type == "spot") {
+      light.kind = type == "point" ? LightKind::Point : LightKind::Spot;
       light.position = read_vec3(entry, "position", where);
     } else {
-      throw Error(where + ": unknown type '" + type + "' (directional or point)");
+      throw Error(where + ": unknown type '" + type.append("' (directional, point or spot)"));
+    }
+    if (light.kind == LightKind::Spot) {
+      light.axis = read_vec3(entry, "axis", where);
+      if (light.axis.norm() < 1e-9) throw Error(where + ": the spot's axis must not be zero");
+      light.axis.normalize();
+      const auto degrees = [&](const char* key, double fallback) {
+        if (!entry.contains(key)) return fallback;
+        if (!entry[key].is_number()) throw Error(where + ": '" + key + "' must be a number of degrees");
+        return entry[key].get<double>();
+      };
+      light.cone_degrees = degrees("cone_degrees", std::nan(""));
+      if (!(light.cone_degrees > 0.0 && light.cone_degrees < 90.0))
+        throw Error(where + ": a spot needs 'cone_degrees' in (0, 90)");
+      light.inner_degrees = degrees("inner_degrees", 0.8 * light.cone_degrees);
+      if (!(light.inner_degrees > 0.0 && light.inner_degrees <= light.cone_degrees))
+        throw Error(where + ": 'inner_degrees' must be in (0, cone_degrees]");
     }
     light.power = read_vec3(entry, "power", where);
     if (light.power.minCoeff() < 0.0) throw Error(where + ": the power must not be negative");

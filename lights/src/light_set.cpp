@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace relight::lights {
 
@@ -11,6 +12,18 @@ Eigen::Vector3d irradiance(const LightSet& set, const Eigen::Vector3d& normal) {
     if (light.kind == LightKind::Directional) sum += light.power * std::max(0.0, normal.dot(light.direction));
   }
   return sum;
+}
+
+double spot_falloff(const Light& light, const Eigen::Vector3d& from_light) {
+  if (light.kind != LightKind::Spot) return 1.0;
+  const double to_radians = std::numbers::pi / 180.0;
+  const double cos_outer = std::cos(light.cone_degrees * to_radians);
+  const double cos_inner = std::cos(light.inner_degrees * to_radians);
+  const double c = light.axis.normalized().dot(from_light);
+  if (c <= cos_outer) return 0.0;
+  if (c >= cos_inner) return 1.0;
+  const double x = (c - cos_outer) / (cos_inner - cos_outer);
+  return x * x * (3.0 - 2.0 * x);
 }
 
 Eigen::Vector3d total_power(const LightSet& set) {

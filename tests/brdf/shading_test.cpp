@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+#include <numbers>
+
 #include "brdf_test_scene.h"
 
 namespace relight::brdf {
@@ -39,6 +42,30 @@ TEST(Shading, DiffuseShadingMatchesTheGroundTruthSplit) {
   const Eigen::Vector3f d = diffuse_shading(s.lights, {p.x, p.y, p.z}, {n.x, n.y, n.z});
   ASSERT_EQ(s.shadowed(r, c), 0);
   EXPECT_NEAR(kd.x * d.x(), s.diffuse(r, c).x, 1e-4f);
+}
+
+TEST(Shading, ASpotLightsOnlyItsCone) {
+  lights::LightSet set;
+  lights::Light spot;
+  spot.kind = lights::LightKind::Spot;
+  spot.position = {0, 0, 2};
+  spot.axis = {0, 0, -1};
+  spot.cone_degrees = 20;
+  spot.inner_degrees = 16;
+  spot.power = {4, 4, 4};
+  set.lights.push_back(spot);
+  const ShadingLights lights = to_camera_frame(set, Pose::Identity());
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  // On its axis, 2 m below: E = I / d^2 (cosine 1); 45 degrees off the axis: nothing.
+  EXPECT_NEAR(diffuse_shading(lights, {0, 0, 0}, up).x(), 1.f / std::numbers::pi_v<float>, 1e-6f);
+  EXPECT_EQ(diffuse_shading(lights, {2, 0, 0}, up).x(), 0.f);
+  // The camera frame turns the axis with the positions: the same point lit the same way.
+  Pose camera_to_world = Pose::Identity();
+  camera_to_world.linear() = Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  const ShadingLights turned = to_camera_frame(set, camera_to_world);
+  const Eigen::Vector3f origin = (camera_to_world.inverse() * Eigen::Vector3d::Zero()).cast<float>();
+  const Eigen::Vector3f normal = (camera_to_world.inverse().linear() * Eigen::Vector3d::UnitZ()).cast<float>();
+  EXPECT_NEAR(diffuse_shading(turned, origin, normal).x(), 1.f / std::numbers::pi_v<float>, 1e-5f);
 }
 
 TEST(Shading, LinearizeInvertsTheSrgbEncoding) {

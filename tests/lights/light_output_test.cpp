@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <numbers>
+
 #include "relight/core/error.h"
 
 namespace relight::lights {
@@ -22,6 +25,40 @@ TEST(LightOutput, JsonRoundTripKeepsEveryLight) {
   EXPECT_EQ(back.lights[1].kind, LightKind::Point);
   EXPECT_TRUE(back.lights[1].position.isApprox(set.lights[1].position, 1e-12));
   EXPECT_FALSE(back.lights[1].real);
+}
+
+TEST(LightOutput, SpotLightsKeepTheirConeAndFadeOutAtItsEdge) {
+  const LightSet set = lights_from_json(R"({"lights": [{"type": "spot", "position": [0, 0, 2], "axis": [0, 0, -3],
+                                                        "cone_degrees": 30, "power": [5, 5, 5]}]})",
+                                        "lamp.json");
+  ASSERT_EQ(set.lights.size(), 1u);
+  const Light& spot = set.lights[0];
+  EXPECT_EQ(spot.kind, LightKind::Spot);
+  EXPECT_TRUE(spot.axis.isApprox(-Eigen::Vector3d::UnitZ(), 1e-12));  // normalised
+  EXPECT_DOUBLE_EQ(spot.inner_degrees, 24.0);                         // 0.8 of the cone by default
+  const auto towards = [](double degrees) {
+    const double a = degrees * std::numbers::pi / 180.0;
+    return Eigen::Vector3d(std::sin(a), 0.0, -std::cos(a));
+  };
+  EXPECT_DOUBLE_EQ(spot_falloff(spot, towards(10)), 1.0);
+  EXPECT_DOUBLE_EQ(spot_falloff(spot, towards(31)), 0.0);
+  const double mid = spot_falloff(spot, towards(27));
+  EXPECT_GT(mid, 0.0);
+  EXPECT_LT(mid, 1.0);
+  const LightSet back = lights_from_json(lights_to_json(set), "again");
+  EXPECT_EQ(back.lights[0].kind, LightKind::Spot);
+  EXPECT_DOUBLE_EQ(back.lights[0].cone_degrees, 30.0);
+  EXPECT_DOUBLE_EQ(back.lights[0].inner_degrees, 24.0);
+  EXPECT_TRUE(back.lights[0].position.isApprox(spot.position, 1e-12));
+  for (const char* bad : {R"({"lights": [{"type": "spot", "position": [0, 0, 2], "power": [1, 1, 1]}]})",
+                          R"({"lights": [{"type": "spot", "position": [0, 0, 2], "axis": [0, 0, 0], "cone_degrees": 30,
+                                          "power": [1, 1, 1]}]})",
+                          R"({"lights": [{"type": "spot", "position": [0, 0, 2], "axis": [0, 0, -1], "cone_degrees": 95,
+                                          "power": [1, 1, 1]}]})",
+                          R"({"lights": [{"type": "spot", "position": [0, 0, 2], "axis": [0, 0, -1], "cone_degrees": 20,
+                                          "inner_degrees": 25, "power": [1, 1, 1]}]})"}) {
+    EXPECT_THROW((void)lights_from_json(bad, "lamp.json"), Error) << bad;
+  }
 }
 
 TEST(LightOutput, MalformedJsonNamesTheSourceAndTheLight) {

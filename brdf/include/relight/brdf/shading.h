@@ -29,9 +29,10 @@ namespace relight::brdf {
 
 /// One light in the camera frame.
 struct ShadingLight {
-  bool point = false;
+  bool point = false;                                 ///< a point or spot light (at `vector`), else directional
   Eigen::Vector3f vector = Eigen::Vector3f::UnitZ();  ///< unit direction towards the light, or the point light's position
   Eigen::Vector3f power = Eigen::Vector3f::Zero();    ///< LightSet units: irradiance (directional), W/sr (point)
+  lights::Light spot{};  ///< a spot's cone in the camera frame (kind Spot), for lights::spot_falloff
 };
 
 /// The lights used for estimation, in the camera frame.

@@ -9,9 +9,14 @@
 namespace relight::lights {
 
 /// {"lights": [{"type": "directional", "direction": [x,y,z], "power": [r,g,b], "real": true}, ...],
+///  a point light with "position" instead of "direction", a spot with "position", "axis",
+///  "cone_degrees" and "inner_degrees" (default 0.8 cone_degrees),
 ///  "count": N, "total_power": [r,g,b], "irradiance_up": [r,g,b]} (irradiance on a surface facing
 /// world +z). Directions are in the scene frame; units as light_set.h.
 [[nodiscard]] std::string lights_to_json(const LightSet& set);
+
+/// "directional", "point" or "spot".
+[[nodiscard]] const char* light_kind_name(LightKind kind);
 
 /// Reads what lights_to_json writes (only "lights" is needed; "real" defaults to true). Throws
 /// relight::Error naming `source` and the entry on malformed JSON, a missing field, an unknown
