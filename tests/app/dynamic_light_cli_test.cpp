@@ -23,6 +23,21 @@ const std::filesystem::path kData = RELIGHT_TEST_DATA;
 constexpr int kFrames = 6;
 constexpr int kSwitchFrame = 3;
 
+// `relight replay` of `sequence` with the shipped pebble into `out`, L_rv/L_r written per frame.
+test::CommandResult replay_pebble(const std::filesystem::path& sequence, const std::filesystem::path& out,
+                                  const std::string& extra = "") {
+  return relight("replay --quiet " + sequence.string() + " --object " +
+                 (kData / "models" / "glossy_pebble.gltf").string() + " --buffers --no-video --out " + out.string() +
+                 " " + extra);
+}
+
+// frames/<frame, 6 digits><suffix>, as the frame writer names its files.
+std::filesystem::path frame_file(const std::filesystem::path& frames, int frame, const char* suffix) {
+  char stem[16];
+  std::snprintf(stem, sizeof stem, "%06d", frame);
+  return frames / (std::string(stem) + suffix);
+}
+
 // The light the virtual object takes from real surfaces: sum of L_r - L_rv over pixels it does
 // not cover (its shadow; its bounce light on them counts against it).
 struct FrameLight {
@@ -37,12 +52,10 @@ double srgb_to_linear(std::uint8_t v) {
 }
 
 FrameLight frame_light(const std::filesystem::path& frames, int frame) {
-  char stem[16];
-  std::snprintf(stem, sizeof stem, "%06d", frame);
-  const RadianceImage lrv = read_radiance(frames / (std::string(stem) + "_L_rv.exr"));
-  const RadianceImage lr = read_radiance(frames / (std::string(stem) + "_L_r.exr"));
-  const ColorImage coverage = read_color(frames / (std::string(stem) + "_virtual_coverage.png"));
-  const ColorImage camera = read_color(frames / (std::string(stem) + "_color.png"));
+  const RadianceImage lrv = read_radiance(frame_file(frames, frame, "_L_rv.exr"));
+  const RadianceImage lr = read_radiance(frame_file(frames, frame, "_L_r.exr"));
+  const ColorImage coverage = read_color(frame_file(frames, frame, "_virtual_coverage.png"));
+  const ColorImage camera = read_color(frame_file(frames, frame, "_color.png"));
   FrameLight light;
   double count = 0.0;
   for (int row = 0; row < lrv.height(); ++row) {
@@ -73,9 +86,7 @@ DynamicLightRun run_with_light(const std::string& animation, const test::TempDir
       "--frames " + std::to_string(kFrames) + " --size 320x240 --trajectory static --light-animation " + animation +
       " --light-event-frame " + std::to_string(kSwitchFrame));
   const auto out = dir.path() / animation;
-  const auto result =
-      relight("replay --quiet " + sequence.string() + " --object " +
-              (kData / "models" / "glossy_pebble.gltf").string() + " --buffers --no-video --out " + out.string());
+  const auto result = replay_pebble(sequence, out);
   EXPECT_EQ(result.exit_code, 0) << result.err;
   DynamicLightRun run;
   if (result.exit_code != 0) return run;
@@ -139,9 +150,7 @@ TEST(DynamicLightCli, ARealSpotLightsTheTableAndThePebbleCastsItsShadow) {
   const auto& sequence = cli_test::synthetic_sequence("--frames 2 --size 320x240 --trajectory static --no-gt");
   const auto run = [&](const std::string& name, const std::string& extra) {
     const auto out = dir.path() / name;
-    const auto result = relight("replay --quiet " + sequence.string() + " --object " +
-                                (kData / "models" / "glossy_pebble.gltf").string() + " --buffers --no-video --out " +
-                                out.string() + " " + extra);
+    const auto result = replay_pebble(sequence, out, extra);
     EXPECT_EQ(result.exit_code, 0) << result.err;
     return result.exit_code == 0 ? frame_light(out / "frames", 1) : FrameLight{};
   };
@@ -167,18 +176,13 @@ TEST(DynamicLightCli, LightSmoothingHalvesTheFlickerOfANoisyProbe) {
       cli_test::synthetic_sequence("--frames 8 --size 320x240 --trajectory static --noise none --probe-noise 0.3");
   const auto flicker = [&](const std::string& name, const std::string& extra) {
     const auto out = dir.path() / name;
-    const auto result = relight("replay --quiet " + sequence.string() + " --object " +
-                                (kData / "models" / "glossy_pebble.gltf").string() + " --buffers --no-video --out " +
-                                out.string() + " " + extra);
+    const auto result = replay_pebble(sequence, out, extra);
     EXPECT_EQ(result.exit_code, 0) << result.err;
     // Mean absolute change between consecutive frames, after the first two (warm-up), of what
     // the composite adds to the camera image: the object and its light and shadow, L_rv - L_r.
     const auto delta = [&](int frame) {
-      char rv[24], r[24];
-      std::snprintf(rv, sizeof rv, "%06d_L_rv.exr", frame);
-      std::snprintf(r, sizeof r, "%06d_L_r.exr", frame);
-      RadianceImage difference = read_radiance(out / "frames" / rv);
-      const RadianceImage real = read_radiance(out / "frames" / r);
+      RadianceImage difference = read_radiance(frame_file(out / "frames", frame, "_L_rv.exr"));
+      const RadianceImage real = read_radiance(frame_file(out / "frames", frame, "_L_r.exr"));
       for (std::size_t i = 0; i < difference.size(); ++i) {
         Float3& d = difference.pixels()[i];
         d = {d.x - real.pixels()[i].x, d.y - real.pixels()[i].y, d.z - real.pixels()[i].z};
