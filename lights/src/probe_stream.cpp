@@ -39,6 +39,8 @@ bool is_ldr_image(const fs::path& path) {
   return extension == ".png" || extension == ".jpg" || extension == ".jpeg";
 }
 
+constexpr const char* kProbeImageKinds = " (.hdr, .exr, .png or .jpg)";
+
 struct ProbeListEntry {
   Timestamp timestamp = 0.0;
   fs::path file;
@@ -102,9 +104,8 @@ std::vector<ProbeListEntry> parse_probe_list(const fs::path& list) {
                   " is not after the previous one (the list must be sorted by time)");
     }
     entry.file = list.parent_path() / name;
-    if (!is_hdr_image(entry.file) && !is_ldr_image(entry.file)) {
-      throw Error(where + ": " + name.append(" is not a probe image (.hdr, .exr, .png or .jpg)"));
-    }
+    if (!is_hdr_image(entry.file) && !is_ldr_image(entry.file))
+      throw Error(where + ": " + name.append(" is not a probe image").append(kProbeImageKinds));
     std::error_code ec;
     if (!fs::is_regular_file(entry.file, ec)) throw Error(where + ": " + entry.file.string() + " does not exist");
     entries.push_back(std::move(entry));
@@ -125,7 +126,7 @@ ProbeFrame read_probe_image(const fs::path& path, const ProbeResponse& response)
     frame.radiance = std::move(ldr.radiance);
     frame.clipped_share = ldr.clipped_share;
   } else {
-    throw Error(path.string() + ": not a probe image (.hdr, .exr, .png or .jpg)");
+    throw Error(path.string() + ": not a probe image" + kProbeImageKinds);
   }
   return frame;
 }
@@ -137,9 +138,8 @@ std::unique_ptr<ProbeStream> open_probe_list(const fs::path& list, const ProbeRe
 std::unique_ptr<ProbeStream> open_still_probe(const fs::path& image, const ProbeResponse& response) {
   std::error_code ec;
   if (!fs::is_regular_file(image, ec)) throw Error("cannot read the probe " + image.string() + ": no such file");
-  if (!is_hdr_image(image) && !is_ldr_image(image)) {
-    throw Error(image.string() + ": not a probe image (.hdr, .exr, .png or .jpg)");
-  }
+  if (!is_hdr_image(image) && !is_ldr_image(image))
+    throw Error(image.string() + ": not a probe image" + kProbeImageKinds);
   return std::make_unique<ProbeListStream>(image, std::vector<ProbeListEntry>{{0.0, image}}, response,
                                            ProbeTiming::Still);
 }

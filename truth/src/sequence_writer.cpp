@@ -57,6 +57,7 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
   const bool per_frame_probes = options.probe && (animated || options.probe_noise > 0.0);
   create_folders(out, options, animated, per_frame_probes);
   std::optional<RadianceImage> still_probe;  // not animated: rendered once, noisy per frame
+  std::optional<RadianceImage> first_probe;  // frame 0's clean probe: probe.hdr
   const PinholeIntrinsics intrinsics = synth::synth_intrinsics(options);
   const std::vector<Pose> poses = synth::make_trajectory(options.trajectory, options.frames, options.seed, scene);
   capture::TumWriter writer(out, synth::kSynthDepthScale);
@@ -81,6 +82,7 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
       if (animated || !still_probe) {
         still_probe = synth::render_probe(frame_scene, synth::default_probe(frame_scene), options.threads);
       }
+      if (i == 0) first_probe = still_probe;
       write_radiance(out / name, synth::add_probe_noise(*still_probe, options.probe_noise, options.seed,
                                                         static_cast<std::uint64_t>(i)));
       probe_list.append(stem).append(" ").append(name).append("\n");
@@ -89,10 +91,9 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
   }
   writer.finish();
   if (options.probe) {
-    const synth::Scene first = animated && options.frames > 0
-                                   ? synth::scene_at_frame(scene, options.light_animation, 0, options.frames)
-                                   : scene;
-    write_radiance(out / "probe.hdr", synth::render_probe(first, synth::default_probe(first), options.threads));
+    // Per-frame probes already rendered frame 0's; otherwise the scene's (frame 0's) is rendered now.
+    if (!first_probe) first_probe = synth::render_probe(scene, synth::default_probe(scene), options.threads);
+    write_radiance(out / "probe.hdr", *first_probe);
     if (per_frame_probes) write_file_atomically(out / "probe.txt", probe_list);
   }
   write_file_atomically(out / "scene.json", synth::scene_json(scene, options));
