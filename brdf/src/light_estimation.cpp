@@ -270,7 +270,7 @@ void LightEstimator::fit() {
   }
   estimate_.fit_samples = samples.size();
   const int clusters = std::clamp(options_.clusters, 1, 16);
-  if (samples.size() < static_cast<std::size_t>(4 * clusters)) return;
+  if (samples.size() < 4 * static_cast<std::size_t>(clusters)) return;
 
   std::vector<std::array<double, lights::kShCoefficients>> basis(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i) basis[i] = lights::sh_basis(samples[i].normal);
