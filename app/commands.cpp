@@ -74,7 +74,9 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
       ->default_str("")
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   command.add_option("--lights", options.lights,
-                     "Lights JSON of `relight lights`: constant real lights instead of a light probe");
+                     "Lights JSON of `relight lights`: constant real lights instead of a light probe; or `estimate`: "
+                     "estimate them from the RGB-D frames (spherical-harmonics environment and the dominant light from "
+                     "cast shadows, accumulated in the world frame) for sequences without a probe");
   command.add_option("--probe", options.probe,
                      "Light probe the real lights are extracted from every frame: a folder with probe.txt "
                      "(\"timestamp filename\" lines), such a list, one image (.hdr, .exr, or 8-bit .png/.jpg), a video "

@@ -40,6 +40,7 @@ lights::ProbeCalibration probe_calibration(const ProbeInputOptions& options) {
 
 RealLightSource real_light_source(const fs::path& lights_file, const std::string& probe,
                                   const std::optional<fs::path>& scene, const std::string& no_probe) {
+  if (lights_file == kEstimateLights) return {{}, {}, true};
   if (!lights_file.empty()) return {lights_file, {}};
   if (!probe.empty()) return {{}, probe};
   std::error_code ec;
@@ -48,19 +49,13 @@ RealLightSource real_light_source(const fs::path& lights_file, const std::string
     if (fs::is_regular_file(*scene / "probe.hdr", ec)) return {{}, (*scene / "probe.hdr").string()};
   }
   throw Error(no_probe +
-              ": give one with --probe PATH|DEVICE or its lights with --lights FILE "
-              "(from `relight lights`)");
+              ": give one with --probe PATH|DEVICE, its lights with --lights FILE (from `relight lights`), "
+              "or estimate them from the frames with --lights estimate");
 }
 
-lights::ProbeStreamStage* add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
-                                                const ProbeInputOptions& options, Backend per_pixel,
-                                                vk::VulkanContext* context) {
-  if (!source.lights_file.empty()) {
-    graph.emplace<ConstantStage<lights::LightSet>>(
-        lights::kLights, lights::lights_from_json(read_text_file(source.lights_file), source.lights_file.string()));
-    return nullptr;
-  }
-  if (options.lights < 1 || options.lights > 4096) throw Error("--probe-lights must be 1 to 4096");
+namespace {
+lights::ProbeStreamStage& add_probe_stream_stage(FrameGraph& graph, const RealLightSource& source,
+                                                 const ProbeInputOptions& options) {
   if (!(options.tolerance_s >= 0.0)) throw Error("--probe-tolerance must not be negative");
   lights::ProbeResponse response =
       options.response.empty() ? lights::ProbeResponse{} : lights::read_probe_response(options.response);
@@ -69,15 +64,33 @@ lights::ProbeStreamStage* add_real_light_stages(FrameGraph& graph, const RealLig
   lights::ProbeMatchOptions matching;
   matching.tolerance_s = options.tolerance_s;
   matching.offset_s = options.offset_s;
-  auto& probe = graph.emplace<lights::ProbeStreamStage>(open_probe_input(source.probe, response), matching);
+  return graph.emplace<lights::ProbeStreamStage>(open_probe_input(source.probe, response), matching);
+}
+}  // namespace
+
+RealLightStages add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
+                                      const ProbeInputOptions& options, Backend per_pixel, vk::VulkanContext* context) {
+  if (!source.lights_file.empty()) {
+    graph.emplace<ConstantStage<lights::LightSet>>(
+        lights::kLights, lights::lights_from_json(read_text_file(source.lights_file), source.lights_file.string()));
+    return {};
+  }
+  if (options.lights < 1 || options.lights > 4096) throw Error("--probe-lights must be 1 to 4096");
+  RealLightStages stages;
   lights::LightExtractionOptions extraction;
   extraction.lights = options.lights;
-  extraction.calibration = probe_calibration(options);
+  if (source.estimate) {
+    stages.estimation = &graph.emplace<brdf::LightEstimationStage>();
+    extraction.calibration = lights::ProbeCalibration::equirectangular();
+  } else {
+    stages.probe = &add_probe_stream_stage(graph, source, options);
+    extraction.calibration = probe_calibration(options);
+  }
   // Without smoothing the extracted lights are the lights (for comparisons: the flicker it removes).
   const lights::LightExtractionBuffers buffers{kProbe, options.smoothing ? lights::kLightsRaw : lights::kLights};
   graph.add(lights::make_light_extraction_stage(per_pixel, context, extraction, buffers));
   if (options.smoothing) graph.emplace<lights::LightSmoothingStage>();
-  return &probe;
+  return stages;
 }
 
 }  // namespace relight::app

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "relight/brdf/light_estimation_stage.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/stage_backend.h"
 #include "relight/lights/probe_geometry.h"
@@ -43,17 +44,28 @@ struct ProbeInputOptions {
 struct RealLightSource {
   std::filesystem::path lights_file;  ///< constant lights (`relight lights` JSON); else the probe
   std::string probe;                  ///< probe spec (video_probe_stream.h: open_probe_input)
+  bool estimate = false;              ///< `--lights estimate`: from the RGB-D frames (brdf/light_estimation.h)
 };
 
-/// --lights, else --probe, else `scene`'s probe.txt, else its probe.hdr; when there is none,
-/// throws relight::Error("<no_probe>: give one with --probe ... or its lights with --lights ...").
+/// The --lights value that estimates the lights from the frames instead of reading a file.
+inline constexpr const char* kEstimateLights = "estimate";
+
+/// --lights (a file, or `estimate`), else --probe, else `scene`'s probe.txt, else its probe.hdr;
+/// when there is none, throws relight::Error("<no_probe>: give one with --probe ... or its
+/// lights with --lights ...").
 [[nodiscard]] RealLightSource real_light_source(const std::filesystem::path& lights_file, const std::string& probe,
                                                 const std::optional<std::filesystem::path>& scene,
                                                 const std::string& no_probe);
 
-/// Adds the stages that write lights::kLights; returns the probe stage (nullptr for a lights file).
-lights::ProbeStreamStage* add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
-                                                const ProbeInputOptions& options, Backend per_pixel,
-                                                vk::VulkanContext* context);
+/// The stages add_real_light_stages added that report.json summarises (null when absent).
+struct RealLightStages {
+  lights::ProbeStreamStage* probe = nullptr;
+  brdf::LightEstimationStage* estimation = nullptr;
+};
+
+/// Adds the stages that write lights::kLights: a constant set from a lights file, or the probe
+/// stream (or the estimate's environment map) -> light_extraction -> light_smoothing.
+RealLightStages add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
+                                      const ProbeInputOptions& options, Backend per_pixel, vk::VulkanContext* context);
 
 }  // namespace relight::app

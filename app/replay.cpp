@@ -175,7 +175,10 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   FrameGraph& graph = *pipeline.graph;
   if (!content.objects.empty())
     pipeline.placement = &graph.emplace<ObjectPlacementStage>(std::move(requests), std::move(names));
-  pipeline.probe = add_real_light_stages(graph, real_lights, options.probe_input, per_pixel, pipeline.vulkan.get());
+  const RealLightStages light_stages =
+      add_real_light_stages(graph, real_lights, options.probe_input, per_pixel, pipeline.vulkan.get());
+  pipeline.probe = light_stages.probe;
+  pipeline.light_estimation = light_stages.estimation;
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
   graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
   render::DirStageOptions dir;
@@ -270,6 +273,7 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
   }
   report["tracking"] = pipeline.trajectory->summary();
   if (pipeline.probe) report["probe"] = pipeline.probe->summary();
+  if (pipeline.light_estimation) report["light_estimate"] = pipeline.light_estimation->summary();
   report["latency_ms"] = pipeline.latency->summary();
   if (pipeline.placement) {
     report["placements"] = pipeline.placement->summary();

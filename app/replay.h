@@ -71,7 +71,8 @@ struct ReplayOptions {
   /// The main job (`relight replay` on the embedded sample with nothing to render) renders the
   /// shipped pebble on the sample's support plane, lit by the shipped probe; this turns it off.
   bool no_object = false;
-  std::filesystem::path lights;  ///< lights JSON of `relight lights`: constant real lights
+  /// Lights JSON of `relight lights` (constant real lights), or "estimate": from the frames.
+  std::filesystem::path lights;
   /// The light probe stream the real lights are extracted from every frame (app/probe_input.h):
   /// a folder with probe.txt, a list, an image, a video or a camera; empty: the sequence's own
   /// probe.txt or probe.hdr. The main job's sample, recorded without one, gets a stand-in.
@@ -118,6 +119,7 @@ struct ReplayPipeline {
   app::ObjectPlacementStage* placement = nullptr;  ///< set when there are virtual objects
   app::LatencyStage* latency = nullptr;           ///< capture to final picture, every frame
   lights::ProbeStreamStage* probe = nullptr;      ///< set when the real lights come from a probe
+  brdf::LightEstimationStage* light_estimation = nullptr;  ///< set with --lights estimate
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".

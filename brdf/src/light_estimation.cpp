@@ -398,15 +398,14 @@ void LightEstimator::fit_shadows(const ColorImage& color, const Mask* highlights
   if (centres_.empty() || estimate_.albedos.empty()) return;
   struct ShadowSample {
     Vector3d position, normal;  // camera frame
-    Vector3d residual;          // I - rho E_sh / pi
     Vector3d base;              // rho / pi
     double locality;
+    Vector3d colour;              // linear RGB
+    std::uint64_t neighbourhood;  // world cell, material and normal (see below)
   };
   std::vector<ShadowSample> samples;
-  const double pixels = static_cast<double>(color.width()) * color.height();
-  const int stride = std::max(1, static_cast<int>(std::sqrt(pixels / std::max(1, options_.shadow_samples))));
+  const int stride = std::max(1, options_.shadow_stride);
   const Eigen::Matrix3d rotation = camera_to_world.linear();
-  double total_squared = 0.0;
   for (int row = stride / 2; row < color.height(); row += stride) {
     for (int col = stride / 2; col < color.width(); col += stride) {
       const Float3& p = positions(row, col);
@@ -414,31 +413,91 @@ void LightEstimator::fit_shadows(const ColorImage& color, const Mask* highlights
       if (!usable_pixel(color(row, col), highlights && (*highlights)(row, col) != 0, p, n)) continue;
       const Vector3d colour = linear_rgb(color(row, col));
       const Vector3d world_normal = rotation * vec(n);
-      const Vector3d& rho = estimate_.albedos[static_cast<std::size_t>(material_of(colour, world_normal))];
-      const Vector3d residual = colour - rho.cwiseProduct(estimate_.irradiance_at(world_normal)) / kPi;
+      const int material = material_of(colour, world_normal);
+      const Vector3d& rho = estimate_.albedos[static_cast<std::size_t>(material)];
+      // Only the neighbourhood: far surfaces under other lamps' falloff mimic shadows.
       const double weight = locality(camera_to_world * vec(p));
-      samples.push_back({vec(p), vec(n), residual, rho / kPi, weight});
-      total_squared += weight * lights::luminance(residual) * lights::luminance(residual);
+      if (weight < 0.3) continue;
+      // Neighbours: one 8 cm world cell, one material, normals in one 0.25-wide bucket.
+      const Vector3d bucket = (world_normal * 4.0).array().round();
+      const std::uint64_t neighbourhood = voxel_key(camera_to_world * vec(p), 0.08) ^
+                                          (voxel_key(bucket, 1.0) * 0x9e3779b97f4a7c15ull) ^
+                                          (static_cast<std::uint64_t>(material) << 58);
+      samples.push_back({vec(p), vec(n), rho / kPi, weight, colour, neighbourhood});
     }
   }
-  if (samples.empty() || total_squared <= 0.0) return;
+  if (samples.empty()) return;
+  // At most shadow_samples of them, evenly spread.
+  const std::size_t keep_every = (samples.size() + static_cast<std::size_t>(std::max(1, options_.shadow_samples)) - 1) /
+                                 static_cast<std::size_t>(std::max(1, options_.shadow_samples));
+  if (keep_every > 1) {
+    std::vector<ShadowSample> kept;
+    for (std::size_t i = 0; i < samples.size(); i += keep_every) kept.push_back(samples[i]);
+    samples = std::move(kept);
+  }
 
-  // Luminance least squares of the shadow term for direction d (camera frame).
+  std::unordered_map<std::uint64_t, std::uint32_t> cell_of;
+  std::vector<std::uint32_t> cells(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    cells[i] = cell_of.emplace(samples[i].neighbourhood, static_cast<std::uint32_t>(cell_of.size())).first->second;
+  }
+  // What the neighbourhoods leave unexplained: the squared error the shadow term can take a share of.
+  double total_squared = 0.0;
+  {
+    std::vector<double> sum(cell_of.size(), 0.0), count(cell_of.size(), 0.0);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      sum[cells[i]] += lights::luminance(samples[i].colour);
+      count[cells[i]] += 1.0;
+    }
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const double r = lights::luminance(samples[i].colour) - sum[cells[i]] / count[cells[i]];
+      total_squared += samples[i].locality * r * r;
+    }
+    if (total_squared <= 0.0) return;
+  }
+
+  // Least squares of the shadow term for direction d (camera frame). An occluded sample is
+  // compared with the lit samples of its neighbourhood (same material, normal and place), not
+  // with the SH: the SH cannot follow a near lamp's falloff or a glossy sheen, its neighbours do.
   struct Score {
     double share = 0.0;
     Vector3d rc = Vector3d::Zero(), cc = Vector3d::Zero();
+    int compared = 0;
   };
+  std::vector<double> cosines(samples.size());
+  std::vector<char> shadowed(samples.size());
+  std::vector<Vector3d> lit_sum(cell_of.size());
+  std::vector<double> lit_count(cell_of.size());
   const auto score = [&](const Vector3d& world_direction) {
+    // A dominant light lies on the bright side of the environment: surfaces facing it receive
+    // more than those facing away (this rules out "lights" below a table, whose darkness the
+    // shadow term would otherwise explain).
+    if (lights::luminance(estimate_.irradiance_at(world_direction)) <=
+        lights::luminance(estimate_.irradiance_at(-world_direction))) {
+      return Score{};
+    }
     const Vector3d d = rotation.transpose() * world_direction;
+    std::fill(lit_sum.begin(), lit_sum.end(), Vector3d::Zero());
+    std::fill(lit_count.begin(), lit_count.end(), 0.0);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      cosines[i] = samples[i].normal.dot(d);
+      shadowed[i] = cosines[i] > 0.1 && occluded(positions, intrinsics, samples[i].position, samples[i].normal, d);
+      if (cosines[i] > 0.1 && !shadowed[i]) {
+        lit_sum[cells[i]] += samples[i].colour;
+        lit_count[cells[i]] += 1.0;
+      }
+    }
     Score s;
     double rc = 0.0, cc = 0.0;
-    for (const ShadowSample& sample : samples) {
-      const double cosine = sample.normal.dot(d);
-      if (cosine <= 0.1 || !occluded(positions, intrinsics, sample.position, sample.normal, d)) continue;
-      const Vector3d c = cosine * sample.base;
-      s.rc += sample.locality * sample.residual.cwiseProduct(c);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      if (!shadowed[i] || lit_count[cells[i]] < 2.0) continue;
+      const ShadowSample& sample = samples[i];
+      const Vector3d residual = sample.colour - lit_sum[cells[i]] / lit_count[cells[i]];
+      const Vector3d c = cosines[i] * sample.base;
+      ++s.compared;
+      s.rc += sample.locality * residual.cwiseProduct(c);
       s.cc += sample.locality * c.cwiseProduct(c);
-      rc += sample.locality * lights::luminance(sample.residual) * lights::luminance(c);
+      rc += sample.locality * lights::luminance(residual) * lights::luminance(c);
       cc += sample.locality * lights::luminance(c) * lights::luminance(c);
     }
     if (rc < 0.0 && cc > 0.0) s.share = rc * rc / cc / total_squared;
@@ -469,7 +528,7 @@ void LightEstimator::fit_shadows(const ColorImage& color, const Mask* highlights
     }
   }
   estimate_.shadow_share = best_score.share;
-  if (best_score.share < options_.min_shadow_share) return;
+  if (best_score.share < options_.min_shadow_share || best_score.compared < options_.min_shadowed_samples) return;
   const Vector3d power = (-best_score.rc).cwiseQuotient(best_score.cc.cwiseMax(1e-12)).cwiseMax(0.0);
   const Vector3d fraction = power.cwiseQuotient(irradiance_floor(estimate_.irradiance_at(best)));
   shadow_direction_sum_ += best_score.share * best;

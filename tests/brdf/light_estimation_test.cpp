@@ -62,6 +62,8 @@ TEST(LightEstimation, MeasuresTheTablesIrradianceOnTheSyntheticRoom) {
   // What is not met yet (printed for the record): the dominant light's direction (goal 10
   // degrees) and the light's colour (the white patch takes the yellow plastic for white).
   const Vector3d chroma = estimated / estimated.sum(), true_chroma = truth / truth.sum();
+  EXPECT_EQ(e.evidence, LightEvidence::Shadows) << e.to_json().dump();
+  EXPECT_EQ(e.shadow_frames, 2);
   EXPECT_LE(lights::luminance(e.power), lights::luminance(e.irradiance_at(e.direction)) + 1e-9);
   std::cout << e.to_json().dump() << "\n  dominant light "
             << degrees_between(e.direction, true_dominant_direction(s.scene))
