@@ -8,6 +8,7 @@
 
 #include "relight/brdf/kmeans.h"
 #include "relight/brdf/shading.h"
+#include "relight/core/parallel.h"
 #include "relight/lights/light_set.h"
 #include "relight/lights/probe_geometry.h"
 
@@ -464,11 +465,13 @@ void LightEstimator::fit_shadows(const ColorImage& color, const Mask* highlights
     Vector3d rc = Vector3d::Zero(), cc = Vector3d::Zero();
     int compared = 0;
   };
-  std::vector<double> cosines(samples.size());
-  std::vector<char> shadowed(samples.size());
-  std::vector<Vector3d> lit_sum(cell_of.size());
-  std::vector<double> lit_count(cell_of.size());
-  const auto score = [&](const Vector3d& world_direction) {
+  struct Scratch {
+    std::vector<double> cosines;
+    std::vector<char> shadowed;
+    std::vector<Vector3d> lit_sum;
+    std::vector<double> lit_count;
+  };
+  const auto score = [&](const Vector3d& world_direction, Scratch& scratch) {
     // A dominant light lies on the bright side of the environment: surfaces facing it receive
     // more than those facing away (this rules out "lights" below a table, whose darkness the
     // shadow term would otherwise explain).
@@ -477,8 +480,11 @@ void LightEstimator::fit_shadows(const ColorImage& color, const Mask* highlights
       return Score{};
     }
     const Vector3d d = rotation.transpose() * world_direction;
-    std::fill(lit_sum.begin(), lit_sum.end(), Vector3d::Zero());
-    std::fill(lit_count.begin(), lit_count.end(), 0.0);
+    auto& [cosines, shadowed, lit_sum, lit_count] = scratch;
+    cosines.resize(samples.size());
+    shadowed.resize(samples.size());
+    lit_sum.assign(cell_of.size(), Vector3d::Zero());
+    lit_count.assign(cell_of.size(), 0.0);
     for (std::size_t i = 0; i < samples.size(); ++i) {
       cosines[i] = samples[i].normal.dot(d);
       shadowed[i] = cosines[i] > 0.1 && occluded(positions, intrinsics, samples[i].position, samples[i].normal, d);
@@ -503,12 +509,28 @@ void LightEstimator::fit_shadows(const ColorImage& color, const Mask* highlights
     if (rc < 0.0 && cc > 0.0) s.share = rc * rc / cc / total_squared;
     return s;
   };
+  // Every candidate of a batch scored in parallel, each worker with its own scratch.
+  const auto score_all = [&](const std::vector<Vector3d>& directions) {
+    std::vector<Score> scores(directions.size());
+    parallel_rows(
+        static_cast<int>(directions.size()), options_.threads,
+        [&](int begin, int end) {
+          Scratch scratch;
+          for (int i = begin; i < end; ++i)
+            scores[static_cast<std::size_t>(i)] = score(directions[static_cast<std::size_t>(i)], scratch);
+        },
+        8);
+    return scores;
+  };
+  const std::vector<Vector3d> sphere = fibonacci_sphere(256);
+  const std::vector<Score> sphere_scores = score_all(sphere);
   std::vector<std::pair<double, Vector3d>> coarse;
-  for (const Vector3d& d : fibonacci_sphere(256)) coarse.emplace_back(score(d).share, d);
+  for (std::size_t i = 0; i < sphere.size(); ++i) coarse.emplace_back(sphere_scores[i].share, sphere[i]);
   std::partial_sort(coarse.begin(), coarse.begin() + 3, coarse.end(),
                     [](const auto& a, const auto& b) { return a.first > b.first; });
   Vector3d best = coarse[0].second;
-  Score best_score = score(best);
+  Score best_score = sphere_scores[static_cast<std::size_t>(
+      std::find_if(sphere.begin(), sphere.end(), [&](const Vector3d& d) { return d == best; }) - sphere.begin())];
   for (const double step_degrees : {3.0, 1.0}) {
     std::vector<Vector3d> candidates;
     if (step_degrees == 3.0) {
@@ -519,11 +541,11 @@ void LightEstimator::fit_shadows(const ColorImage& color, const Mask* highlights
     } else {
       candidates = grid_around(best, step_degrees * kPi / 180.0, 2);
     }
-    for (const Vector3d& d : candidates) {
-      const Score s = score(d);
-      if (s.share > best_score.share) {
-        best_score = s;
-        best = d;
+    const std::vector<Score> scores = score_all(candidates);
+    for (std::size_t i = 0; i < candidates.size(); ++i) {
+      if (scores[i].share > best_score.share) {
+        best_score = scores[i];
+        best = candidates[i];
       }
     }
   }

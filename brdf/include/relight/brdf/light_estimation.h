@@ -89,6 +89,7 @@ struct LightEstimationOptions {
   /// distant environment cannot explain; the estimate holds for where the camera looks.
   double locality_radius = 0.4;
   std::uint64_t seed = 1;
+  int threads = 0;  ///< the shadow search's workers (core/parallel.h; 0 = all)
 };
 
 enum class LightEvidence { None, Shading, Shadows };
