@@ -4,11 +4,15 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <sstream>
 
 #include "bench.h"
+#include "relight/brdf/highlight.h"
+#include "relight/brdf/light_estimation.h"
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/image_io.h"
@@ -19,6 +23,7 @@
 #include "relight/lights/probe_stream_stage.h"
 #include "relight/synth/light_animation.h"
 #include "relight/synth/probe.h"
+#include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
 #include "relight/vk/transfer.h"
@@ -190,6 +195,53 @@ bench::Json stream_640x480(const bench::Options& options) { return stream::run(o
 bench::Json stream_640x480_vulkan(const bench::Options& options) { return stream::run(options, Backend::Vulkan); }
 
 RELIGHT_BENCH_CASE("lights/stream_640x480", stream_640x480);
+
+// lights/estimate_640x480: the real light without a probe (brdf/light_estimation.h), one
+// add_frame per RGB-D frame of the synthetic room's static 640x480 view (highlights removed as
+// the graph does; the accumulation grows over the first frames, then only the voxels' means
+// change). `ms` is the per-frame median; the quality fields are the last estimate's dominant-light
+// direction error against lamp 1 seen from the table and the table's irradiance error.
+bench::Json estimate_640x480(const bench::Options& options) {
+  const synth::Scene scene = synth::default_indoor_scene();
+  const PinholeIntrinsics intrinsics = PinholeIntrinsics::kinect_v1();
+  const Pose pose = synth::make_trajectory(synth::Trajectory::Static, 1, 0, scene)[0];
+  const synth::RenderedFrame frame = synth::render_frame(scene, intrinsics, pose);
+  PositionMap positions(intrinsics.width, intrinsics.height);
+  for (int r = 0; r < intrinsics.height; ++r) {
+    for (int c = 0; c < intrinsics.width; ++c) {
+      const float z = frame.depth(r, c);
+      if (z <= 0.f) continue;
+      const Eigen::Vector3d p = intrinsics.unproject(c, r, z);
+      positions(r, c) = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+    }
+  }
+  ColorImage cleaned;
+  Mask highlights;
+  brdf::remove_highlights(synth::encode_color(frame.radiance), {}, cleaned, highlights);
+  brdf::LightEstimator estimator;
+  const double ms =
+      bench::median_ms([&] { estimator.add_frame(cleaned, &highlights, positions, frame.normals, intrinsics, pose); },
+                       std::max(options.repetitions, 3));
+  const brdf::LightEstimate& e = estimator.estimate();
+  Eigen::Vector3d truth = std::numbers::pi * scene.environment;
+  for (const synth::PointLight& light : scene.lights) {
+    const Eigen::Vector3d offset = light.position - scene.look_at;
+    truth += light.colour * (light.intensity * offset.normalized().z() / offset.squaredNorm());
+  }
+  const Eigen::Vector3d lamp = (scene.lights[0].position - scene.look_at).normalized();
+  const double direction_error = std::acos(std::clamp(e.direction.dot(lamp), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+  const double irradiance_error =
+      lights::luminance(e.irradiance_at(Eigen::Vector3d::UnitZ())) / lights::luminance(truth) - 1.0;
+  return {{"ms", ms},
+          {"width", intrinsics.width},
+          {"height", intrinsics.height},
+          {"evidence", brdf::to_string(e.evidence)},
+          {"direction_error_degrees", direction_error},
+          {"irradiance_rel_error", irradiance_error},
+          {"voxels", e.voxels}};
+}
+
+RELIGHT_BENCH_CASE("lights/estimate_640x480", estimate_640x480);
 RELIGHT_BENCH_CASE("lights/stream_640x480_vulkan", stream_640x480_vulkan);
 
 }  // namespace
