@@ -91,15 +91,14 @@ bool occluded(const PositionMap& positions, const PinholeIntrinsics& k, const Ve
 
 Vector3d irradiance_floor(const Vector3d& e) { return e.cwiseMax(kMinIrradiance); }
 
-/// The K-means feature of a reflectance: chromaticity (r, g of r + g + b) and, with weight
-/// `brightness_weight`, the log of its luminance relative to `median` (one unit per factor e^4):
-/// shading changes brightness but not chromaticity, so the first iterations cluster on colour
-/// alone and only a light that already explains the shading lets brightness split materials.
-Float3 material_feature(const Vector3d& kd, double median, double brightness_weight) {
+/// The K-means feature of a reflectance: its chromaticity (r and g of r + g + b, doubled to
+/// use the feature range), third component 0. Shading changes brightness but not chromaticity;
+/// brightness would split one material by its shading wherever the light does not explain it yet
+/// (a point light's falloff, shadows), so a black and a white material of one hue share a
+/// cluster and the darker one counts as an outlier.
+Float3 material_feature(const Vector3d& kd) {
   const double sum = std::max(kd.sum(), 1e-9);
-  const double brightness = std::log(std::max(lights::luminance(kd), 1e-9) / std::max(median, 1e-9)) / 4.0;
-  return kmeans_feature({static_cast<float>(2.0 * kd.x() / sum), static_cast<float>(2.0 * kd.y() / sum),
-                         static_cast<float>(brightness_weight * (brightness + 1.0))});
+  return kmeans_feature({static_cast<float>(2.0 * kd.x() / sum), static_cast<float>(2.0 * kd.y() / sum), 0.f});
 }
 
 /// Greedy merge of centres closer than `distance` (the larger cluster's centre stays); relabels.
@@ -246,7 +245,7 @@ double LightEstimator::locality(const Vector3d& world) const {
 
 int LightEstimator::material_of(const Vector3d& colour, const Vector3d& world_normal) const {
   const Vector3d kd = kPi * colour.cwiseQuotient(irradiance_floor(estimate_.irradiance_at(world_normal)));
-  const Float3 f = material_feature(kd, median_kd_, brightness_weight_);
+  const Float3 f = material_feature(kd);
   int best = 0;
   float best_distance = std::numeric_limits<float>::max();
   for (std::size_t c = 0; c < centres_.size(); ++c) {
@@ -294,16 +293,10 @@ void LightEstimator::fit() {
   const int iterations = std::max(2, options_.iterations);
   for (int iteration = 0; iteration < iterations; ++iteration) {
     // k_d per sample with the current light, clustered into materials.
-    std::vector<Vector3d> kd(samples.size());
-    std::vector<double> lum(samples.size());
     for (std::size_t i = 0; i < samples.size(); ++i) {
-      kd[i] = kPi * samples[i].colour.cwiseQuotient(irradiance_floor(sh.evaluate(samples[i].normal)));
-      lum[i] = lights::luminance(kd[i]);
+      features[i] =
+          material_feature(kPi * samples[i].colour.cwiseQuotient(irradiance_floor(sh.evaluate(samples[i].normal))));
     }
-    std::nth_element(lum.begin(), lum.begin() + static_cast<std::ptrdiff_t>(lum.size() / 2), lum.end());
-    median_kd_ = lum[lum.size() / 2];
-    for (std::size_t i = 0; i < samples.size(); ++i)
-      features[i] = material_feature(kd[i], median_kd_, brightness_weight_);
     engine_->set_points(features);
     KMeansResult result = kmeans(*engine_, features, kmeans_options, 2, rng);
     centres_ = std::move(result.centres);
@@ -366,7 +359,6 @@ void LightEstimator::fit() {
       const double s = options_.white_albedo / brightest;
       for (int k = 0; k < 9; ++k) sh.coefficients[static_cast<std::size_t>(k)] = (environment[k] / s) * light_colour_;
       for (auto& a : albedos) a *= s;
-      median_kd_ *= s;  // k_d with the rescaled light (the feature is chromaticity)
     }
 
     // Cauchy weights from the relative luminance residual.

@@ -46,11 +46,6 @@ ShRgb ShRgb::irradiance_to_radiance() const {
   return out;
 }
 
-ShRgb& ShRgb::operator+=(const ShRgb& other) {
-  for (std::size_t i = 0; i < coefficients.size(); ++i) coefficients[i] += other.coefficients[i];
-  return *this;
-}
-
 ShRgb& ShRgb::operator-=(const ShRgb& other) {
   for (std::size_t i = 0; i < coefficients.size(); ++i) coefficients[i] -= other.coefficients[i];
   return *this;

@@ -73,7 +73,7 @@ struct LightEstimationOptions {
   std::size_t max_voxels = 40000;      ///< new surfaces beyond this are not added
   std::size_t max_fit_samples = 6000;  ///< voxels one fit uses (an even stride over them)
   int clusters = 6;                    ///< K-means' K; centres closer than merge_distance merge
-  double merge_distance = 0.08;        ///< feature units: 0.04 of chromaticity, or a brightness factor 1.4
+  double merge_distance = 0.08;        ///< feature units: 0.04 of chromaticity
   int iterations = 5;                  ///< albedo / light alternations per frame
   double white_albedo = 0.75;          ///< luminance albedo of the brightest samples (step 3)
   double white_share = 0.03;           ///< the brightest share of samples that is "white" (step 3)
@@ -158,13 +158,7 @@ class LightEstimator {
   std::unordered_map<std::uint64_t, std::uint32_t> voxel_index_;
   std::vector<Voxel> voxels_;
   std::unique_ptr<KMeansEngine> engine_;
-  std::vector<Eigen::Vector3f> centres_;  ///< materials in feature space (light_estimation.cpp)
-  double median_kd_ = 1.0;                ///< luminance, the brightness feature's reference
-  /// Of the brightness feature. 0: materials by chromaticity alone. Brightness would split one
-  /// material by its shading wherever the light does not explain it yet (a point light's falloff,
-  /// shadows); a black and a white material of one hue share a cluster and the darker one counts
-  /// as an outlier.
-  double brightness_weight_ = 0.0;
+  std::vector<Eigen::Vector3f> centres_;                         ///< materials in feature space (light_estimation.cpp)
   Eigen::Vector3d brightest_normal_ = Eigen::Vector3d::UnitZ();  ///< of the fit's samples, by E_sh
   Eigen::Vector3d shadow_direction_sum_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d shadow_fraction_sum_ = Eigen::Vector3d::Zero();  ///< P / E_sh(d), share-weighted

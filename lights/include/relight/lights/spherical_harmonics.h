@@ -40,7 +40,6 @@ struct ShRgb {
   /// Irradiance coefficients of this radiance (A_l L_lm), or radiance of this irradiance.
   [[nodiscard]] ShRgb radiance_to_irradiance() const;
   [[nodiscard]] ShRgb irradiance_to_radiance() const;
-  ShRgb& operator+=(const ShRgb& other);
   ShRgb& operator-=(const ShRgb& other);
   [[nodiscard]] ShRgb operator*(double factor) const;
 };
