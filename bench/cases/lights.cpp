@@ -223,11 +223,7 @@ bench::Json estimate_640x480(const bench::Options& options) {
       bench::median_ms([&] { estimator.add_frame(cleaned, &highlights, positions, frame.normals, intrinsics, pose); },
                        std::max(options.repetitions, 3));
   const brdf::LightEstimate& e = estimator.estimate();
-  Eigen::Vector3d truth = std::numbers::pi * scene.environment;
-  for (const synth::PointLight& light : scene.lights) {
-    const Eigen::Vector3d offset = light.position - scene.look_at;
-    truth += light.colour * (light.intensity * offset.normalized().z() / offset.squaredNorm());
-  }
+  const Eigen::Vector3d truth = synth::unoccluded_irradiance(scene, scene.look_at, Eigen::Vector3d::UnitZ());
   const Eigen::Vector3d lamp = (scene.lights[0].position - scene.look_at).normalized();
   const double direction_error = std::acos(std::clamp(e.direction.dot(lamp), -1.0, 1.0)) * 180.0 / std::numbers::pi;
   const double irradiance_error =

@@ -1,6 +1,8 @@
 #include "relight/synth/scene.h"
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "relight/core/error.h"
 
@@ -109,6 +111,15 @@ int Scene::object_index(const std::string& name) const {
     if (objects[i].name == name) return static_cast<int>(i);
   }
   throw Error("synthetic scene has no object named " + name);
+}
+
+Eigen::Vector3d unoccluded_irradiance(const Scene& scene, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
+  Eigen::Vector3d e = std::numbers::pi * scene.environment;
+  for (const PointLight& light : scene.lights) {
+    const Vector3d offset = light.position - point;
+    e += light.colour * (light.intensity * std::max(0.0, normal.dot(offset.normalized())) / offset.squaredNorm());
+  }
+  return e;
 }
 
 Scene default_indoor_scene() {

@@ -23,12 +23,7 @@ double degrees_between(const Vector3d& a, const Vector3d& b) {
 /// What the synthetic camera image says the table receives at the look-at point: both point
 /// lights unoccluded plus the constant sky (synth/scene.h's shading model).
 Vector3d true_table_irradiance(const synth::Scene& scene) {
-  Vector3d e = std::numbers::pi * scene.environment;
-  for (const synth::PointLight& light : scene.lights) {
-    const Vector3d offset = light.position - scene.look_at;
-    e += light.colour * (light.intensity * offset.normalized().z() / offset.squaredNorm());
-  }
-  return e;
+  return synth::unoccluded_irradiance(scene, scene.look_at, Vector3d::UnitZ());
 }
 
 /// The strongest light as seen from the table: the direction towards it.

@@ -109,6 +109,12 @@ struct Scene {
   [[nodiscard]] int object_index(const std::string& name) const;    ///< throws relight::Error
 };
 
+/// Irradiance (RGB) on a surface at `point` of unit normal `normal` with nothing in the way: the
+/// sky's pi * environment plus every light's E of the shading model above (the k_d / pi factor
+/// turns it into the diffuse radiance the camera sees).
+[[nodiscard]] Eigen::Vector3d unoccluded_irradiance(const Scene& scene, const Eigen::Vector3d& point,
+                                                    const Eigen::Vector3d& normal);
+
 /// Unit world up (+z).
 inline Eigen::Vector3d world_up() { return Eigen::Vector3d::UnitZ(); }
 
