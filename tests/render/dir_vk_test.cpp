@@ -136,9 +136,19 @@ TEST_F(DirVkTest, ShadowAtlasMatchesTheRayCastReference) {
   EXPECT_LT(coverage_mismatch, cpu.size() / 100);
 }
 
-TEST_F(DirVkTest, IsmAtlasMatchesTheCpuSplatsAndPullPush) {
-  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
-  const MrScene scene = cube_scene();
+/// The cube scene with a sun that reaches it through its emitter VPL (vpl.h).
+MrScene cube_scene_with_emitter() {
+  MrScene scene = cube_scene();
+  MrLight sun;
+  sun.kind = LightKind::Directional;
+  sun.direction = Eigen::Vector3f(-0.6f, -0.3f, 1.f).normalized();
+  sun.intensity = Eigen::Vector3f::Constant(1.5f);
+  sun.through_vpl = true;
+  scene.lights.push_back(sun);
+  return scene;
+}
+
+void expect_ism_atlas_matches_cpu(vk::VulkanContext& context, const MrScene& scene) {
   const DirRenderOptions options = test_options();
   const std::vector<Vpl> vpls = make_vpls(scene, 48);
   DirRendererVk renderer(context, 32, 24);
@@ -162,19 +172,21 @@ TEST_F(DirVkTest, IsmAtlasMatchesTheCpuSplatsAndPullPush) {
   EXPECT_GT(agree, cpu.size() * 995 / 1000);
 }
 
-TEST_F(DirVkTest, ShadingMatchesTheCpuMirrorOnTheSameMaps) {
+TEST_F(DirVkTest, IsmAtlasMatchesTheCpuSplatsAndPullPush) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
-  const MrScene scene = cube_scene();
+  expect_ism_atlas_matches_cpu(context, cube_scene());
+}
+
+void expect_shading_matches_cpu(vk::VulkanContext& context, const MrScene& scene) {
   const DirRenderOptions options = test_options();
   const std::vector<Vpl> vpls = make_vpls(scene, 64);
   const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 64, 48);
   DirRendererVk renderer(context, 64, 48);
   renderer.set_scene(scene, options);
   const DifferentialImages gpu = renderer.render(camera, vpls, options);
-  const DifferentialImages cpu =
-      shade_dir_from_maps(renderer.last_gbuffer(), scene, camera.camera_to_world.translation().cast<float>(),
-                          renderer.shadow_layout(), renderer.last_shadow_atlas(), vpls, renderer.last_ism_atlas(),
-                          renderer.ism_points().virtual_bounds, options);
+  const DifferentialImages cpu = shade_dir_from_maps(
+      renderer.last_gbuffer(), scene, camera.camera_to_world.translation().cast<float>(), renderer.shadow_layout(),
+      renderer.last_shadow_atlas(), vpls, renderer.last_ism_atlas(), renderer.ism_points(), options);
   int close = 0, virtual_pixels = 0;
   const int pixels = 64 * 48;
   for (int i = 0; i < pixels; ++i) {
@@ -190,6 +202,22 @@ TEST_F(DirVkTest, ShadingMatchesTheCpuMirrorOnTheSameMaps) {
   // A handful of pixels may sit exactly on a visibility edge where the GPU's fused arithmetic
   // rounds the other way.
   EXPECT_GT(close, pixels * 99 / 100);
+}
+
+TEST_F(DirVkTest, ShadingMatchesTheCpuMirrorOnTheSameMaps) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  expect_shading_matches_cpu(context, cube_scene());
+}
+
+// An emitter VPL's tiles look at the scene from far away (ism.h) and it shades like a
+// directional light (vpl.h): both on the GPU as in the CPU mirror.
+TEST_F(DirVkTest, EmitterVplSplatsAndShadesLikeTheCpuMirror) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const MrScene scene = cube_scene_with_emitter();
+  const std::vector<Vpl> vpls = make_vpls(scene, 48);
+  ASSERT_TRUE(vpls.back().emitter());
+  expect_ism_atlas_matches_cpu(context, scene);
+  expect_shading_matches_cpu(context, scene);
 }
 
 /// The floor + red virtual cube of dir_cpu_test.cpp (no wall): the path tracer's scene.

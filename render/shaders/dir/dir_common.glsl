@@ -4,7 +4,7 @@ const float PI = 3.14159265358979;
 
 struct Vpl {  // vpl_buffer.h: GpuVpl
   vec4 position_material;  // w: material index (bits)
-  vec4 normal_flags;       // w: bit 0 r(VPL), bit 1 in_real_virtual, bit 2 in_real (bits)
+  vec4 normal_flags;       // w: bit 0 r(VPL), bit 1 in_real_virtual, bit 2 in_real, bit 3 emitter (bits)
   vec4 incident;
   vec4 flux;
 };
@@ -57,6 +57,15 @@ Projection towards(Vpl vpl, vec4 sphere) {
   orthonormal_basis(p.n, p.t, p.b);
   p.tan_half = radius / sqrt(distance * distance - radius * radius);
   return p;
+}
+
+bool is_emitter(Vpl vpl) { return (floatBitsToUint(vpl.normal_flags.w) & 8u) != 0u; }
+
+// TileProjection::real_tile / virtual_tile (ism.h): an emitter's tiles look at the scene.
+Projection real_tile(Vpl vpl, vec4 scene_bounds) { return is_emitter(vpl) ? towards(vpl, scene_bounds) : hemisphere(vpl); }
+
+Projection virtual_tile(Vpl vpl, vec4 virtual_bounds, vec4 scene_bounds) {
+  return towards(vpl, is_emitter(vpl) && !(virtual_bounds.w > 0.0) ? scene_bounds : virtual_bounds);
 }
 
 vec3 projection_local(Projection p, vec3 point, out float distance) {

@@ -24,7 +24,7 @@ struct Material {
   vec4 emission_n;   // emission, Phong exponent n
 };
 struct Light {
-  vec4 position_kind;      // w: 0 point, 1 spot, 2 directional (bits)
+  vec4 position_kind;      // w: 0 point, 1 spot, 2 directional, 3 directional through its emitter VPL (bits)
   vec4 direction_real;     // unit; w: r(light)
   vec4 intensity_inner;    // w: cos_inner
   vec4 outer_views;        // x: cos_outer, y: first view (bits), z: view count (bits)
@@ -60,6 +60,7 @@ layout(push_constant) uniform Params {
   vec4 camera_centre;
   vec4 environment;
   vec4 virtual_bounds;  // IsmPointPools::virtual_bounds
+  vec4 scene_bounds;    // IsmPointPools::scene_bounds
 } params;
 
 // phong_brdf() (core/phong.h, core/shaders/phong.glsl) of a packed material.
@@ -108,12 +109,13 @@ float ism_visible(Projection projection, uint tile_offset, vec3 point) {
   return reach <= ism_atlas[tile_offset + uint(xy.y * tile + xy.x)] ? 1.0 : 0.0;
 }
 
-// IsmLookup: V_r from the VPL's hemisphere tile, V_v from its (focused) virtual tile.
+// IsmLookup: V_r from the VPL's real tile (its hemisphere), V_v from its (focused) virtual tile.
 vec2 ism_visibility(uint index, Vpl vpl, vec3 point) {
   const uint texels = uint(params.ism_tile * params.ism_tile);
-  const float real = ism_visible(hemisphere(vpl), index * texels, point);
+  const float real = ism_visible(real_tile(vpl, params.scene_bounds), index * texels, point);
   if (real == 0.0) return vec2(0.0);
-  return vec2(real, ism_visible(towards(vpl, params.virtual_bounds), (params.vpl_count + index) * texels, point));
+  return vec2(real, ism_visible(virtual_tile(vpl, params.virtual_bounds, params.scene_bounds),
+                                (params.vpl_count + index) * texels, point));
 }
 
 void main() {
@@ -145,6 +147,7 @@ void main() {
     for (uint l = 0u; l < params.light_count; ++l) {
       const Light light = lights[l];
       const uint kind = floatBitsToUint(light.position_kind.w);
+      if (kind == 3u) continue;  // its emitter VPL lights the point (vpl.h)
       vec3 wi, irradiance;
       if (kind == 2u) {
         wi = light.direction_real.xyz;
@@ -184,15 +187,22 @@ void main() {
       const bool in_rv = want_rv && (flags & 2u) != 0u;
       const bool in_r = want_r && (flags & 4u) != 0u && real_pixel > 0.0;
       if (!in_rv && !in_r) continue;
-      const vec3 to_vpl = vpl.position_material.xyz - point;
-      const float d2 = dot(to_vpl, to_vpl);
-      if (!(d2 > 0.0)) continue;
-      const vec3 wi = to_vpl / sqrt(d2);
-      const float cos_x = dot(wi, n), cos_y = -dot(wi, vpl.normal_flags.xyz);
-      if (cos_x <= 0.0 || cos_y <= 0.0) continue;
-      const Material mv = materials[floatBitsToUint(vpl.position_material.w)];
-      const vec3 contribution = vpl.flux.xyz * phong(mv, vpl.normal_flags.xyz, vpl.incident.xyz, -wi) *
-                                phong(m, n, wi, wo) * (cos_x * cos_y / max(d2, min_d2));
+      vec3 contribution;
+      if ((flags & 8u) != 0u) {  // an emitter: irradiance `flux` from `incident` (vpl.h)
+        const float cos_x = dot(vpl.incident.xyz, n);
+        if (cos_x <= 0.0) continue;
+        contribution = vpl.flux.xyz * phong(m, n, vpl.incident.xyz, wo) * cos_x;
+      } else {
+        const vec3 to_vpl = vpl.position_material.xyz - point;
+        const float d2 = dot(to_vpl, to_vpl);
+        if (!(d2 > 0.0)) continue;
+        const vec3 wi = to_vpl / sqrt(d2);
+        const float cos_x = dot(wi, n), cos_y = -dot(wi, vpl.normal_flags.xyz);
+        if (cos_x <= 0.0 || cos_y <= 0.0) continue;
+        const Material mv = materials[floatBitsToUint(vpl.position_material.w)];
+        contribution = vpl.flux.xyz * phong(mv, vpl.normal_flags.xyz, vpl.incident.xyz, -wi) * phong(m, n, wi, wo) *
+                       (cos_x * cos_y / max(d2, min_d2));
+      }
       const vec2 seen = ism_visibility(j, vpl, point);
       if (seen.x == 0.0) continue;
       if (in_rv) indirect_rv += contribution * seen.y;

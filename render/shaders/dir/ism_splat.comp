@@ -23,6 +23,7 @@ layout(push_constant) uniform Params {
   uint virtual_pool;
   uint pad0, pad1, pad2;
   vec4 virtual_bounds;  // IsmPointPools::virtual_bounds
+  vec4 scene_bounds;    // IsmPointPools::scene_bounds
 } params;
 
 const int MAX_SPLAT = 16;  // kMaxSplat
@@ -36,7 +37,8 @@ void main() {
   if (pool == 0u) return;
   const Point point = points[(layer == 0u ? 0u : params.real_pool) + ism_point_index(vpl_index, slot, pool)];
   const Vpl vpl = vpls[vpl_index];
-  const Projection projection = layer == 0u ? hemisphere(vpl) : towards(vpl, params.virtual_bounds);
+  const Projection projection =
+      layer == 0u ? real_tile(vpl, params.scene_bounds) : virtual_tile(vpl, params.virtual_bounds, params.scene_bounds);
   float distance;
   const vec3 centre_dir = projection_local(projection, point.position_half_size.xyz, distance);
   vec2 centre;

@@ -22,10 +22,14 @@ struct Radiance {
 class MapShader {
  public:
   MapShader(const MrScene& scene, const ShadowLayout& layout, std::span<const float> shadow_atlas,
-            std::span<const Vpl> vpls, std::span<const float> ism_atlas, const Eigen::Vector4f& virtual_bounds,
+            std::span<const Vpl> vpls, std::span<const float> ism_atlas, const IsmPointPools& ism_points,
             const DirRenderOptions& options)
-      : scene_(scene), layout_(layout), shadow_atlas_(shadow_atlas), vpls_(vpls),
-        ism_(ism_atlas, options.ism, vpls, virtual_bounds), options_(options) {}
+      : scene_(scene),
+        layout_(layout),
+        shadow_atlas_(shadow_atlas),
+        vpls_(vpls),
+        ism_(ism_atlas, options.ism, vpls, ism_points),
+        options_(options) {}
 
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
                                float real_pixel, std::uint32_t subset) const {
@@ -45,6 +49,7 @@ class MapShader {
                   Radiance& out) const {
     for (std::size_t l = 0; l < scene_.lights.size(); ++l) {
       const MrLight& light = scene_.lights[l];
+      if (light.through_vpl) continue;  // its emitter VPL lights the point (vpl.h)
       const std::optional<detail::LightSample> sample = detail::sample_light(light, point);
       if (!sample) continue;
       const float cos_i = sample->wi.dot(n);
@@ -68,15 +73,22 @@ class MapShader {
       const bool in_rv = want_rv() && vpl.in_real_virtual;
       const bool in_r = want_r() && vpl.in_real && real_pixel > 0.f;
       if (!in_rv && !in_r) continue;
-      const Vec3 to_vpl = vpl.position - point;
-      const float distance2 = to_vpl.squaredNorm();
-      if (!(distance2 > 0.f)) continue;
-      const Vec3 wi = to_vpl / std::sqrt(distance2);
-      const float cos_x = wi.dot(n), cos_y = -wi.dot(vpl.normal);
-      if (cos_x <= 0.f || cos_y <= 0.f) continue;
-      const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(scene_.materials[vpl.material], vpl.normal, vpl.incident, -wi))
-                                    .cwiseProduct(phong_brdf(m, n, wi, wo)) *
-                                (cos_x * cos_y / std::max(distance2, min_distance2));
+      Vec3 contribution;
+      if (vpl.emitter()) {  // directional: irradiance `flux` from `incident` (vpl.h)
+        const float cos_x = vpl.incident.dot(n);
+        if (cos_x <= 0.f) continue;
+        contribution = vpl.flux.cwiseProduct(phong_brdf(m, n, vpl.incident, wo)) * cos_x;
+      } else {
+        const Vec3 to_vpl = vpl.position - point;
+        const float distance2 = to_vpl.squaredNorm();
+        if (!(distance2 > 0.f)) continue;
+        const Vec3 wi = to_vpl / std::sqrt(distance2);
+        const float cos_x = wi.dot(n), cos_y = -wi.dot(vpl.normal);
+        if (cos_x <= 0.f || cos_y <= 0.f) continue;
+        contribution = vpl.flux.cwiseProduct(phong_brdf(scene_.materials[vpl.material], vpl.normal, vpl.incident, -wi))
+                           .cwiseProduct(phong_brdf(m, n, wi, wo)) *
+                       (cos_x * cos_y / std::max(distance2, min_distance2));
+      }
       const IsmLookup::Visibility seen = ism_(j, point);
       if (seen.real == 0.f) continue;
       if (in_rv) rv += contribution * seen.virtual_;
@@ -154,14 +166,14 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
 DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene, const Vec3& camera_centre,
                                        const ShadowLayout& layout, std::span<const float> shadow_atlas,
                                        std::span<const Vpl> vpls, std::span<const float> ism_atlas,
-                                       const Eigen::Vector4f& virtual_bounds, const DirRenderOptions& options) {
+                                       const IsmPointPools& ism_points, const DirRenderOptions& options) {
   const int width = gbuffer.position.width(), height = gbuffer.position.height();
   if (shadow_atlas.size() < static_cast<std::size_t>(layout.atlas_width()) * static_cast<std::size_t>(layout.atlas_height()))
     throw Error("shade_dir_from_maps: the shadow atlas is smaller than its layout");
   const std::size_t ism_texels = 2 * vpls.size() * static_cast<std::size_t>(options.ism.tile) * static_cast<std::size_t>(options.ism.tile);
   if (ism_atlas.size() < ism_texels) throw Error("shade_dir_from_maps: the ISM atlas is smaller than its VPLs need");
   if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
-  const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, virtual_bounds, options);
+  const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
   const Vec3 environment = scene.environment.radiance;
   const int n = options.interleave;
   Image<Radiance> shaded(width, height);
@@ -208,7 +220,7 @@ DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, 
   const IsmPointPools points = sample_ism_points(scene, options.ism);
   const std::vector<float> ism_atlas = ism_atlas_cpu(points, vpls, options.ism);
   return shade_dir_from_maps(gbuffer, scene, camera.camera_to_world.translation().cast<float>(), layout, shadow_atlas,
-                             vpls, ism_atlas, points.virtual_bounds, options);
+                             vpls, ism_atlas, points, options);
 }
 
 }  // namespace relight::render

@@ -57,6 +57,7 @@ MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& optio
     : content_(std::move(content)),
       mesh_(options.mesh),
       reconstruction_material_(options.reconstruction_material),
+      environment_(options.environment),
       materials_buffer_(options.materials_buffer),
       placements_buffer_(options.placements_buffer),
       real_lights_buffer_(options.real_lights_buffer) {}
@@ -88,6 +89,8 @@ void MrSceneStage::run(StageContext& context) {
   scene.meshes.push_back(std::move(mesh));
   if (real_lights_buffer_) add_lights(scene, context.get(real_lights_));
   scene.lights.insert(scene.lights.end(), content_.lights.begin(), content_.lights.end());
+  if (environment_ == EnvironmentLight::Vpls)
+    for (MrLight& light : scene.lights) light.through_vpl = light.kind == LightKind::Directional;
   if (!placements_buffer_) {
     for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
     return;

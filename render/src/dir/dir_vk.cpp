@@ -30,6 +30,7 @@ struct ShadeParams {
   float camera_centre[4];
   float environment[4];
   float virtual_bounds[4];
+  float scene_bounds[4];
 };
 static_assert(sizeof(ShadeParams) <= 128);
 
@@ -58,7 +59,10 @@ std::vector<float> pack_lights(const MrScene& scene, const ShadowLayout& layout)
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
     const MrLight& l = scene.lights[i];
     const Eigen::Vector3f d = l.direction.normalized();
-    const auto kind = static_cast<std::uint32_t>(l.kind == LightKind::Point ? 0 : l.kind == LightKind::Spot ? 1 : 2);
+    const auto kind = static_cast<std::uint32_t>(l.through_vpl                ? 3
+                                                 : l.kind == LightKind::Point ? 0
+                                                 : l.kind == LightKind::Spot  ? 1
+                                                                              : 2);
     out.insert(out.end(), {l.position.x(), l.position.y(), l.position.z(), bits(kind), d.x(), d.y(), d.z(),
                            l.real ? 1.f : 0.f, l.intensity.x(), l.intensity.y(), l.intensity.z(), l.cos_inner,
                            l.cos_outer, bits(layout.light_views[i][0]), bits(layout.light_views[i][1]), 0.f});
@@ -85,7 +89,8 @@ std::vector<float> pack_vpls(std::span<const Vpl> vpls) {
   std::vector<float> out;
   out.reserve(vpls.size() * 16);
   for (const Vpl& v : vpls) {
-    const std::uint32_t flags = (v.on_real_surface ? 1u : 0u) | (v.in_real_virtual ? 2u : 0u) | (v.in_real ? 4u : 0u);
+    const std::uint32_t flags =
+        (v.on_real_surface ? 1u : 0u) | (v.in_real_virtual ? 2u : 0u) | (v.in_real ? 4u : 0u) | (v.emitter() ? 8u : 0u);
     out.insert(out.end(), {v.position.x(), v.position.y(), v.position.z(), bits(v.material), v.normal.x(), v.normal.y(),
                            v.normal.z(), bits(flags), v.incident.x(), v.incident.y(), v.incident.z(), 0.f, v.flux.x(),
                            v.flux.y(), v.flux.z(), 0.f});
@@ -201,14 +206,24 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
 
   const Eigen::Vector3f centre = camera.camera_to_world.translation().cast<float>();
   const Eigen::Vector3f environment = d.scene->environment.radiance;
-  const ShadeParams params{static_cast<std::uint32_t>(d.width), static_cast<std::uint32_t>(d.height),
-                           static_cast<std::uint32_t>(d.scene->lights.size()), d.vpl_count, d.layout.tile,
-                           d.layout.columns, d.layout.rows(), options.ism.tile, options.shading.min_distance,
-                           shade_flags(options), static_cast<std::uint32_t>(options.interleave), 0,
-                           {centre.x(), centre.y(), centre.z(), 1.f},
-                           {environment.x(), environment.y(), environment.z(), 0.f},
-                           {d.points.virtual_bounds.x(), d.points.virtual_bounds.y(), d.points.virtual_bounds.z(),
-                            d.points.virtual_bounds.w()}};
+  const ShadeParams params{
+      static_cast<std::uint32_t>(d.width),
+      static_cast<std::uint32_t>(d.height),
+      static_cast<std::uint32_t>(d.scene->lights.size()),
+      d.vpl_count,
+      d.layout.tile,
+      d.layout.columns,
+      d.layout.rows(),
+      options.ism.tile,
+      options.shading.min_distance,
+      shade_flags(options),
+      static_cast<std::uint32_t>(options.interleave),
+      0,
+      {centre.x(), centre.y(), centre.z(), 1.f},
+      {environment.x(), environment.y(), environment.z(), 0.f},
+      {d.points.virtual_bounds.x(), d.points.virtual_bounds.y(), d.points.virtual_bounds.z(),
+       d.points.virtual_bounds.w()},
+      {d.points.scene_bounds.x(), d.points.scene_bounds.y(), d.points.scene_bounds.z(), d.points.scene_bounds.w()}};
   const bool cpu_shading =
       options.backend == DirBackend::Cpu || (options.backend == DirBackend::Auto && d.context.is_cpu_device());
   d.context.submit([&](VkCommandBuffer cmd) {
@@ -248,9 +263,9 @@ DifferentialImages DirRendererVk::shade_on_cpu(const MrCamera& camera, std::span
   const auto start = Clock::now();
   d.cpu_ism_atlas = ism_atlas_cpu(d.points, vpls, options.ism);
   const auto ism_done = Clock::now();
-  DifferentialImages out = shade_dir_from_maps(last_gbuffer(), *d.scene, camera.camera_to_world.translation().cast<float>(),
-                                               d.layout, last_shadow_atlas(), vpls, d.cpu_ism_atlas,
-                                               d.points.virtual_bounds, options);
+  DifferentialImages out =
+      shade_dir_from_maps(last_gbuffer(), *d.scene, camera.camera_to_world.translation().cast<float>(), d.layout,
+                          last_shadow_atlas(), vpls, d.cpu_ism_atlas, d.points, options);
   const auto done = Clock::now();
   d.timings.ism_ms = std::chrono::duration<double, std::milli>(ism_done - start).count();
   d.timings.shading_ms = std::chrono::duration<double, std::milli>(done - ism_done).count();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
 
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
@@ -130,14 +131,16 @@ void splat(const TileProjection& projection, const IsmPoint& point, int tile, fl
   own = std::min(own, distance);
 }
 
-/// Centre and radius of a sphere around `points` (radius 0 when there are none).
-Eigen::Vector4f bounding_sphere(const std::vector<IsmPoint>& points) {
+/// Centre and radius of a sphere around the points of `pools` (radius 0 when there are none).
+Eigen::Vector4f bounding_sphere(std::initializer_list<const std::vector<IsmPoint>*> pools) {
   Eigen::AlignedBox3f box;
-  for (const IsmPoint& p : points) box.extend(p.position);
+  for (const auto* points : pools)
+    for (const IsmPoint& p : *points) box.extend(p.position);
   if (box.isEmpty()) return Eigen::Vector4f::Zero();
   const Vec3 c = box.center();
   float radius = 0.f;
-  for (const IsmPoint& p : points) radius = std::max(radius, (p.position - c).norm() + p.half_size);
+  for (const auto* points : pools)
+    for (const IsmPoint& p : *points) radius = std::max(radius, (p.position - c).norm() + p.half_size);
   return {c.x(), c.y(), c.z(), radius * 1.01f + 1e-3f};
 }
 
@@ -184,7 +187,8 @@ void fill_holes(float* texels, int tile, int levels) {
 IsmPointPools sample_ism_points(const MrScene& scene, const IsmOptions& options) {
   validate(options);
   IsmPointPools pools{sample_layer(scene, true, options, 1), sample_layer(scene, false, options, 2)};
-  if (options.focus_virtual) pools.virtual_bounds = bounding_sphere(pools.virtual_points);
+  if (options.focus_virtual) pools.virtual_bounds = bounding_sphere({&pools.virtual_points});
+  pools.scene_bounds = bounding_sphere({&pools.real, &pools.virtual_points});
   return pools;
 }
 
@@ -201,6 +205,15 @@ TileProjection TileProjection::towards(const Vpl& vpl, const Eigen::Vector4f& sp
   TileProjection p{vpl.position, {}, {}, to_centre / distance, radius / std::sqrt(distance * distance - radius * radius)};
   orthonormal_basis(p.n, p.t, p.b);
   return p;
+}
+
+TileProjection TileProjection::real_tile(const Vpl& vpl, const IsmPointPools& points) {
+  return vpl.emitter() ? towards(vpl, points.scene_bounds) : hemisphere(vpl);
+}
+
+TileProjection TileProjection::virtual_tile(const Vpl& vpl, const IsmPointPools& points) {
+  const bool focused = points.virtual_bounds.w() > 0.f;
+  return towards(vpl, vpl.emitter() && !focused ? points.scene_bounds : points.virtual_bounds);
 }
 
 Vec3 TileProjection::local(const Vec3& p, float& distance) const {
@@ -260,7 +273,7 @@ std::vector<float> ism_atlas_cpu(const IsmPointPools& points, std::span<const Vp
       if (!pool.empty()) {
         const bool real = t < static_cast<int>(vpls.size());
         const TileProjection projection =
-            real ? TileProjection::hemisphere(vpls[vpl]) : TileProjection::towards(vpls[vpl], points.virtual_bounds);
+            real ? TileProjection::real_tile(vpls[vpl], points) : TileProjection::virtual_tile(vpls[vpl], points);
         for (int i = 0; i < options.points_per_vpl; ++i)
           splat(projection, pool[ism_point_index(vpl, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(pool.size()))], tile,
                 texels);
@@ -272,7 +285,7 @@ std::vector<float> ism_atlas_cpu(const IsmPointPools& points, std::span<const Vp
 }
 
 IsmLookup::IsmLookup(std::span<const float> atlas, const IsmOptions& options, std::span<const Vpl> vpls,
-                     const Eigen::Vector4f& virtual_bounds)
+                     const IsmPointPools& points)
     : atlas_(atlas),
       tile_(options.tile),
       layer_stride_(vpls.size() * static_cast<std::size_t>(options.tile) * static_cast<std::size_t>(options.tile)) {
@@ -280,8 +293,8 @@ IsmLookup::IsmLookup(std::span<const float> atlas, const IsmOptions& options, st
   real_.reserve(vpls.size());
   virtual_.reserve(vpls.size());
   for (const Vpl& vpl : vpls) {
-    real_.push_back(TileProjection::hemisphere(vpl));
-    virtual_.push_back(TileProjection::towards(vpl, virtual_bounds));
+    real_.push_back(TileProjection::real_tile(vpl, points));
+    virtual_.push_back(TileProjection::virtual_tile(vpl, points));
   }
 }
 

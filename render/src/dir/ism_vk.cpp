@@ -21,6 +21,7 @@ struct SplatParams {
   std::int32_t tile;
   std::uint32_t points_per_vpl, vpl_count, real_pool, virtual_pool, pad[3];
   float virtual_bounds[4];
+  float scene_bounds[4];
 };
 
 struct PullPushParams {
@@ -55,6 +56,7 @@ void IsmVk::set_points(const IsmPointPools& points) {
     throw Error("too many ISM points (at most 65536 per layer)");
   real_points_ = static_cast<std::uint32_t>(points.real.size());
   virtual_bounds_ = points.virtual_bounds;
+  scene_bounds_ = points.scene_bounds;
   virtual_points_ = static_cast<std::uint32_t>(points.virtual_points.size());
   // The points change in number every frame.
   vk::reserve_with_headroom(points_, context_, std::max<std::size_t>(packed.size(), 8) * sizeof(float));
@@ -89,9 +91,14 @@ void IsmVk::record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint3
   if (vpl_count == 0) return;
   vkCmdFillBuffer(cmd, atlas_->handle(), 0, VK_WHOLE_SIZE, std::bit_cast<std::uint32_t>(kShadowEmpty));
   vk::compute_barrier(cmd);
-  const SplatParams splat{options.tile, static_cast<std::uint32_t>(options.points_per_vpl), vpl_count, real_points_,
-                          virtual_points_, {0, 0, 0},
-                          {virtual_bounds_.x(), virtual_bounds_.y(), virtual_bounds_.z(), virtual_bounds_.w()}};
+  const SplatParams splat{options.tile,
+                          static_cast<std::uint32_t>(options.points_per_vpl),
+                          vpl_count,
+                          real_points_,
+                          virtual_points_,
+                          {0, 0, 0},
+                          {virtual_bounds_.x(), virtual_bounds_.y(), virtual_bounds_.z(), virtual_bounds_.w()},
+                          {scene_bounds_.x(), scene_bounds_.y(), scene_bounds_.z(), scene_bounds_.w()}};
   splat_.dispatch(cmd, splat_set_, splat, vk::ComputePipeline::group_count(splat.points_per_vpl, kGroup), vpl_count, 2);
   vk::compute_barrier(cmd);
   const int levels = options.pull_push_levels;

@@ -32,6 +32,7 @@ class IsmVk {
   std::unique_ptr<vk::VulkanBuffer> atlas_, pyramid_;
   std::uint32_t real_points_ = 0, virtual_points_ = 0;
   Eigen::Vector4f virtual_bounds_ = Eigen::Vector4f::Zero();
+  Eigen::Vector4f scene_bounds_ = Eigen::Vector4f::Zero();
   vk::UniqueDescriptorSet splat_set_, pull_push_set_;
 };
 

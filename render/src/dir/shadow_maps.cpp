@@ -76,7 +76,9 @@ ShadowLayout plan_shadow_views(const MrScene& scene, int tile) {
   for (const MrLight& light : scene.lights) {
     const auto first = static_cast<std::uint32_t>(layout.views.size());
     const float spot_half_angle = std::acos(std::clamp(light.cos_outer, -1.f, 1.f)) * 1.02f;
-    if (light.kind == LightKind::Directional) {
+    if (light.through_vpl) {
+      // Shadowed by its emitter VPL's imperfect shadow map (vpl.h): no views.
+    } else if (light.kind == LightKind::Directional) {
       layout.views.push_back(orthographic_view(light.direction, centre, radius, tile));
       if (virtual_bounds.radius > 0.f) {
         layout.virtual_views.push_back(

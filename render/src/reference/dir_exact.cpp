@@ -1,6 +1,7 @@
 #include "relight/render/reference/dir_exact.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
@@ -58,6 +59,7 @@ class DirShader {
 
   void add_direct(const Vertex& v, float real_pixel, PixelResult& out) const {
     for (const MrLight& light : scene_.lights) {
+      if (light.through_vpl) continue;  // its emitter VPL lights the point (vpl.h)
       const std::optional<LightSample> sample = sample_light(light, v.point);
       if (!sample) continue;
       const Vec3 contribution = direct_light(v, *sample);
@@ -72,6 +74,10 @@ class DirShader {
     const float min_distance2 = options_.min_distance * options_.min_distance;
     for (const Vpl& vpl : vpls_) {
       if (!vpl.in_real_virtual && (!vpl.in_real || real_pixel == 0.f)) continue;
+      if (vpl.emitter()) {
+        add_emitter(v, real_pixel, vpl, out);
+        continue;
+      }
       const Vec3 to_vpl = vpl.position - v.point;
       const float distance2 = to_vpl.squaredNorm();
       if (!(distance2 > 0.f)) continue;
@@ -91,6 +97,16 @@ class DirShader {
       if (seen.real_virtual && vpl.in_real_virtual) out.real_virtual += contribution;
       if (seen.real && vpl.in_real) out.real += real_pixel * contribution;
     }
+  }
+
+  /// An emitter VPL: the directional light it stands for, with exact visibility.
+  void add_emitter(const Vertex& v, float real_pixel, const Vpl& vpl, PixelResult& out) const {
+    const float infinity = std::numeric_limits<float>::infinity();
+    const Vec3 contribution = direct_light(v, LightSample{vpl.incident, infinity, vpl.flux});
+    if (contribution.isZero()) return;
+    const Visibility seen = visibility(v, vpl.incident, infinity);
+    if (seen.real_virtual && vpl.in_real_virtual) out.real_virtual += contribution;
+    if (seen.real && vpl.in_real) out.real += real_pixel * contribution;
   }
 
   const MrScene& scene_;

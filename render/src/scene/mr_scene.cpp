@@ -59,6 +59,9 @@ void MrScene::validate() const {
     if (!material.kd.allFinite() || !std::isfinite(material.ks) || !std::isfinite(material.n) || material.n < 0.f ||
         !material.emission.allFinite())
       throw Error("material '" + material.name + "' has invalid Phong parameters");
+  for (const MrLight& light : lights)
+    if (light.through_vpl && light.kind != LightKind::Directional)
+      throw Error("only directional (environment) lights can reach the scene through VPLs");
 }
 
 BoundingSphere bounding_sphere(const MrScene& scene, SceneMeshes meshes) {

@@ -107,6 +107,31 @@ std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t
   return flux;
 }
 
+namespace {
+
+/// The emitter VPL of every light with MrLight::through_vpl (see vpl.h).
+void add_emitters(const MrScene& scene, const BoundingSphere& bounds, std::vector<Vpl>& vpls) {
+  const float radius = bounds.radius > 0.f ? bounds.radius : 1.f;
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    const MrLight& light = scene.lights[l];
+    if (!light.through_vpl) continue;
+    const Vec3 towards_light = light.direction.normalized();
+    Vpl emitter;
+    emitter.position = bounds.centre + kEmitterDistance * radius * towards_light;
+    emitter.normal = -towards_light;
+    emitter.incident = towards_light;
+    emitter.flux = light.intensity;
+    emitter.on_real_surface = light.real;
+    emitter.in_real_virtual = true;
+    emitter.in_real = light.real;
+    emitter.bounce = 0;
+    emitter.light = static_cast<std::uint32_t>(l);
+    vpls.push_back(emitter);
+  }
+}
+
+}  // namespace
+
 std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options,
                                const VplGpu& gpu) {
   if (options.count < 0) throw Error("the VPL count must not be negative");
@@ -158,6 +183,7 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
     }
   }
   vpl_tracer.finish();
+  add_emitters(scene, bounds, vpls);
   return vpls;
 }
 

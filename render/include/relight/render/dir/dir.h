@@ -41,12 +41,12 @@ struct DirRenderOptions {
 [[nodiscard]] DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
                                                 const DirRenderOptions& options = {}, GBuffer* gbuffer_out = nullptr);
 
-/// The shading pass on the CPU, from the same inputs as the GPU's (`virtual_bounds`: the ISM
-/// point pools' IsmPointPools::virtual_bounds).
+/// The shading pass on the CPU, from the same inputs as the GPU's (`ism_points`: the pools the
+/// ISM atlas was splatted from, for their bounds).
 [[nodiscard]] DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene,
                                                      const Eigen::Vector3f& camera_centre, const ShadowLayout& layout,
                                                      std::span<const float> shadow_atlas, std::span<const Vpl> vpls,
-                                                     std::span<const float> ism_atlas,
-                                                     const Eigen::Vector4f& virtual_bounds, const DirRenderOptions& options);
+                                                     std::span<const float> ism_atlas, const IsmPointPools& ism_points,
+                                                     const DirRenderOptions& options);
 
 }  // namespace relight::render

@@ -11,7 +11,9 @@
 //                                   real mesh, that frame's real lights (when set) and the
 //                                   configured real and virtual lights, the
 //                                   configured virtual objects (at the placements of that
-//                                   buffer when set, none while it is unresolved)
+//                                   buffer when set, none while it is unresolved); with
+//                                   EnvironmentLight::Vpls every directional light reaches the
+//                                   scene through its emitter VPL (MrLight::through_vpl)
 //   vpls                     reads  MrScene "mr_scene"; with VplBudget::ByPreviousFlux also the
 //                                   previous frame's VplSet "vpls" (its flux per light)
 //                            writes VplSet "vpls" (vpl.h)
@@ -42,6 +44,7 @@
 // every real surface is `reconstruction_material`. The real materials matter for the picture:
 // the differential adds TM(L_rv) - TM(L_r) to the camera image, so a virtual shadow computed
 // with a grey albedo on a brown table subtracts grey and tints the shadow orange.
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -52,6 +55,7 @@
 #include "relight/colormap/tone_map.h"
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
+#include "relight/core/named_values.h"
 #include "relight/core/rgbd_frame.h"
 #include "relight/core/stage_backend.h"
 #include "relight/lights/light_set.h"
@@ -66,6 +70,17 @@
 
 namespace relight::render {
 
+/// How the directional lights of the environment (the probe's lights) light the scene:
+///   Directional  through the direct pass, each with two orthographic shadow maps (real and
+///                virtual layer) rasterised every frame;
+///   Vpls         as emitter VPLs shadowed through their ISMs, like every other VPL (Knecht et
+///                al. 2010 §3.6 and §5.2, dissertation §5.2.7; vpl.h says where ours depart): far
+///                cheaper per light, so the probe can give many more of them, with the
+///                interleaved VPLs' softer shadows.
+enum class EnvironmentLight { Directional, Vpls };
+inline constexpr std::array<NamedValue<EnvironmentLight>, 2> kEnvironmentLightNames{
+    {{"directional", EnvironmentLight::Directional}, {"vpls", EnvironmentLight::Vpls}}};
+
 /// A per-pixel k_d of the real surfaces and where it is valid (brdf/'s diffuse estimate).
 struct RealAlbedoBuffers {
   BufferName<RadianceImage> albedo = kKd;
@@ -78,6 +93,7 @@ struct DirStageOptions {
   DepthMeshOptions mesh{.stride = 2};
   PhongMaterial reconstruction_material{{{0.5f, 0.5f, 0.5f}, 0.f, 1.f}, "reconstruction", {0.f, 0.f, 0.f}};
   colormap::ToneMap tone_map{};
+  EnvironmentLight environment = EnvironmentLight::Directional;
   std::optional<BufferName<brdf::Materials>> materials_buffer;  ///< none: no Materials input
   /// ObjectPlacements of the objects (virtual_model.h), e.g. resolved on a real surface at the
   /// first frame; none: the placements in DirSceneContent.
@@ -115,6 +131,7 @@ class MrSceneStage final : public Stage {
   DirSceneContent content_;
   DepthMeshOptions mesh_;
   PhongMaterial reconstruction_material_;
+  EnvironmentLight environment_;
   std::optional<BufferName<brdf::Materials>> materials_buffer_;
   std::optional<BufferName<ObjectPlacements>> placements_buffer_;
   std::optional<BufferName<lights::LightSet>> real_lights_buffer_;

@@ -21,6 +21,13 @@
 // perspective view of the cone around that sphere (every virtual point lies inside it); the
 // real tile keeps the hemisphere. Directions outside the cone see nothing virtual (V_v = 1).
 //
+// Emitters (vpl.h, bounce 0) light the scene from far away: a hemisphere around them would
+// squeeze the scene into a few texels, so both their tiles are perspective views, the real one
+// of the cone around every point of the pools (IsmPointPools::scene_bounds) and the virtual one
+// of the cone around the virtual objects (or the scene's when the focus is off). From
+// kEmitterDistance scene radii these are nearly orthographic, like a directional light's
+// shadow map, at the ISM's resolution and built from the same points.
+//
 // Holes: pull-push (Marroquim et al. 2007): a coarser texel averages its valid children and is
 // valid when at least two are; holes of a finer level take their parent's value. Requiring two
 // children keeps the fill from growing a lone occluder's silhouette into empty space.
@@ -61,6 +68,9 @@ struct TileProjection {
   /// The view of `sphere` (centre, radius) from the VPL; the hemisphere when the VPL is inside
   /// or near the sphere, or the radius is 0.
   [[nodiscard]] static TileProjection towards(const Vpl& vpl, const Eigen::Vector4f& sphere);
+  /// The mapping of VPL `vpl`'s real tile (layer 0) and of its virtual tile (layer 1).
+  [[nodiscard]] static TileProjection real_tile(const Vpl& vpl, const IsmPointPools& points);
+  [[nodiscard]] static TileProjection virtual_tile(const Vpl& vpl, const IsmPointPools& points);
 
   /// Unit direction towards `p` in the (t, b, n) frame, and its distance.
   [[nodiscard]] Eigen::Vector3f local(const Eigen::Vector3f& p, float& distance) const;
@@ -90,8 +100,9 @@ struct TileProjection {
 /// angular texel size.
 class IsmLookup {
  public:
+  /// `points`: the pools the atlas was splatted from (for their bounds).
   IsmLookup(std::span<const float> atlas, const IsmOptions& options, std::span<const Vpl> vpls,
-            const Eigen::Vector4f& virtual_bounds);
+            const IsmPointPools& points);
 
   struct Visibility {
     float real = 1.f;     ///< V_r

@@ -3,7 +3,8 @@
 // depth of each light's reflective shadow map). Every light is seen through one or six views:
 //   spot light, half-angle <= 75 deg  one perspective view along its axis;
 //   point light or wider spot          six cube faces (+x, -x, +y, -y, +z, -z);
-//   directional light                  one orthographic view over the scene's bounding sphere.
+//   directional light                  one orthographic view over the scene's bounding sphere;
+//   light with MrLight::through_vpl    none (its emitter VPL's ISM shadows it).
 // Each view is rendered twice, through the real and through the virtual layer, so that the
 // shading pass gets V_r and V_v separately (eqs. 5.1-5.5 need min(V_r, V_v) and V_r). A
 // directional light's virtual-layer view covers only the virtual objects' bounding sphere: the

@@ -46,6 +46,11 @@ enum class LightKind { Point, Spot, Directional };
 /// around `direction`. A directional light delivers the irradiance `intensity` (W/m^2, RGB) to a
 /// surface facing it, coming from `direction` (unit, towards the light) - the environment
 /// lights of the light-extraction stage.
+///
+/// `through_vpl` (directional lights only) is the environment light of Knecht et al. 2010 §5.2
+/// and the dissertation §5.2.7: the light reaches surfaces through an emitter VPL (vpl.h,
+/// bounce 0) shadowed by that VPL's imperfect shadow map, like every other VPL, instead of
+/// through the direct pass and its two shadow maps. The path tracer is unaffected.
 struct MrLight {
   LightKind kind = LightKind::Point;
   Eigen::Vector3f position{0.f, 0.f, 0.f};
@@ -54,6 +59,7 @@ struct MrLight {
   float cos_inner = 0.9f;
   float cos_outer = 0.8f;
   bool real = true;
+  bool through_vpl = false;
 };
 
 /// A spot light at `position` shining along `direction` (stored as given), at full intensity

@@ -20,6 +20,9 @@ struct IsmPointPools {
   std::vector<IsmPoint> virtual_points;
   /// Centre and radius of a sphere around every virtual point; radius 0 = none, or focus off.
   Eigen::Vector4f virtual_bounds = Eigen::Vector4f::Zero();
+  /// Centre and radius of a sphere around every point of both pools: what an emitter VPL's
+  /// tiles look at (ism.h); radius 0 = no points.
+  Eigen::Vector4f scene_bounds = Eigen::Vector4f::Zero();
 };
 
 }  // namespace relight::render

@@ -36,6 +36,15 @@
 // are drawn over the light's whole emission and dropped when they fall into that cone (flux
 // I Omega_light / n_rest each). The two strata cover every direction once: unbiased.
 //
+// Emitters: a directional light with MrLight::through_vpl (the environment light of Knecht et al.
+// 2010 §3.6 and §5.2, dissertation §5.2.7) also gets one VPL of bounce 0 that lights surfaces directly.
+// The paper places such VPLs on a hemisphere around the scene centre, which gives light from
+// infinitely far away an inverse-square falloff and a parallax across the scene; ours is a
+// directional emitter: it delivers the light's irradiance E (its `flux`, W/m^2) from `incident`
+// at every point, L_o = E f_x cos(theta_x), and only its imperfect shadow map needs a position,
+// far out along the light (kEmitterDistance scene radii from the scene's centre), from where its
+// tiles are nearly orthographic views of the scene and of the virtual objects (ism.h).
+//
 // Flux (W, RGB): a light of intensity I sampled with density p(omega) over N samples gives each
 // first-bounce VPL Phi = I(omega) / (p(omega) N), so that its contribution to a point x is
 //   Phi f_y(omega_in, y->x) f_x(y->x, omega_o) cos(theta_y) cos(theta_x) / |x - y|^2.
@@ -58,11 +67,16 @@ struct Vpl {
   bool on_real_surface = true;  ///< r(VPL)
   bool in_real_virtual = true;
   bool in_real = true;
-  int bounce = 1;  ///< 1 = lit directly by a primary light
+  int bounce = 1;           ///< 1 = lit directly by a primary light; 0 = an emitter (see the header)
   std::uint32_t light = 0;  ///< index of the primary light (MrScene::lights) the path started at
   static constexpr std::uint32_t kNoParent = 0xffffffffu;
   std::uint32_t parent = kNoParent;  ///< index (in the generated list) of the VPL this one continues
+
+  [[nodiscard]] bool emitter() const { return bounce == 0; }
 };
+
+/// How far out along its light an emitter VPL sits, in radii of the scene's bounding sphere.
+inline constexpr float kEmitterDistance = 100.f;
 
 /// How the `count` light samples are shared among the lights (dissertation §5.2.3). Whatever the
 /// shares, each light's VPLs carry its whole emitted flux (flux per sample = power / samples), so
@@ -144,7 +158,8 @@ struct VplGpu {
 /// its end before the next (a VPL's continuations come right after it); BounceMethod::PointCone
 /// resolves all paths of one bounce together, one search per layer, on gpu.cone_search when
 /// given (its points are replaced), so the list holds all first bounces, then all second
-/// bounces, and so on. Vpl::parent links them either way.
+/// bounces, and so on. Vpl::parent links them either way. The emitters of the lights with
+/// MrLight::through_vpl come last, one per light, whatever the count.
 [[nodiscard]] std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options,
                                              const VplGpu& gpu = {});
 
