@@ -107,8 +107,11 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
       .add_option("--probe-offset", probe.offset_s,
                   "Video probes: seconds from the first RGB-D frame to the video's first frame")
       ->capture_default_str();
-  command.add_option("--probe-lights", probe.lights, "Real lights extracted from the probe every frame")
-      ->capture_default_str();
+  command
+      .add_option("--probe-lights", probe.lights,
+                  "Real lights extracted from the probe (or the estimate) every frame (default: 8; 64 with "
+                  "--environment vpls)")
+      ->check(CLI::Range(1, 4096));
   command.add_flag("!--no-light-smoothing", probe.smoothing,
                    "Use each frame's extracted lights as they are (no temporal smoothing, lights/light_smoothing.h)");
   command.add_option("--virtual-light", options.virtual_lights, "A virtual point light x,y,z,intensity[,r,g,b] (repeatable)");
@@ -121,6 +124,10 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--vpls", options.vpls, "Light samples for virtual point lights per frame")
       ->check(CLI::Range(0, 4096))
       ->capture_default_str();
+  add_choice_option(command, "--environment", options.environment, render::kEnvironmentLightNames,
+                    "How the real directional lights (a probe's, an estimate's) light the scene: directional (the "
+                    "direct pass, two shadow maps each) or vpls (Knecht 2010: one emitter VPL each, shadowed by its "
+                    "imperfect shadow map like the other VPLs; far cheaper per light, softer shadows)");
   add_choice_option(command, "--vpl-budget", options.vpl_budget, render::kVplBudgetNames,
                     "How the VPL samples are shared among the lights: equal, power (emitted power), weights "
                     "(--vpl-weights) or flux (the flux each light's VPLs carried last frame)");

@@ -33,7 +33,9 @@ struct ProbeInputOptions {
   double exposure = 1.0;           ///< 8-bit probes: relative exposure
   double tolerance_s = 0.05;       ///< timestamp matching (probe_stream.h)
   double offset_s = 0.0;           ///< video probes: start relative to the first RGB-D frame
-  int lights = 8;                  ///< lights extracted per frame
+  /// Lights extracted per frame; 0: 8, or 64 when they reach the scene as VPLs (replay's
+  /// --environment vpls), which costs little per light and samples the probe more finely.
+  int lights = 0;
   bool smoothing = true;           ///< light_smoothing between extraction and the lights
 };
 

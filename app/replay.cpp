@@ -175,8 +175,11 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   FrameGraph& graph = *pipeline.graph;
   if (!content.objects.empty())
     pipeline.placement = &graph.emplace<ObjectPlacementStage>(std::move(requests), std::move(names));
+  const bool lights_as_vpls = options.environment == render::EnvironmentLight::Vpls;
+  ProbeInputOptions probe_input = options.probe_input;
+  if (probe_input.lights == 0) probe_input.lights = lights_as_vpls ? 64 : 8;
   const RealLightStages light_stages =
-      add_real_light_stages(graph, real_lights, options.probe_input, per_pixel, pipeline.vulkan.get());
+      add_real_light_stages(graph, real_lights, probe_input, per_pixel, pipeline.vulkan.get());
   pipeline.probe = light_stages.probe;
   pipeline.light_estimation = light_stages.estimation;
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
@@ -189,6 +192,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.bounce_method = options.bounce_method;
   dir.vpls.source = options.vpl_source;
   dir.tone_map.exposure = options.exposure;
+  dir.environment = options.environment;
   dir.materials_buffer = brdf::kMaterials;
   dir.real_lights_buffer = lights::kLights;
   if (pipeline.placement) dir.placements_buffer = render::kObjectPlacements;

@@ -16,6 +16,7 @@
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/named_values.h"
+#include "relight/render/dir/dir_stage.h"
 #include "relight/render/vpl/vpl.h"
 #include "relight/vk/backend.h"
 
@@ -82,6 +83,8 @@ struct ReplayOptions {
   std::vector<std::string> virtual_spots;      ///< x,y,z,tx,ty,tz,angle,intensity[,r,g,b]
   std::vector<std::string> real_spots;         ///< the same, for lamps of the real scene
   int vpls = 64;                               ///< first-bounce light samples per frame
+  /// How the real directional lights (a probe's, an estimate's, a lights file's) reach the scene.
+  render::EnvironmentLight environment = render::EnvironmentLight::Directional;
   render::VplBudget vpl_budget = render::VplBudget::ByPower;  ///< render/vpl/vpl.h
   std::vector<float> vpl_weights;              ///< per light (lights file order, then virtual lights)
   int vpl_bounces = 1;                         ///< indirect bounces carried by VPLs (render/vpl.h)

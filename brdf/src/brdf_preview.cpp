@@ -66,7 +66,8 @@ void BrdfPreviewStage::declare(StageBuilder& builder) {
 
 void BrdfPreviewStage::run(StageContext& context) {
   const FrameInfo& frame = context.get(frame_);
-  const ShadingLights lights = to_camera_frame(context.get(lights_), frame.camera_to_world.value_or(Pose::Identity()));
+  const ShadingLights lights =
+      estimation_lights(context.get(lights_), frame.camera_to_world.value_or(Pose::Identity()));
   const Materials& materials = context.get(materials_);
   const RadianceImage rerender = render_materials(materials, context.get(positions_), context.get(normals_), lights);
   context.get(preview_) =

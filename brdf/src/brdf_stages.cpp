@@ -13,7 +13,7 @@ namespace relight::brdf {
 namespace {
 
 ShadingLights camera_lights(const lights::LightSet& set, const FrameInfo& frame, const Eigen::Vector3f& ambient) {
-  return to_camera_frame(set, frame.camera_to_world.value_or(Pose::Identity()), ambient);
+  return estimation_lights(set, frame.camera_to_world.value_or(Pose::Identity()), ambient);
 }
 
 std::unique_ptr<SpecularSolver> make_solver(SpecularMethod method) {

@@ -5,6 +5,7 @@
 #include <numbers>
 
 #include "relight/core/phong.h"
+#include "relight/lights/merge_lights.h"
 
 namespace relight::brdf {
 
@@ -27,6 +28,11 @@ ShadingLights to_camera_frame(const lights::LightSet& set, const Pose& camera_to
     out.lights.push_back(l);
   }
   return out;
+}
+
+ShadingLights estimation_lights(const lights::LightSet& set, const Pose& camera_to_world,
+                                const Eigen::Vector3f& ambient) {
+  return to_camera_frame(lights::merge_directional_lights(set, kEstimationDirectionalLights), camera_to_world, ambient);
 }
 
 LightAtPoint light_at(const ShadingLight& light, const Eigen::Vector3f& position) {

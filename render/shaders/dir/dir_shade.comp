@@ -56,7 +56,7 @@ layout(push_constant) uniform Params {
   float min_distance;
   uint flags;  // bit 0 direct, bit 1 indirect, bit 2 write L_rv, bit 3 write L_r
   uint interleave;
-  uint pad;
+  uint emitter_count;  // the last emitter_count VPLs are emitters (vpl.h)
   vec4 camera_centre;
   vec4 environment;
   vec4 virtual_bounds;  // IsmPointPools::virtual_bounds
@@ -175,34 +175,41 @@ void main() {
       if (want_rv) rv += contribution * shadow_visibility(light, 1, point, n);
       r += contribution * (light.direction_real.w * real_pixel);
     }
+    // Emitter VPLs (vpl.h), the last emitter_count VPLs: every pixel sees all of them.
+    for (uint j = params.vpl_count - params.emitter_count; j < params.vpl_count; ++j) {
+      const Vpl vpl = vpls[j];
+      const uint flags = floatBitsToUint(vpl.normal_flags.w);
+      const bool in_rv = want_rv && (flags & 2u) != 0u;
+      const bool in_r = want_r && (flags & 4u) != 0u && real_pixel > 0.0;
+      const float cos_x = dot(vpl.incident.xyz, n);
+      if ((!in_rv && !in_r) || cos_x <= 0.0) continue;
+      const vec3 contribution = vpl.flux.xyz * phong(m, n, vpl.incident.xyz, wo) * cos_x;
+      const vec2 seen = ism_visibility(j, vpl, point);
+      if (seen.x == 0.0) continue;
+      if (in_rv) rv += contribution * seen.y;
+      if (in_r) r += contribution;
+    }
   }
 
   vec3 indirect_rv = vec3(0.0), indirect_r = vec3(0.0);
   if ((params.flags & 2u) != 0u) {
     const float min_d2 = params.min_distance * params.min_distance;
     const uint subset = (pixel.x % interleave) + interleave * (pixel.y % interleave);
-    for (uint j = subset; j < params.vpl_count; j += interleave * interleave) {
+    for (uint j = subset; j < params.vpl_count - params.emitter_count; j += interleave * interleave) {
       const Vpl vpl = vpls[j];
       const uint flags = floatBitsToUint(vpl.normal_flags.w);
       const bool in_rv = want_rv && (flags & 2u) != 0u;
       const bool in_r = want_r && (flags & 4u) != 0u && real_pixel > 0.0;
       if (!in_rv && !in_r) continue;
-      vec3 contribution;
-      if ((flags & 8u) != 0u) {  // an emitter: irradiance `flux` from `incident` (vpl.h)
-        const float cos_x = dot(vpl.incident.xyz, n);
-        if (cos_x <= 0.0) continue;
-        contribution = vpl.flux.xyz * phong(m, n, vpl.incident.xyz, wo) * cos_x;
-      } else {
-        const vec3 to_vpl = vpl.position_material.xyz - point;
-        const float d2 = dot(to_vpl, to_vpl);
-        if (!(d2 > 0.0)) continue;
-        const vec3 wi = to_vpl / sqrt(d2);
-        const float cos_x = dot(wi, n), cos_y = -dot(wi, vpl.normal_flags.xyz);
-        if (cos_x <= 0.0 || cos_y <= 0.0) continue;
-        const Material mv = materials[floatBitsToUint(vpl.position_material.w)];
-        contribution = vpl.flux.xyz * phong(mv, vpl.normal_flags.xyz, vpl.incident.xyz, -wi) * phong(m, n, wi, wo) *
-                       (cos_x * cos_y / max(d2, min_d2));
-      }
+      const vec3 to_vpl = vpl.position_material.xyz - point;
+      const float d2 = dot(to_vpl, to_vpl);
+      if (!(d2 > 0.0)) continue;
+      const vec3 wi = to_vpl / sqrt(d2);
+      const float cos_x = dot(wi, n), cos_y = -dot(wi, vpl.normal_flags.xyz);
+      if (cos_x <= 0.0 || cos_y <= 0.0) continue;
+      const Material mv = materials[floatBitsToUint(vpl.position_material.w)];
+      const vec3 contribution = vpl.flux.xyz * phong(mv, vpl.normal_flags.xyz, vpl.incident.xyz, -wi) *
+                                phong(m, n, wi, wo) * (cos_x * cos_y / max(d2, min_d2));
       const vec2 seen = ism_visibility(j, vpl, point);
       if (seen.x == 0.0) continue;
       if (in_rv) indirect_rv += contribution * seen.y;

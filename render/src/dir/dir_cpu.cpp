@@ -29,6 +29,7 @@ class MapShader {
         shadow_atlas_(shadow_atlas),
         vpls_(vpls),
         ism_(ism_atlas, options.ism, vpls, ism_points),
+        first_emitter_(vpls.size() - emitter_count(vpls)),
         options_(options) {}
 
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
@@ -60,12 +61,25 @@ class MapShader {
       if (want_rv()) out.real_virtual += contribution * shadow_visibility(layout_, shadow_atlas_, index, 1, point, n);
       out.real += contribution * ((light.real ? 1.f : 0.f) * real_pixel);
     }
+    // Emitter VPLs (vpl.h): direct light, so every pixel sees all of them (not interleaved).
+    for (std::size_t j = first_emitter_; j < vpls_.size(); ++j) {
+      const Vpl& vpl = vpls_[j];
+      const bool in_rv = want_rv() && vpl.in_real_virtual;
+      const bool in_r = want_r() && vpl.in_real && real_pixel > 0.f;
+      const float cos_x = vpl.incident.dot(n);
+      if ((!in_rv && !in_r) || cos_x <= 0.f) continue;
+      const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(m, n, vpl.incident, wo)) * cos_x;
+      const IsmLookup::Visibility seen = ism_(static_cast<std::uint32_t>(j), point);
+      if (seen.real == 0.f) continue;
+      if (in_rv) out.real_virtual += contribution * seen.virtual_;
+      if (in_r) out.real += contribution;
+    }
   }
 
   void add_indirect(const Vec3& point, const Vec3& n, const Vec3& wo, const PhongMaterial& m, float real_pixel,
                     std::uint32_t subset, Radiance& out) const {
     const float min_distance2 = options_.shading.min_distance * options_.shading.min_distance;
-    const auto count = static_cast<std::uint32_t>(vpls_.size());
+    const auto count = static_cast<std::uint32_t>(first_emitter_);
     const auto subsets = static_cast<std::uint32_t>(options_.interleave * options_.interleave);
     Vec3 rv = Vec3::Zero(), r = Vec3::Zero();
     for (std::uint32_t j = subset; j < count; j += subsets) {
@@ -73,22 +87,16 @@ class MapShader {
       const bool in_rv = want_rv() && vpl.in_real_virtual;
       const bool in_r = want_r() && vpl.in_real && real_pixel > 0.f;
       if (!in_rv && !in_r) continue;
-      Vec3 contribution;
-      if (vpl.emitter()) {  // directional: irradiance `flux` from `incident` (vpl.h)
-        const float cos_x = vpl.incident.dot(n);
-        if (cos_x <= 0.f) continue;
-        contribution = vpl.flux.cwiseProduct(phong_brdf(m, n, vpl.incident, wo)) * cos_x;
-      } else {
-        const Vec3 to_vpl = vpl.position - point;
-        const float distance2 = to_vpl.squaredNorm();
-        if (!(distance2 > 0.f)) continue;
-        const Vec3 wi = to_vpl / std::sqrt(distance2);
-        const float cos_x = wi.dot(n), cos_y = -wi.dot(vpl.normal);
-        if (cos_x <= 0.f || cos_y <= 0.f) continue;
-        contribution = vpl.flux.cwiseProduct(phong_brdf(scene_.materials[vpl.material], vpl.normal, vpl.incident, -wi))
-                           .cwiseProduct(phong_brdf(m, n, wi, wo)) *
-                       (cos_x * cos_y / std::max(distance2, min_distance2));
-      }
+      const Vec3 to_vpl = vpl.position - point;
+      const float distance2 = to_vpl.squaredNorm();
+      if (!(distance2 > 0.f)) continue;
+      const Vec3 wi = to_vpl / std::sqrt(distance2);
+      const float cos_x = wi.dot(n), cos_y = -wi.dot(vpl.normal);
+      if (cos_x <= 0.f || cos_y <= 0.f) continue;
+      const Vec3 contribution =
+          vpl.flux.cwiseProduct(phong_brdf(scene_.materials[vpl.material], vpl.normal, vpl.incident, -wi))
+              .cwiseProduct(phong_brdf(m, n, wi, wo)) *
+          (cos_x * cos_y / std::max(distance2, min_distance2));
       const IsmLookup::Visibility seen = ism_(j, point);
       if (seen.real == 0.f) continue;
       if (in_rv) rv += contribution * seen.virtual_;
@@ -103,6 +111,7 @@ class MapShader {
   std::span<const float> shadow_atlas_;
   std::span<const Vpl> vpls_;
   IsmLookup ism_;
+  std::size_t first_emitter_;  ///< vpls_[first_emitter_, end) are emitters
   const DirRenderOptions& options_;
 };
 

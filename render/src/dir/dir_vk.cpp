@@ -26,7 +26,7 @@ struct ShadeParams {
   std::uint32_t width, height, light_count, vpl_count;
   std::int32_t shadow_tile, shadow_columns, shadow_rows, ism_tile;
   float min_distance;
-  std::uint32_t flags, interleave, pad = 0;
+  std::uint32_t flags, interleave, emitter_count;
   float camera_centre[4];
   float environment[4];
   float virtual_bounds[4];
@@ -218,7 +218,7 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
       options.shading.min_distance,
       shade_flags(options),
       static_cast<std::uint32_t>(options.interleave),
-      0,
+      static_cast<std::uint32_t>(emitter_count(vpls)),
       {centre.x(), centre.y(), centre.z(), 1.f},
       {environment.x(), environment.y(), environment.z(), 0.f},
       {d.points.virtual_bounds.x(), d.points.virtual_bounds.y(), d.points.virtual_bounds.z(),

@@ -68,16 +68,15 @@ class DirShader {
       if (seen.real_virtual) out.real_virtual += contribution;
       if (seen.real && light.real) out.real += real_pixel * contribution;
     }
+    for (const Vpl& vpl : vpls_)
+      if (vpl.emitter()) add_emitter(v, real_pixel, vpl, out);
   }
 
   void add_indirect(const Vertex& v, float real_pixel, PixelResult& out) const {
     const float min_distance2 = options_.min_distance * options_.min_distance;
     for (const Vpl& vpl : vpls_) {
       if (!vpl.in_real_virtual && (!vpl.in_real || real_pixel == 0.f)) continue;
-      if (vpl.emitter()) {
-        add_emitter(v, real_pixel, vpl, out);
-        continue;
-      }
+      if (vpl.emitter()) continue;  // direct light: add_direct
       const Vec3 to_vpl = vpl.position - v.point;
       const float distance2 = to_vpl.squaredNorm();
       if (!(distance2 > 0.f)) continue;

@@ -1,6 +1,7 @@
 #include "relight/render/vpl/vpl.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <numbers>
@@ -105,6 +106,13 @@ std::vector<double> vpl_flux_per_light(const std::vector<Vpl>& vpls, std::size_t
     flux[vpl.light] += luminance(vpl.flux);
   }
   return flux;
+}
+
+std::size_t emitter_count(std::span<const Vpl> vpls) {
+  const auto first = std::find_if(vpls.begin(), vpls.end(), [](const Vpl& v) { return v.emitter(); });
+  if (std::any_of(first, vpls.end(), [](const Vpl& v) { return !v.emitter(); }))
+    throw Error("the emitter VPLs must come after every bounce VPL");
+  return static_cast<std::size_t>(vpls.end() - first);
 }
 
 namespace {

@@ -19,6 +19,7 @@
 // come from the reconstruction, lights are moved into the camera frame once per frame.
 #include <Eigen/Core>
 #include <array>
+#include <cstddef>
 #include <vector>
 
 #include "relight/core/image.h"
@@ -45,6 +46,16 @@ struct ShadingLights {
 /// `real` set take part (virtual objects' lights do not light the real surfaces' colours).
 [[nodiscard]] ShadingLights to_camera_frame(const lights::LightSet& set, const Pose& camera_to_world,
                                             const Eigen::Vector3f& ambient = Eigen::Vector3f::Zero());
+
+/// The most directional lights BRDF estimation shades with. A set with more (a probe's 64 for
+/// replay's --environment vpls) is merged down to them first (lights/merge_lights.h): the
+/// specular fit's cost grows with every light (measured at 640x480: 355 ms a frame with 64
+/// lights, 45 ms with 8) and the merged clusters shade alike to within 1 / cos(theta / 2).
+inline constexpr std::size_t kEstimationDirectionalLights = 8;
+
+/// to_camera_frame() of `set` with at most kEstimationDirectionalLights directional lights.
+[[nodiscard]] ShadingLights estimation_lights(const lights::LightSet& set, const Pose& camera_to_world,
+                                              const Eigen::Vector3f& ambient = Eigen::Vector3f::Zero());
 
 /// Unit direction towards light `light` from camera-frame point `position` and the irradiance
 /// factor it delivers there without the cosine: power for directional lights, power / d^2 for

@@ -7,7 +7,9 @@
 // shade_dir_from_maps() is its shading pass (eqs. 5.1-5.8 with interleaved sampling and the
 // geometry-aware merge) on the same G-buffer and atlases the GPU shades from, so that a test can
 // hold the GPU to it. Reads an MrScene, an MrCamera and the VPLs (vpl/vpl.h); writes
-// DifferentialImages (L_rv, L_r, coverage, their indirect parts).
+// DifferentialImages (L_rv, L_r, coverage, their indirect parts). Emitter VPLs (the last of the
+// list, vpl.h) are direct light: every pixel sums all of them, outside the interleaving, the
+// merge and the indirect parts that temporal smoothing blends.
 #include <span>
 
 #include "relight/render/differential_images.h"

@@ -1,0 +1,20 @@
+#pragma once
+// Fewer directional lights for the stages whose cost grows with every light (BRDF estimation,
+// brdf/): the directional lights of a set, merged pairwise, nearest directions first, until at
+// most `max_directional` of each kind (real, virtual) are left. A merged light carries the sum of
+// its parts' power (the energy stays) along their luminance-weighted mean direction; for a
+// normal that faces all parts, its irradiance differs from theirs by at most 1 / cos(theta / 2)
+// with theta the angle between the parts: a probe's 64 importance samples merged to 8 clusters
+// are what extracting 8 lights from the probe would have given.
+//
+// Reads and writes lights::LightSet; point and spot lights pass unchanged, first, in order, then
+// the real and the virtual directional lights; a set within the limit comes back as it is.
+#include <cstddef>
+
+#include "relight/lights/light_set.h"
+
+namespace relight::lights {
+
+[[nodiscard]] LightSet merge_directional_lights(const LightSet& set, std::size_t max_directional);
+
+}  // namespace relight::lights
