@@ -181,6 +181,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   const RealLightStages light_stages =
       add_real_light_stages(graph, real_lights, probe_input, per_pixel, pipeline.vulkan.get());
   pipeline.probe = light_stages.probe;
+  if (real_lights.lights_file.empty()) pipeline.extracted_lights = probe_input.lights;
   pipeline.light_estimation = light_stages.estimation;
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
   graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
@@ -278,6 +279,10 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
   report["tracking"] = pipeline.trajectory->summary();
   if (pipeline.probe) report["probe"] = pipeline.probe->summary();
   if (pipeline.light_estimation) report["light_estimate"] = pipeline.light_estimation->summary();
+  if (pipeline.renders) {
+    report["environment"] = {{"mode", name_of(render::kEnvironmentLightNames, options.environment)},
+                             {"extracted_lights", pipeline.extracted_lights}};
+  }
   report["latency_ms"] = pipeline.latency->summary();
   if (pipeline.placement) {
     report["placements"] = pipeline.placement->summary();

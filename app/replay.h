@@ -125,6 +125,7 @@ struct ReplayPipeline {
   brdf::LightEstimationStage* light_estimation = nullptr;  ///< set with --lights estimate
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
+  int extracted_lights = 0;                       ///< lights extracted per frame (probe or estimate); 0: none
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".
   BufferName<ColorImage> final_composite = kComposite;
   app::ReportCollectorStage* report = nullptr;    ///< gathers report.html's pictures, materials, lights
