@@ -18,19 +18,30 @@
 // indirect bounces, for DIR (Vulkan, 256 light samples) with one bounce, with two whose second
 // bounce is ray traced, and with two found by the point-cone method (vpl.h), its search on the
 // CPU and on Vulkan (cone_search_vk.h); median of 3 runs.
+// dir/environment_vpls_vs_directional: the room under a uniform sky (no lamps), the path tracer
+// its truth; DIR lights it with the sky importance-sampled into directional lights, 64 reaching
+// the scene as emitter VPLs shadowed by their ISMs (ours, vpl.h) against 8 shadow-mapped ones
+// (the baseline, what replay's --environment directional runs), at 320x240 with 256 light
+// samples of bounce VPLs each; ms per frame including the VPLs, errors as dir/vs_reference.
+// Also: 8 lights as VPLs and 64 shadow-mapped ones, each with its time and error.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
+#include <tuple>
+#include <utility>
 
 #include "bench.h"
-#include "relight/render/vpl/cone_search_vk.h"
-#include "relight/render/reference/dir_exact.h"
+#include "relight/lights/light_stages.h"
 #include "relight/render/dir/dir_vk.h"
 #include "relight/render/dir/gbuffer_vk.h"
+#include "relight/render/reference/dir_exact.h"
 #include "relight/render/reference/path_tracer.h"
 #include "relight/render/scene/procedural_models.h"
-#include "relight/truth/scene_from_synth.h"
+#include "relight/render/scene/scene_lights.h"
+#include "relight/render/vpl/cone_search_vk.h"
 #include "relight/synth/trajectory.h"
+#include "relight/truth/scene_from_synth.h"
 #include "relight/vk/context.h"
 
 namespace {
@@ -324,9 +335,107 @@ bench::Json gbuffer_640x480(const bench::Options& options) {
   return json;
 }
 
+/// The bench scene under a uniform sky of radiance `sky` (no lamps): the truth's scene.
+render::MrScene sky_scene(float sky) {
+  render::MrScene scene = bench_scene();
+  scene.lights.clear();
+  scene.environment.radiance.setConstant(sky);
+  return scene;
+}
+
+/// The bench scene without its lamps, lit by the uniform sky importance-sampled into `count`
+/// directional lights, through emitter VPLs when `through_vpl`.
+render::MrScene sampled_sky_scene(float sky, int count, bool through_vpl) {
+  render::MrScene scene = bench_scene();
+  scene.lights.clear();
+  RadianceImage probe(128, 64);
+  for (Float3& texel : probe.pixels()) texel = {sky, sky, sky};
+  lights::LightExtractionOptions extraction;
+  extraction.lights = count;
+  extraction.calibration = lights::ProbeCalibration::equirectangular();
+  render::add_lights(scene, lights::extract_lights(probe, extraction));
+  for (render::MrLight& light : scene.lights) light.through_vpl = through_vpl;
+  return scene;
+}
+
+bench::Json environment_vpls_vs_directional(const bench::Options& options) {
+  auto context = vk::try_create_vulkan();
+  if (!context) return {{"skipped", "no Vulkan device"}};
+  constexpr float kSky = 1.f;
+  render::MrCamera camera = bench_camera();
+  camera.intrinsics = PinholeIntrinsics{525.0, 525.0, 159.5, 119.5, 320, 240};
+  const render::DifferentialImages reference = reference_images(sky_scene(kSky), camera, 1);
+  render::DirRenderOptions dir_options;
+  dir_options.shading.min_distance = 0.05f;
+  dir_options.shadow_tile = 256;  // replay's, for its several soft probe lights
+  struct Variant {
+    render::MrScene scene;
+    std::unique_ptr<render::DirRendererVk> renderer;
+    render::RayTracer tracer;
+    Errors errors;
+    render::DirVkTimings timings;
+    std::size_t shadow_views = 0;
+    Variant(vk::VulkanContext& context, render::MrScene s, const render::MrCamera& camera,
+            const render::DirRenderOptions& options)
+        : scene(std::move(s)),
+          renderer(std::make_unique<render::DirRendererVk>(context, camera.intrinsics.width, camera.intrinsics.height)),
+          tracer(scene) {
+      renderer->set_scene(scene, options);
+      shadow_views = renderer->shadow_layout().views.size();
+    }
+    void frame(const render::MrCamera& camera, const render::DirRenderOptions& options,
+               const render::DifferentialImages& reference) {
+      render::VplOptions vpl_options;
+      vpl_options.count = 256;
+      errors = compare(renderer->render(camera, render::generate_vpls(scene, tracer, vpl_options), options), reference);
+      timings = renderer->last_timings();
+    }
+    [[nodiscard]] bench::Json steps() const {
+      return {{"shadow_maps", timings.shadow_maps_ms},
+              {"ism", timings.ism_ms},
+              {"shading", timings.shading_ms},
+              {"merge", timings.merge_ms}};
+    }
+  };
+  Variant ours(*context, sampled_sky_scene(kSky, 64, true), camera, dir_options);
+  Variant baseline(*context, sampled_sky_scene(kSky, 8, false), camera, dir_options);
+  const bench::Comparison c = bench::compare_interleaved([&] { ours.frame(camera, dir_options, reference); },
+                                                         [&] { baseline.frame(camera, dir_options, reference); },
+                                                         std::max(3, options.repetitions / 2));
+  bench::Json json = bench::comparison_json(c, "directional_8_shadow_mapped");
+  json["delta_rel_error"] = ours.errors.delta_rel;
+  json["baseline_delta_rel_error"] = baseline.errors.delta_rel;
+  json["error_ratio"] = ours.errors.delta_rel / baseline.errors.delta_rel;
+  json["composite_rmse"] = ours.errors.composite_rmse;
+  json["baseline_composite_rmse"] = baseline.errors.composite_rmse;
+  json["lights"] = 64;
+  json["baseline_lights"] = 8;
+  json["baseline_shadow_views"] = baseline.shadow_views;
+  json["stages_ms"] = ours.steps();
+  json["baseline_stages_ms"] = baseline.steps();
+  // The other two corners: light count and mechanism apart.
+  for (const auto& [name, count, through_vpl] :
+       {std::tuple{"vpls_8", 8, true}, std::tuple{"directional_64", 64, false}}) {
+    Variant other(*context, sampled_sky_scene(kSky, count, through_vpl), camera, dir_options);
+    const double ms = bench::median_ms([&] { other.frame(camera, dir_options, reference); }, 3);
+    json[name] = {{"ms", ms},
+                  {"delta_rel_error", other.errors.delta_rel},
+                  {"composite_rmse", other.errors.composite_rmse},
+                  {"shadow_views", other.shadow_views},
+                  {"stages_ms", other.steps()}};
+  }
+  json["width"] = camera.intrinsics.width;
+  json["height"] = camera.intrinsics.height;
+  json["light_samples"] = 256;
+  json["reference_spp"] = kReferenceSpp;
+  json["device"] = context->device_info().name;
+  return json;
+}
+
 }  // namespace
 
 RELIGHT_BENCH_CASE("dir/vs_reference", vs_reference);
+RELIGHT_BENCH_CASE("dir/environment_vpls_vs_directional", environment_vpls_vs_directional);
 RELIGHT_BENCH_CASE("dir/gbuffer_640x480", gbuffer_640x480);
 RELIGHT_BENCH_CASE("dir/frame_640x480_64vpl", [](const bench::Options& o) { return frame_640x480(o, 64); });
 RELIGHT_BENCH_CASE("dir/frame_640x480_256vpl", [](const bench::Options& o) { return frame_640x480(o, 256); });
