@@ -18,12 +18,12 @@
 // indirect bounces, for DIR (Vulkan, 256 light samples) with one bounce, with two whose second
 // bounce is ray traced, and with two found by the point-cone method (vpl.h), its search on the
 // CPU and on Vulkan (cone_search_vk.h); median of 3 runs.
-// dir/environment_vpls_vs_directional: the room under a uniform sky (no lamps), the path tracer
-// its truth; DIR lights it with the sky importance-sampled into directional lights, 64 reaching
-// the scene as emitter VPLs shadowed by their ISMs (ours, vpl.h) against 8 shadow-mapped ones
-// (the baseline, what replay's --environment directional runs), at 320x240 with 256 light
-// samples of bounce VPLs each; ms per frame including the VPLs, errors as dir/vs_reference.
-// Also: 8 lights as VPLs and 64 shadow-mapped ones, each with its time and error.
+// dir/environment_vpls_vs_directional: the room as replay reconstructs it (its depth mesh) with
+// the pebble, under a uniform sky (no lamps), the path tracer its truth; DIR lights it with the sky importance-sampled
+// into directional lights, 64 reaching the scene as emitter VPLs shadowed by their ISMs (ours, vpl.h) against 8
+// shadow-mapped ones (the baseline "directional", what replay's --environment directional runs), at 640x480 with 256
+// light samples of bounce VPLs each; ms per frame including the VPLs, errors as dir/vs_reference, and each renderer's
+// steps. Also: 8 lights as VPLs and 64 shadow-mapped.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -37,9 +37,11 @@
 #include "relight/render/dir/gbuffer_vk.h"
 #include "relight/render/reference/dir_exact.h"
 #include "relight/render/reference/path_tracer.h"
+#include "relight/render/scene/depth_mesh.h"
 #include "relight/render/scene/procedural_models.h"
 #include "relight/render/scene/scene_lights.h"
 #include "relight/render/vpl/cone_search_vk.h"
+#include "relight/synth/raycast.h"
 #include "relight/synth/trajectory.h"
 #include "relight/truth/scene_from_synth.h"
 #include "relight/vk/context.h"
@@ -335,19 +337,41 @@ bench::Json gbuffer_640x480(const bench::Options& options) {
   return json;
 }
 
-/// The bench scene under a uniform sky of radiance `sky` (no lamps): the truth's scene.
-render::MrScene sky_scene(float sky) {
-  render::MrScene scene = bench_scene();
+/// The real scene as the product sees it: the depth mesh (stride 2, as the DIR stage makes it)
+/// of the synthetic room seen from `camera`, with the room's materials, and the pebble; no
+/// lights. Its shadow maps rasterise what replay's do (~150k triangles), not the room's few
+/// analytic shapes.
+render::MrScene reconstructed_scene(const render::MrCamera& camera) {
+  const synth::Scene room = synth::default_indoor_scene();
+  render::MrScene scene = truth::scene_from_synth(room);
+  scene.meshes.clear();
   scene.lights.clear();
+  scene.environment.radiance.setZero();
+  const synth::RenderedFrame frame = synth::render_frame(room, camera.intrinsics, camera.camera_to_world);
+  render::DepthMeshMaterials materials;
+  materials.labels = &frame.material;
+  materials.material_of_label.push_back(0);  // nothing hit: no triangle uses it
+  for (std::uint32_t m = 0; m < room.materials.size(); ++m) materials.material_of_label.push_back(m);
+  render::TriangleMesh mesh =
+      render::mesh_from_positions(render::positions_from_depth(frame.depth, camera.intrinsics), &frame.normals,
+                                  camera.camera_to_world, materials, {.stride = 2});
+  mesh.name = "reconstruction";
+  scene.meshes.push_back(std::move(mesh));
+  render::add_virtual_model(scene, render::make_glossy_pebble(), render::Placement::parse("0.35,-0.2,0.75,30"));
+  return scene;
+}
+
+/// The reconstructed scene under a uniform sky of radiance `sky`: the truth's scene.
+render::MrScene sky_scene(const render::MrCamera& camera, float sky) {
+  render::MrScene scene = reconstructed_scene(camera);
   scene.environment.radiance.setConstant(sky);
   return scene;
 }
 
 /// The bench scene without its lamps, lit by the uniform sky importance-sampled into `count`
 /// directional lights, through emitter VPLs when `through_vpl`.
-render::MrScene sampled_sky_scene(float sky, int count, bool through_vpl) {
-  render::MrScene scene = bench_scene();
-  scene.lights.clear();
+render::MrScene sampled_sky_scene(const render::MrCamera& camera, float sky, int count, bool through_vpl) {
+  render::MrScene scene = reconstructed_scene(camera);
   RadianceImage probe(128, 64);
   for (Float3& texel : probe.pixels()) texel = {sky, sky, sky};
   lights::LightExtractionOptions extraction;
@@ -362,9 +386,8 @@ bench::Json environment_vpls_vs_directional(const bench::Options& options) {
   auto context = vk::try_create_vulkan();
   if (!context) return {{"skipped", "no Vulkan device"}};
   constexpr float kSky = 1.f;
-  render::MrCamera camera = bench_camera();
-  camera.intrinsics = PinholeIntrinsics{525.0, 525.0, 159.5, 119.5, 320, 240};
-  const render::DifferentialImages reference = reference_images(sky_scene(kSky), camera, 1);
+  const render::MrCamera camera = kinect_camera();
+  const render::DifferentialImages reference = reference_images(sky_scene(camera, kSky), camera, 1);
   render::DirRenderOptions dir_options;
   dir_options.shading.min_distance = 0.05f;
   dir_options.shadow_tile = 256;  // replay's, for its several soft probe lights
@@ -397,12 +420,12 @@ bench::Json environment_vpls_vs_directional(const bench::Options& options) {
               {"merge", timings.merge_ms}};
     }
   };
-  Variant ours(*context, sampled_sky_scene(kSky, 64, true), camera, dir_options);
-  Variant baseline(*context, sampled_sky_scene(kSky, 8, false), camera, dir_options);
+  Variant ours(*context, sampled_sky_scene(camera, kSky, 64, true), camera, dir_options);
+  Variant baseline(*context, sampled_sky_scene(camera, kSky, 8, false), camera, dir_options);
   const bench::Comparison c = bench::compare_interleaved([&] { ours.frame(camera, dir_options, reference); },
                                                          [&] { baseline.frame(camera, dir_options, reference); },
                                                          std::max(3, options.repetitions / 2));
-  bench::Json json = bench::comparison_json(c, "directional_8_shadow_mapped");
+  bench::Json json = bench::comparison_json(c, "directional");
   json["delta_rel_error"] = ours.errors.delta_rel;
   json["baseline_delta_rel_error"] = baseline.errors.delta_rel;
   json["error_ratio"] = ours.errors.delta_rel / baseline.errors.delta_rel;
@@ -416,7 +439,7 @@ bench::Json environment_vpls_vs_directional(const bench::Options& options) {
   // The other two corners: light count and mechanism apart.
   for (const auto& [name, count, through_vpl] :
        {std::tuple{"vpls_8", 8, true}, std::tuple{"directional_64", 64, false}}) {
-    Variant other(*context, sampled_sky_scene(kSky, count, through_vpl), camera, dir_options);
+    Variant other(*context, sampled_sky_scene(camera, kSky, count, through_vpl), camera, dir_options);
     const double ms = bench::median_ms([&] { other.frame(camera, dir_options, reference); }, 3);
     json[name] = {{"ms", ms},
                   {"delta_rel_error", other.errors.delta_rel},
