@@ -109,12 +109,10 @@ TEST_F(DirStageTest, CpuFallbackMatchesTheVulkanRenderer) {
 }
 
 // EnvironmentLight::Vpls routes the sun through its emitter VPL; the lamps stay point lights.
-// The picture is the shadow-mapped sun's up to what the ISM and the interleaving cost: the
-// emitter's light on the glossy pebble is spread over the 4 x 4 merge window (a softer
-// highlight) and its grazing rim falls into the ISM's self-shadow early. Measured (160 x 120,
-// ISM tile 64): the sun changes 165 pixels (the pebble) by 55.6 levels on average, the modes
-// differ there by 19.8 (37 % within 3 levels; 16.1 with 32-texel tiles); 99.4 % of all pixels
-// within 3 levels.
+// The picture is the shadow-mapped sun's up to what the emitter's coarser imperfect shadow map
+// costs. Measured (160 x 120, ISM tile 64): the sun changes 165 pixels (the pebble) by 55.6
+// levels on average, the modes differ there by 1.3 (99 % within 3 levels; 19.8 when the emitter
+// was interleaved with the bounce VPLs and merged, vpl.h); 100 % of all pixels within 3 levels.
 TEST_F(DirStageTest, EnvironmentVplsLightThePictureLikeShadowMappedDirectionalLights) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const StageRun directional = run_stage(&context, EnvironmentLight::Directional);
@@ -143,7 +141,8 @@ TEST_F(DirStageTest, EnvironmentVplsLightThePictureLikeShadowMappedDirectionalLi
       sunlit, effect / std::max(sunlit, 1), error / std::max(sunlit, 1), 100.0 * agree / std::max(sunlit, 1),
       100.0 * close / static_cast<double>(pixels.size()));
   EXPECT_GT(sunlit, 100) << "the sun lights the pebble";
-  EXPECT_LT(error, 0.45 * effect);
+  EXPECT_LT(error, 0.1 * effect);
+  EXPECT_GT(agree, sunlit * 9 / 10);
   EXPECT_GT(close, static_cast<int>(pixels.size()) * 99 / 100);
 }
 

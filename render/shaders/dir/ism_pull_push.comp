@@ -16,6 +16,8 @@ layout(push_constant) uniform Params {
   uint fine_offset;    // into pyramid; unused for level 0
   uint coarse_offset;  // into pyramid
   uint fine_is_atlas;
+  uint vpl_count;      // tile t belongs to VPL t % vpl_count
+  uint first_emitter;  // push: tiles of VPLs from here on are not filled at this level
 } params;
 
 const float EMPTY = 1e30;
@@ -45,6 +47,7 @@ void main() {
     if (id >= params.tiles * fine * fine) return;
     if (read_fine(id) < EMPTY) return;
     const uint tile = id / (fine * fine), x = id % fine, y = (id / fine) % fine;
+    if (tile % params.vpl_count >= params.first_emitter) return;
     const float parent = pyramid[params.coarse_offset + tile * coarse * coarse + (y / 2u) * coarse + x / 2u];
     if (params.fine_is_atlas != 0u) atlas[id] = parent; else pyramid[params.fine_offset + id] = parent;
   }

@@ -154,7 +154,7 @@ struct DirRendererVk::Impl {
   void record_shading(VkCommandBuffer cmd, const ShadeParams& params, const DirRenderOptions& options) {
     Impl& d = *this;
     d.timers[2].start(cmd);
-    d.ism.record(cmd, *d.vpls, d.vpl_count, options.ism);
+    d.ism.record(cmd, *d.vpls, d.vpl_count, params.emitter_count, options.ism);
     d.timers[2].stop(cmd);
     vk::compute_barrier(cmd);
     d.shade_set = {};

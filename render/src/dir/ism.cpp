@@ -278,7 +278,9 @@ std::vector<float> ism_atlas_cpu(const IsmPointPools& points, std::span<const Vp
           splat(projection, pool[ism_point_index(vpl, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(pool.size()))], tile,
                 texels);
       }
-      fill_holes(texels, tile, options.pull_push_levels);
+      fill_holes(
+          texels, tile,
+          vpls[vpl].emitter() ? std::min(options.pull_push_levels, kEmitterPullPushLevels) : options.pull_push_levels);
     }
   }, 4);
   return atlas;

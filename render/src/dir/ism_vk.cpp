@@ -26,6 +26,7 @@ struct SplatParams {
 
 struct PullPushParams {
   std::uint32_t mode, tiles, fine_size, fine_offset, coarse_offset, fine_is_atlas;
+  std::uint32_t vpl_count, first_emitter;  ///< push: emitter tiles skip levels >= kEmitterPullPushLevels
 };
 
 /// Dispatches `items` invocations of a 1D shader that indexes by gl_GlobalInvocationID.y * row + x.
@@ -76,7 +77,8 @@ void IsmVk::ensure_buffers(std::size_t atlas_floats, std::size_t pyramid_floats)
   pull_push_set_ = pull_push_.bind({atlas_.get(), pyramid_.get()});
 }
 
-void IsmVk::record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint32_t vpl_count, const IsmOptions& options) {
+void IsmVk::record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint32_t vpl_count,
+                   std::uint32_t emitter_count, const IsmOptions& options) {
   if (!points_) throw LogicError("IsmVk::set_points must come before record");
   const auto tile = static_cast<std::uint32_t>(options.tile);
   const std::uint32_t tiles = 2 * vpl_count;
@@ -104,15 +106,29 @@ void IsmVk::record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint3
   const int levels = options.pull_push_levels;
   for (int l = 0; l < levels; ++l) {  // pull: level l -> l + 1
     const std::uint32_t fine = tile >> l, coarse = fine / 2;
-    const PullPushParams params{0, tiles, fine, l == 0 ? 0u : offsets[static_cast<std::size_t>(l - 1)],
-                                offsets[static_cast<std::size_t>(l)], l == 0 ? 1u : 0u};
+    const PullPushParams params{0,
+                                tiles,
+                                fine,
+                                l == 0 ? 0u : offsets[static_cast<std::size_t>(l - 1)],
+                                offsets[static_cast<std::size_t>(l)],
+                                l == 0 ? 1u : 0u,
+                                vpl_count,
+                                vpl_count - emitter_count};
     dispatch_items(cmd, pull_push_, pull_push_set_, params, tiles * coarse * coarse);
     vk::compute_barrier(cmd);
   }
   for (int l = levels - 1; l >= 0; --l) {  // push: level l + 1 -> l
     const std::uint32_t fine = tile >> l;
-    const PullPushParams params{1, tiles, fine, l == 0 ? 0u : offsets[static_cast<std::size_t>(l - 1)],
-                                offsets[static_cast<std::size_t>(l)], l == 0 ? 1u : 0u};
+    // Emitter tiles: levels from kEmitterPullPushLevels on keep their holes.
+    const std::uint32_t first_emitter = l >= kEmitterPullPushLevels ? vpl_count - emitter_count : vpl_count;
+    const PullPushParams params{1,
+                                tiles,
+                                fine,
+                                l == 0 ? 0u : offsets[static_cast<std::size_t>(l - 1)],
+                                offsets[static_cast<std::size_t>(l)],
+                                l == 0 ? 1u : 0u,
+                                vpl_count,
+                                first_emitter};
     dispatch_items(cmd, pull_push_, pull_push_set_, params, tiles * fine * fine);
     vk::compute_barrier(cmd);
   }

@@ -19,8 +19,10 @@ class IsmVk {
 
   /// Uploads both point pools (real first).
   void set_points(const IsmPointPools& points);
-  /// Records the atlas of `vpl_count` VPLs from `vpls` (GpuVpl records, see dir_vk.cpp).
-  void record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint32_t vpl_count, const IsmOptions& options);
+  /// Records the atlas of `vpl_count` VPLs from `vpls` (GpuVpl records, see dir_vk.cpp), the
+  /// last `emitter_count` of them emitters (ism.h: fewer pull-push levels).
+  void record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint32_t vpl_count, std::uint32_t emitter_count,
+              const IsmOptions& options);
   [[nodiscard]] const vk::VulkanBuffer& atlas() const { return *atlas_; }
 
  private:
