@@ -239,11 +239,17 @@ TEST(Vpls, BudgetByWeightOrLastFramesFluxMovesSamplesNotEnergy) {
   const double floor_share = (1.0 / 16.0) / (2.0 + 1.0 / 16.0);  // mean weight 1, floor 1/16
   EXPECT_NEAR(by_flux.second, 400 * floor_share, 1.0);
   EXPECT_EQ(by_flux.first + by_flux.second, 400);
-  // Without last frame's flux the budget is by power: equal here.
+  // Without last frame's flux (the first frame) the shares are equal, even for a light three
+  // times as bright, which ByPower gives three times the samples.
+  MrScene unequal = scene;
+  unequal.lights[1].intensity *= 3.f;
+  const RayTracer unequal_tracer(unequal);
   options.previous_flux.clear();
-  EXPECT_EQ(vpls_per_light(generate_vpls(scene, tracer, options)), std::make_pair(200, 200));
+  EXPECT_EQ(vpls_per_light(generate_vpls(unequal, unequal_tracer, options)), std::make_pair(200, 200));
   options.budget = VplBudget::Equal;
-  EXPECT_EQ(vpls_per_light(generate_vpls(scene, tracer, options)), std::make_pair(200, 200));
+  EXPECT_EQ(vpls_per_light(generate_vpls(unequal, unequal_tracer, options)), std::make_pair(200, 200));
+  options.budget = VplBudget::ByPower;
+  EXPECT_EQ(vpls_per_light(generate_vpls(unequal, unequal_tracer, options)), std::make_pair(100, 300));
 }
 
 TEST(Vpls, DirectionalLightDeliversItsIrradianceTimesTheLitArea) {

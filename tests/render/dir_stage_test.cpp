@@ -175,7 +175,7 @@ TEST(VplStage, FluxBudgetComesFromThePreviousFramesVpls) {
     const std::vector<Vpl>& vpls = graph.find<VplSet>("vpls")->vpls;
     return std::count_if(vpls.begin(), vpls.end(), [](const Vpl& v) { return v.light == 0; });
   };
-  // First frame: no history, so by power: 200 samples each. Second: the far light's VPLs
+  // First frame: no history, so equal shares: 200 samples each. Second: the far light's VPLs
   // carried almost nothing, it keeps the floor share (1/16 of the mean weight) and the near
   // light gets about 388 of the 400 samples, so nearly twice the VPLs.
   const auto first = near_light_vpls();

@@ -32,6 +32,10 @@ std::vector<double> budget_weights(const MrScene& scene, const BoundingSphere& b
     }
   }
   if (options.budget != VplBudget::ByPreviousFlux) return weight;
+  if (options.previous_flux.empty()) {  // the first frame: equal shares, the paper's default mode
+    for (double& w : weight) w = w > 0.0 ? 1.0 : 0.0;
+    return weight;
+  }
   // Lights without last frame's flux keep their power weight, scaled by the ratio of flux to
   // power of the lights that have one.
   double flux_sum = 0.0, power_sum = 0.0;

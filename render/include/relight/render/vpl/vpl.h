@@ -98,10 +98,11 @@ inline constexpr float kEmitterDistance = 100.f;
 ///   ByWeight        proportional to `light_weights` (one per light; missing entries count 1);
 ///   ByPreviousFlux  proportional to the flux the light's VPLs carried last frame
 ///                   (`previous_flux`, from vpl_flux_per_light), i.e. the light that actually
-///                   reached surfaces: a spot light aimed past the scene gets few samples. A light
-///                   without an entry takes its ByPower weight scaled to the others, and every
-///                   light keeps at least 1/16 of the mean share so that one that found nothing
-///                   last frame can recover.
+///                   reached surfaces: a spot light aimed past the scene gets few samples. Without
+///                   any (the first frame) the shares are equal, as the dissertation's default
+///                   mode (§5.2.7); a light without an entry takes its ByPower weight scaled to
+///                   the others, and every light keeps at least 1/16 of the mean share so that
+///                   one that found nothing last frame can recover.
 enum class VplBudget { Equal, ByPower, ByWeight, ByPreviousFlux };
 inline constexpr std::array<NamedValue<VplBudget>, 4> kVplBudgetNames{{{"equal", VplBudget::Equal},
                                                                        {"power", VplBudget::ByPower},
