@@ -104,32 +104,27 @@ void IsmVk::record(VkCommandBuffer cmd, const vk::VulkanBuffer& vpls, std::uint3
   splat_.dispatch(cmd, splat_set_, splat, vk::ComputePipeline::group_count(splat.points_per_vpl, kGroup), vpl_count, 2);
   vk::compute_barrier(cmd);
   const int levels = options.pull_push_levels;
+  // Level l (fine) and l + 1 (coarse); the push leaves emitter tiles' holes from level
+  // kEmitterPullPushLevels on (ism.h), the pull ignores first_emitter.
+  const auto level_params = [&](std::uint32_t mode, int l) {
+    const std::uint32_t first_emitter = l >= kEmitterPullPushLevels ? vpl_count - emitter_count : vpl_count;
+    return PullPushParams{mode,
+                          tiles,
+                          tile >> l,
+                          l == 0 ? 0u : offsets[static_cast<std::size_t>(l - 1)],
+                          offsets[static_cast<std::size_t>(l)],
+                          l == 0 ? 1u : 0u,
+                          vpl_count,
+                          first_emitter};
+  };
   for (int l = 0; l < levels; ++l) {  // pull: level l -> l + 1
-    const std::uint32_t fine = tile >> l, coarse = fine / 2;
-    const PullPushParams params{0,
-                                tiles,
-                                fine,
-                                l == 0 ? 0u : offsets[static_cast<std::size_t>(l - 1)],
-                                offsets[static_cast<std::size_t>(l)],
-                                l == 0 ? 1u : 0u,
-                                vpl_count,
-                                vpl_count - emitter_count};
-    dispatch_items(cmd, pull_push_, pull_push_set_, params, tiles * coarse * coarse);
+    const std::uint32_t coarse = (tile >> l) / 2;
+    dispatch_items(cmd, pull_push_, pull_push_set_, level_params(0, l), tiles * coarse * coarse);
     vk::compute_barrier(cmd);
   }
   for (int l = levels - 1; l >= 0; --l) {  // push: level l + 1 -> l
     const std::uint32_t fine = tile >> l;
-    // Emitter tiles: levels from kEmitterPullPushLevels on keep their holes.
-    const std::uint32_t first_emitter = l >= kEmitterPullPushLevels ? vpl_count - emitter_count : vpl_count;
-    const PullPushParams params{1,
-                                tiles,
-                                fine,
-                                l == 0 ? 0u : offsets[static_cast<std::size_t>(l - 1)],
-                                offsets[static_cast<std::size_t>(l)],
-                                l == 0 ? 1u : 0u,
-                                vpl_count,
-                                first_emitter};
-    dispatch_items(cmd, pull_push_, pull_push_set_, params, tiles * fine * fine);
+    dispatch_items(cmd, pull_push_, pull_push_set_, level_params(1, l), tiles * fine * fine);
     vk::compute_barrier(cmd);
   }
 }
