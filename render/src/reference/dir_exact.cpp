@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <span>
 
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
@@ -21,7 +22,11 @@ struct PixelResult {
 class DirShader {
  public:
   DirShader(const MrScene& scene, const RayTracer& tracer, const std::vector<Vpl>& vpls, const DirOptions& options)
-      : scene_(scene), tracer_(tracer), vpls_(vpls), options_(options) {}
+      : scene_(scene),
+        tracer_(tracer),
+        bounce_vpls_(std::span(vpls).first(vpls.size() - emitter_count(vpls))),
+        emitters_(std::span(vpls).subspan(bounce_vpls_.size())),
+        options_(options) {}
 
   [[nodiscard]] PixelResult shade(const Vec3& origin, const Vec3& direction) const {
     PixelResult out;
@@ -68,15 +73,13 @@ class DirShader {
       if (seen.real_virtual) out.real_virtual += contribution;
       if (seen.real && light.real) out.real += real_pixel * contribution;
     }
-    for (const Vpl& vpl : vpls_)
-      if (vpl.emitter()) add_emitter(v, real_pixel, vpl, out);
+    for (const Vpl& emitter : emitters_) add_emitter(v, real_pixel, emitter, out);
   }
 
   void add_indirect(const Vertex& v, float real_pixel, PixelResult& out) const {
     const float min_distance2 = options_.min_distance * options_.min_distance;
-    for (const Vpl& vpl : vpls_) {
+    for (const Vpl& vpl : bounce_vpls_) {
       if (!vpl.in_real_virtual && (!vpl.in_real || real_pixel == 0.f)) continue;
-      if (vpl.emitter()) continue;  // direct light: add_direct
       const Vec3 to_vpl = vpl.position - v.point;
       const float distance2 = to_vpl.squaredNorm();
       if (!(distance2 > 0.f)) continue;
@@ -110,7 +113,8 @@ class DirShader {
 
   const MrScene& scene_;
   const RayTracer& tracer_;
-  const std::vector<Vpl>& vpls_;
+  std::span<const Vpl> bounce_vpls_;
+  std::span<const Vpl> emitters_;  ///< the last VPLs (vpl.h): direct light, in add_direct
   const DirOptions& options_;
 };
 
