@@ -20,22 +20,21 @@ double power_weight(const MrLight& light, const BoundingSphere& bounds) {
 /// The weights of VplBudget (vpl.h) for the lights that emit VPLs; 0 for the others.
 std::vector<double> budget_weights(const MrScene& scene, const BoundingSphere& bounds, const VplOptions& options) {
   const std::size_t n = scene.lights.size();
+  // The first frame of ByPreviousFlux (no flux yet) shares equally, the paper's default mode.
+  const VplBudget budget =
+      options.budget == VplBudget::ByPreviousFlux && options.previous_flux.empty() ? VplBudget::Equal : options.budget;
   std::vector<double> weight(n, 0.0);
   for (std::size_t i = 0; i < n; ++i) {
     const MrLight& light = scene.lights[i];
     if (!emits_vpls(light)) continue;
-    switch (options.budget) {
+    switch (budget) {
       case VplBudget::Equal: weight[i] = 1.0; break;
       case VplBudget::ByPower:
       case VplBudget::ByPreviousFlux: weight[i] = power_weight(light, bounds); break;
       case VplBudget::ByWeight: weight[i] = i < options.light_weights.size() ? options.light_weights[i] : 1.0; break;
     }
   }
-  if (options.budget != VplBudget::ByPreviousFlux) return weight;
-  if (options.previous_flux.empty()) {  // the first frame: equal shares, the paper's default mode
-    for (double& w : weight) w = w > 0.0 ? 1.0 : 0.0;
-    return weight;
-  }
+  if (budget != VplBudget::ByPreviousFlux) return weight;
   // Lights without last frame's flux keep their power weight, scaled by the ratio of flux to
   // power of the lights that have one.
   double flux_sum = 0.0, power_sum = 0.0;
