@@ -154,6 +154,25 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  command
+      .add_option("--camera-artefacts", options.camera_artefacts,
+                  "What of the camera's look goes on the virtual layer, measured in every frame: all, none, or "
+                  "a comma-separated list of blur (the camera's defocus, from its edges), motion (blur along the "
+                  "tracked camera motion over --exposure-time) and noise (the camera's noise per intensity)")
+      ->check([](const std::string& text) {
+        try {
+          (void)colormap::parse_camera_artefacts(text);
+          return std::string();
+        } catch (const Error& error) {
+          return std::string(error.what());
+        }
+      })
+      ->capture_default_str();
+  command
+      .add_option("--exposure-time", options.exposure_time_s,
+                  "Seconds the colour camera exposes each frame (its motion blur; at most the frame interval)")
+      ->check(CLI::PositiveNumber)
+      ->default_str("0.0333");
   add_choice_option(command, "--colormap", options.colormap, colormap::kColorMapMethodNames,
                     "Map the rendered colours to the camera's: stats (CIELab statistics), sample (colour samples "
                     "and a fitted 3x4 matrix) or none; composite.mp4 shows the mapped result, frames/ both");

@@ -131,7 +131,7 @@ std::optional<capture::TagLayout> marker_layout(const ReplayOptions& options) {
 /// The colour mapping between DIR's L_rv/L_r and the camera, and its composite; returns the
 /// buffer that holds the final picture (DIR's own composite when there is no mapping).
 BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel,
-                                         const colormap::ToneMap& tone_map) {
+                                         const colormap::ToneMap& tone_map, bool camera_look) {
   const auto method = options.colormap;
   if (method == colormap::ColorMapMethod::None) return kComposite;  // DIR's own composite is unmapped
   colormap::SampleMappingOptions mapping;
@@ -139,7 +139,7 @@ BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayO
   mapping.channel_swap = options.channel_swap;
   mapping.model = options.colormap_model;
   pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping));
-  pipeline.graph->emplace<render::MappedCompositeStage>();
+  pipeline.graph->emplace<render::MappedCompositeStage>(camera_look);
   pipeline.graph->keep(kCompositeMapped);
   return kCompositeMapped;
 }
@@ -193,6 +193,10 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.bounce_method = options.bounce_method;
   dir.vpls.source = options.vpl_source;
   dir.tone_map.exposure = options.exposure;
+  render::CameraLookOptions look;
+  look.artefacts = colormap::parse_camera_artefacts(options.camera_artefacts);
+  look.exposure_time_s = options.exposure_time_s;
+  dir.camera_look = look;
   dir.environment = options.environment;
   dir.materials_buffer = brdf::kMaterials;
   dir.real_lights_buffer = lights::kLights;
@@ -203,9 +207,9 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.renderer.shadow_tile = 256;
   // DIR rasterises: on Vulkan wherever a device exists, lavapipe included (vk::StageKind).
   const Backend rendering = vk::choose_backend(vk::StageKind::Rasterisation, pipeline.vulkan.get(), options.backend);
-  render::add_dir_stages(graph, rendering, pipeline.vulkan.get(), std::move(content), dir);
+  pipeline.camera_look = render::add_dir_stages(graph, rendering, pipeline.vulkan.get(), std::move(content), dir);
   graph.keep(kComposite);
-  pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, dir.tone_map);
+  pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, dir.tone_map, look.artefacts.any());
   if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", pipeline.final_composite);
   pipeline.renders = true;
 }
@@ -267,6 +271,24 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
   pipeline.graph->add(std::move(collector));
 }
 
+nlohmann::ordered_json camera_look_json(const render::CameraLookSummary& summary) {
+  nlohmann::ordered_json noise = nlohmann::ordered_json::array();
+  for (int band = 0; band < colormap::kNoiseBands; ++band) {
+    const auto& sigma = summary.noise.sigma[static_cast<std::size_t>(band)];
+    noise.push_back({{"code", (band + 0.5) * 256.0 / colormap::kNoiseBands},
+                     {"sigma", {sigma[0], sigma[1], sigma[2]}},
+                     {"samples", summary.noise.samples[static_cast<std::size_t>(band)]}});
+  }
+  return {{"artefacts", colormap::to_string(summary.artefacts)},
+          {"frames", summary.frames},
+          {"blur_sigma_px", summary.blur_sigma_px},
+          {"applied_blur_sigma_px", summary.applied_sigma_px},
+          {"blur_edges", summary.blur_edges},
+          {"frames_with_motion", summary.frames_with_motion},
+          {"max_motion_px", summary.max_motion_px},
+          {"noise", std::move(noise)}};
+}
+
 }  // namespace
 
 void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline& pipeline,
@@ -283,6 +305,7 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
     report["environment"] = {{"mode", name_of(render::kEnvironmentLightNames, options.environment)},
                              {"extracted_lights", pipeline.extracted_lights}};
   }
+  if (pipeline.camera_look) report["camera_look"] = camera_look_json(pipeline.camera_look->summary());
   report["latency_ms"] = pipeline.latency->summary();
   if (pipeline.placement) {
     report["placements"] = pipeline.placement->summary();

@@ -92,6 +92,9 @@ struct ReplayOptions {
   render::VplSource vpl_source = render::VplSource::RayTraced;           ///< where spot lights' first VPLs come from
   RealAlbedo real_albedo = RealAlbedo::Pixel;
   float exposure = 1.f;                        ///< tone mapping of the rendered light
+  /// The camera's artefacts on the virtual layer (--camera-artefacts, colormap/camera_look.h).
+  std::string camera_artefacts = "all";
+  double exposure_time_s = 1.0 / 30.0;         ///< the colour camera's exposure (motion blur)
   bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
   /// Colour mapping of the rendered light to the camera (colormap/).
   colormap::ColorMapMethod colormap = colormap::ColorMapMethod::Statistics;
@@ -123,6 +126,7 @@ struct ReplayPipeline {
   app::LatencyStage* latency = nullptr;           ///< capture to final picture, every frame
   lights::ProbeStreamStage* probe = nullptr;      ///< set when the real lights come from a probe
   brdf::LightEstimationStage* light_estimation = nullptr;  ///< set with --lights estimate
+  render::CameraLookStage* camera_look = nullptr;          ///< set with --camera-artefacts other than none
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
   int extracted_lights = 0;                       ///< lights extracted per frame (probe or estimate); 0: none

@@ -26,6 +26,8 @@ struct SynthCommandOptions {
   synth::NoiseModel noise = synth::NoiseModel::Kinect1;
   std::vector<double> white_balance{1.0, 1.0, 1.0};
   double exposure = 1.0;
+  double color_blur = 0.0;
+  std::vector<double> color_noise{0.0, 0.0};
   int threads = 0;
   ImageSize size = ImageSize::Vga;
   synth::LightAnimationOptions light_animation;
@@ -42,6 +44,9 @@ int run_synth(const SynthCommandOptions& command) {
   options.seed = command.seed;
   options.color.gains = {command.white_balance[0], command.white_balance[1], command.white_balance[2]};
   options.color.exposure = command.exposure;
+  options.camera.blur_sigma_px = command.color_blur;
+  options.camera.noise_floor = command.color_noise[0];
+  options.camera.noise_gain = command.color_noise[1];
   options.threads = command.threads;
   if (command.size == ImageSize::Qvga) {
     options.width = 320;
@@ -82,6 +87,18 @@ void register_synth(CLI::App& app, Runners& runners) {
   synth->add_option("--exposure", options->exposure, "Colour camera exposure multiplier")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  synth
+      ->add_option("--color-blur", options->color_blur,
+                   "Colour camera's point spread: Gaussian sigma in pixels on the radiance (0 = sharp)")
+      ->check(CLI::Range(0.0, 20.0))
+      ->capture_default_str();
+  synth
+      ->add_option("--color-noise", options->color_noise,
+                   "Colour camera's noise: FLOOR,GAIN of sigma(I)^2 = FLOOR + GAIN * I in 8-bit code values, per "
+                   "channel, new every frame (0,0 = none)")
+      ->expected(2)
+      ->delimiter(',')
+      ->check(CLI::NonNegativeNumber);
   add_choice_option(*synth, "--size", options->size, kImageSizeNames,
                     "Image size: 640x480 (Kinect v1) or 320x240 (its QVGA mode, the intrinsics halved)");
   add_choice_option(*synth, "--light-animation", options->light_animation.kind, synth::kLightAnimationNames,

@@ -71,7 +71,10 @@ void write_sequence(const synth::Scene& scene, const synth::SynthOptions& option
                                : synth::apply_kinect_noise(frame.depth, frame.normals, intrinsics, options.kinect,
                                                     options.seed, static_cast<std::uint64_t>(i), options.threads);
     const Timestamp timestamp = synth::frame_timestamp(i);
-    writer.add(timestamp, synth::encode_color(frame.radiance, options.color), depth, poses[static_cast<std::size_t>(i)]);
+    const ColorImage color = synth::add_color_noise(
+        synth::encode_color(synth::blur_radiance(frame.radiance, options.camera.blur_sigma_px), options.color),
+        options.camera, options.seed, static_cast<std::uint64_t>(i), options.threads);
+    writer.add(timestamp, color, depth, poses[static_cast<std::size_t>(i)]);
     if (options.ground_truth) write_ground_truth(out, timestamp, frame);
     const std::string stem = stem_of(timestamp);
     if (animated && options.ground_truth) {

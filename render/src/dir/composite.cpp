@@ -1,5 +1,7 @@
 #include "relight/render/dir/composite.h"
 
+#include <optional>
+
 #include "relight/colormap/color_space.h"
 #include "relight/core/error.h"
 
@@ -14,40 +16,70 @@ void require_camera_size(const ColorImage& camera, std::initializer_list<const I
   if (!same) throw Error("differential composite: the camera image and the rendered images differ in size");
 }
 
+/// The layer of composite_layer: c V and (1 - c) Delta per pixel. At a partly covered pixel
+/// (0 < c < 1) with `virtual_centre`, V is the mean over the pixels of its 3x3 neighbourhood
+/// (itself included) whose centre saw the virtual object, and Delta the mean over those whose
+/// centre saw the real scene (none: its own V, or no Delta). So a blend never takes one pixel's
+/// virtual shading as a real differential, and a sliver of a face that only the centre sample hit
+/// (a side seen at a grazing angle) does not stand for the whole covered part of the pixel.
+template <class VirtualColour, class Difference>
+colormap::VirtualLayer separated_layer(const CoverageImage& coverage, const Mask* virtual_centre,
+                                       const VirtualColour& virtual_colour, const Difference& difference) {
+  const int width = coverage.width(), height = coverage.height();
+  colormap::VirtualLayer layer{RadianceImage(width, height), coverage, RadianceImage(width, height)};
+  const auto neighbours_mean = [&](int row, int col, bool want_virtual, const auto& value) -> std::optional<Float3> {
+    Float3 sum;
+    int n = 0;
+    for (int i = -1; i <= 1; ++i)
+      for (int j = -1; j <= 1; ++j) {
+        const int r = row + i, c = col + j;
+        if (r < 0 || c < 0 || r >= height || c >= width) continue;
+        if (((*virtual_centre)(r, c) != 0) != want_virtual) continue;
+        sum += value(static_cast<std::size_t>(r) * static_cast<std::size_t>(width) + static_cast<std::size_t>(c));
+        ++n;
+      }
+    if (n == 0) return std::nullopt;
+    return (1.f / float(n)) * sum;
+  };
+  for (int row = 0; row < height; ++row) {
+    for (int col = 0; col < width; ++col) {
+      const std::size_t i =
+          static_cast<std::size_t>(row) * static_cast<std::size_t>(width) + static_cast<std::size_t>(col);
+      const float c = coverage.pixels()[i];
+      Float3 v, d;
+      if (c > 0.f) v = virtual_colour(i);
+      if (c < 1.f) d = difference(i);
+      if (virtual_centre && c > 0.f && c < 1.f) {
+        v = neighbours_mean(row, col, true, virtual_colour).value_or(v);
+        d = neighbours_mean(row, col, false, difference).value_or(Float3{});
+      }
+      layer.virtual_color.pixels()[i] = c * v;
+      layer.delta.pixels()[i] = (1.f - c) * d;
+    }
+  }
+  return layer;
+}
+
 }  // namespace
 
 ColorImage differential_composite(const ColorImage& camera, const RadianceImage& real_virtual,
                                   const RadianceImage& real, const CoverageImage& virtual_coverage,
-                                  const colormap::ToneMap& tone_map) {
+                                  const colormap::ToneMap& tone_map, const colormap::CameraLook* look,
+                                  const Mask* virtual_centre) {
   require_camera_size(camera, {&real_virtual, &real}, virtual_coverage);
-  ColorImage out(camera.width(), camera.height());
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const Float3 with = colormap::tone_map(real_virtual.pixels()[i], tone_map);
-    const Float3 without = colormap::tone_map(real.pixels()[i], tone_map);
-    const Float3 background = colormap::decode_srgb8(camera.pixels()[i]) + (with - without);
-    const float c = virtual_coverage.pixels()[i];
-    out.pixels()[i] = colormap::encode_srgb8(c * with + (1.f - c) * background);
-  }
-  return out;
+  const auto with = [&](std::size_t i) { return colormap::tone_map(real_virtual.pixels()[i], tone_map); };
+  const auto difference = [&](std::size_t i) { return with(i) - colormap::tone_map(real.pixels()[i], tone_map); };
+  return colormap::composite_layer(camera, separated_layer(virtual_coverage, virtual_centre, with, difference), look);
 }
 
 ColorImage mapped_differential_composite(const ColorImage& camera, const RadianceImage& delta,
                                          const RadianceImage& real_virtual, const CoverageImage& virtual_coverage,
-                                         const colormap::ColorMapping& mapping) {
+                                         const colormap::ColorMapping& mapping, const colormap::CameraLook* look,
+                                         const Mask* virtual_centre) {
   require_camera_size(camera, {&delta, &real_virtual}, virtual_coverage);
-  ColorImage out(camera.width(), camera.height());
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const Float3& d = delta.pixels()[i];
-    const float c = virtual_coverage.pixels()[i];
-    if (c == 0.f && d == Float3{}) {
-      out.pixels()[i] = camera.pixels()[i];
-      continue;
-    }
-    Float3 mapped = colormap::decode_srgb8(camera.pixels()[i]) + d;
-    if (c > 0.f) mapped = c * mapping(real_virtual.pixels()[i]) + (1.f - c) * mapped;
-    out.pixels()[i] = colormap::encode_srgb8(mapped);
-  }
-  return out;
+  const auto mapped = [&](std::size_t i) { return mapping(real_virtual.pixels()[i]); };
+  const auto difference = [&](std::size_t i) { return delta.pixels()[i]; };
+  return colormap::composite_layer(camera, separated_layer(virtual_coverage, virtual_centre, mapped, difference), look);
 }
 
 ColorImage tone_mapped_preview(const RadianceImage& radiance, const colormap::ToneMap& tone_map) {

@@ -1,8 +1,10 @@
 #include "relight/render/dir/dir_stage.h"
 
+#include "relight/colormap/buffers.h"
 #include "relight/core/error.h"
 #include "relight/render/dir/camera_albedo.h"
 #include "relight/render/dir/composite.h"
+#include "relight/render/dir/edge_coverage.h"
 #include "relight/render/reference/ray_tracer.h"
 #include "relight/render/scene/scene_lights.h"
 
@@ -41,14 +43,17 @@ MrCamera frame_camera(const FrameInfo& frame, int width, int height) {
 
 }  // namespace
 
-void add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* given_context, DirSceneContent content,
-                    const DirStageOptions& options) {
+CameraLookStage* add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* given_context,
+                                DirSceneContent content, const DirStageOptions& options) {
   vk::VulkanContext* context = context_for_backend(backend, given_context, "add_dir_stages");
   graph.emplace<MrSceneStage>(std::move(content), options);
   graph.emplace<VplStage>(options.vpls, context);
-  graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffers);
+  graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffers, options.edge_samples);
   graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
-  graph.emplace<DifferentialCompositeStage>(options.tone_map);
+  const bool camera_look = options.camera_look && options.camera_look->artefacts.any();
+  CameraLookStage* look = camera_look ? &graph.emplace<CameraLookStage>(*options.camera_look) : nullptr;
+  graph.emplace<DifferentialCompositeStage>(options.tone_map, camera_look);
+  return look;
 }
 
 // ---- mr_scene ----------------------------------------------------------------------------------
@@ -140,8 +145,8 @@ void VplStage::run(StageContext& context) {
 // ---- dir ---------------------------------------------------------------------------------------
 
 DirRenderStage::DirRenderStage(vk::VulkanContext* context, DirRenderOptions options,
-                               std::optional<RealAlbedoBuffers> albedo_buffers)
-    : context_(context), options_(options), albedo_buffers_(albedo_buffers) {}
+                               std::optional<RealAlbedoBuffers> albedo_buffers, int edge_samples)
+    : context_(context), options_(options), albedo_buffers_(albedo_buffers), edge_samples_(edge_samples) {}
 
 DirRenderStage::~DirRenderStage() = default;
 
@@ -188,6 +193,11 @@ void DirRenderStage::run(StageContext& context) {
         t.gbuffer_ms + t.shadow_maps_ms + t.ism_ms + (t.cpu_shading ? 0.0 : t.shading_ms + t.merge_ms);
     if (gpu_ms > 0.0) context.report_device_ms(gpu_ms);
   }
+  if (edge_samples_ > 0 && scene.triangle_count(false) > 0) {
+    const RayTracer virtual_tracer(virtual_part(scene), RayTracer::Build::Fast);
+    (void)refine_edge_coverage(images.virtual_coverage, gbuffer, positions, virtual_tracer, camera,
+                               {.samples = edge_samples_});
+  }
   if (albedo_buffers_) {
     modulate_camera_albedo(images, gbuffer, scene, context.get(albedo_), context.get(albedo_valid_));
   }
@@ -229,6 +239,8 @@ void DifferentialCompositeStage::declare(StageBuilder& builder) {
   real_virtual_ = builder.read(kRealVirtualRadiance);
   real_ = builder.read(kRealRadiance);
   coverage_ = builder.read(kVirtualCoverage);
+  gbuffer_ = builder.read(kDirGBuffer);
+  if (camera_look_) look_ = builder.read(colormap::kCameraLook);
   composite_ = builder.write(kComposite);
 }
 
@@ -240,7 +252,8 @@ void DifferentialCompositeStage::run(StageContext& context) {
                 std::to_string(color.height()) + ") and the rendered image (" + std::to_string(real_virtual.width()) +
                 "x" + std::to_string(real_virtual.height()) + ") differ in size");
   context.get(composite_) =
-      differential_composite(color, real_virtual, context.get(real_), context.get(coverage_), tone_map_);
+      differential_composite(color, real_virtual, context.get(real_), context.get(coverage_), tone_map_,
+                             camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface);
 }
 
 }  // namespace relight::render

@@ -13,13 +13,15 @@ void MappedCompositeStage::declare(StageBuilder& builder) {
   real_virtual_ = builder.read(kRealVirtualRadiance);
   coverage_ = builder.read(kVirtualCoverage);
   mapping_ = builder.read(colormap::kColorMapping);
+  gbuffer_ = builder.read(kDirGBuffer);
+  if (camera_look_) look_ = builder.read(colormap::kCameraLook);
   composite_ = builder.write(kCompositeMapped);
 }
 
 void MappedCompositeStage::run(StageContext& context) {
-  context.get(composite_) = mapped_differential_composite(context.get(camera_), context.get(delta_),
-                                                          context.get(real_virtual_), context.get(coverage_),
-                                                          context.get(mapping_));
+  context.get(composite_) = mapped_differential_composite(
+      context.get(camera_), context.get(delta_), context.get(real_virtual_), context.get(coverage_),
+      context.get(mapping_), camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface);
 }
 
 }  // namespace relight::render

@@ -23,6 +23,7 @@
 #include <string>
 
 #include "relight/core/camera.h"
+#include "relight/synth/camera_effects.h"
 #include "relight/synth/kinect_noise.h"
 #include "relight/synth/light_animation.h"
 #include "relight/synth/probe.h"
@@ -42,6 +43,7 @@ struct SynthOptions {
   NoiseModel noise = NoiseModel::Kinect1;
   KinectNoiseOptions kinect;  ///< used when noise == Kinect1
   ColorResponse color;        ///< white-balance gains and exposure of the colour camera
+  ColorCameraEffects camera;  ///< the colour camera's blur and noise (camera_effects.h)
   int width = 640;            ///< other sizes scale the Kinect v1 intrinsics
   int height = 480;
   int threads = 0;  ///< 0 = all hardware threads

@@ -1,6 +1,6 @@
 #pragma once
 // Differential instant radiosity (dir_vk.h) as frame-graph stages, one per step, so that the
-// graph times each step and keeps each step's output (add_dir_stages() adds all five):
+// graph times each step and keeps each step's output (add_dir_stages() adds all five, and camera_look when asked):
 //
 //   mr_scene                 reads  FrameInfo "frame" (camera_to_world: identity when absent),
 //                                   PositionMap "positions" and NormalMap "normals" (camera frame,
@@ -23,7 +23,8 @@
 //                                   set, its RadianceImage (per-pixel k_d, "kd") and Mask
 //                                   ("kd_valid", camera_albedo.h)
 //                            writes DifferentialImages "dir_images" (L_rv, L_r, coverage and
-//                                   their indirect parts, one shading pass) and GBuffer
+//                                   their indirect parts, one shading pass; the coverage
+//                                   fractional at outlines, edge_coverage.h) and GBuffer
 //                                   "dir_gbuffer"
 //   indirect_smoothing       reads  DifferentialImages "dir_images", GBuffer "dir_gbuffer",
 //                                   FrameInfo "frame"
@@ -34,7 +35,9 @@
 //                                   "indirect_history" (G-buffer, camera, indirect light), whose
 //                                   previous frame's version it reads; unchanged when off
 //   differential_composite   reads  ColorImage "color", RadianceImage "L_rv", "L_r",
-//                                   CoverageImage "virtual_coverage"
+//                                   CoverageImage "virtual_coverage", GBuffer "dir_gbuffer"
+//                                   (which pixel centres are virtual); with `camera_look` also
+//                                   colormap::CameraLook "camera_look" (camera_look_stage.h)
 //                            writes ColorImage "composite" (composite.h, eq. 5.1)
 //
 // With a Vulkan context `dir` renders with DirRendererVk (made on the first frame, remade when
@@ -60,6 +63,7 @@
 #include "relight/core/stage_backend.h"
 #include "relight/lights/light_set.h"
 #include "relight/render/buffers.h"
+#include "relight/render/dir/camera_look_stage.h"
 #include "relight/render/dir/dir_vk.h"
 #include "relight/render/dir/temporal_smoothing.h"
 #include "relight/render/scene/depth_mesh.h"
@@ -106,6 +110,12 @@ struct DirStageOptions {
   std::optional<RealAlbedoBuffers> albedo_buffers;
   bool temporal_smoothing = true;
   TemporalOptions temporal{};
+  /// Anti-aliased outlines (edge_coverage.h): edge_samples^2 sub-pixel rays per outline pixel
+  /// give its fractional virtual coverage; 0: the centre sample's 0 or 1.
+  int edge_samples = 4;
+  /// The camera's look on the virtual layer (camera_look_stage.h): with any artefact on, a
+  /// camera_look stage, and the composite reads it; none (or no artefact): the sharp render.
+  std::optional<CameraLookOptions> camera_look;
 };
 
 /// What the stages add to every frame's real geometry.
@@ -114,10 +124,11 @@ struct DirSceneContent {
   std::vector<std::pair<VirtualModel, Placement>> objects;
 };
 
-/// Adds the five stages above for `backend` (core/stage_backend.h: Backend::Cpu renders without a
-/// GPU, Backend::Vulkan needs `context`, which must outlive the graph).
-void add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* context, DirSceneContent content,
-                    const DirStageOptions& options = {});
+/// Adds the five stages above (and camera_look with DirStageOptions::camera_look) for `backend` (core/stage_backend.h:
+/// Backend::Cpu renders without a GPU, Backend::Vulkan needs `context`, which must outlive the graph). Returns the
+/// camera_look stage when it added one (for its summary), else nullptr.
+CameraLookStage* add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* context, DirSceneContent content,
+                                const DirStageOptions& options = {});
 
 /// Step 1 (scene): the mixed-reality scene of the frame.
 class MrSceneStage final : public Stage {
@@ -172,8 +183,9 @@ class VplStage final : public Stage {
 class DirRenderStage final : public Stage {
  public:
   /// `albedo_buffers`: DirStageOptions::albedo_buffers.
+  /// `edge_samples`: DirStageOptions::edge_samples.
   DirRenderStage(vk::VulkanContext* context, DirRenderOptions options,
-                 std::optional<RealAlbedoBuffers> albedo_buffers = std::nullopt);
+                 std::optional<RealAlbedoBuffers> albedo_buffers = std::nullopt, int edge_samples = 0);
   ~DirRenderStage() override;
   [[nodiscard]] std::string name() const override { return "dir"; }
   /// Vulkan with a context (rasterisation on the GPU, shading where DirBackend says); its
@@ -186,6 +198,7 @@ class DirRenderStage final : public Stage {
   vk::VulkanContext* context_;
   DirRenderOptions options_;
   std::optional<RealAlbedoBuffers> albedo_buffers_;
+  int edge_samples_;
   std::unique_ptr<DirRendererVk> renderer_;
   std::pair<int, int> renderer_size_{0, 0};
   Read<FrameInfo> frame_;
@@ -224,17 +237,22 @@ class IndirectSmoothingStage final : public Stage {
 /// Step 7 (tone mapping and differential composite).
 class DifferentialCompositeStage final : public Stage {
  public:
-  explicit DifferentialCompositeStage(colormap::ToneMap tone_map) : tone_map_(tone_map) {}
+  /// With `camera_look`, also reads colormap::CameraLook "camera_look" (camera_look_stage.h).
+  explicit DifferentialCompositeStage(colormap::ToneMap tone_map, bool camera_look = false)
+      : tone_map_(tone_map), camera_look_(camera_look) {}
   [[nodiscard]] std::string name() const override { return "differential_composite"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
  private:
   colormap::ToneMap tone_map_;
+  bool camera_look_;
   Read<ColorImage> color_;
   Read<RadianceImage> real_virtual_;
   Read<RadianceImage> real_;
   Read<CoverageImage> coverage_;
+  Read<GBuffer> gbuffer_;
+  Read<colormap::CameraLook> look_;
   Write<ColorImage> composite_;
 };
 

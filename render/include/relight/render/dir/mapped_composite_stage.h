@@ -3,18 +3,22 @@
 // mapped_differential_composite): the picture of `relight replay --colormap sample|stats`.
 // Reads:  ColorImage "color" (camera), RadianceImage "delta_L" and ColorMapping "color_mapping"
 //         (a colour-mapping stage, colormap_stages.h), RadianceImage "L_rv" and CoverageImage
-//         "virtual_coverage" (the DIR stage, dir_stage.h).
+//         "virtual_coverage" and GBuffer "dir_gbuffer" (the DIR stage, dir_stage.h); with `camera_look`, CameraLook
+//         "camera_look" (camera_look_stage.h), whose artefacts go on the virtual layer.
 // Writes: ColorImage "composite_mapped".
 #include <string>
 
+#include "relight/colormap/camera_look.h"
 #include "relight/colormap/color_mapping.h"
 #include "relight/core/frame_graph.h"
 #include "relight/render/differential_images.h"
+#include "relight/render/dir/gbuffer.h"
 
 namespace relight::render {
 
 class MappedCompositeStage final : public Stage {
  public:
+  explicit MappedCompositeStage(bool camera_look = false) : camera_look_(camera_look) {}
   [[nodiscard]] std::string name() const override { return "mapped_composite"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
@@ -23,7 +27,10 @@ class MappedCompositeStage final : public Stage {
   Read<ColorImage> camera_;
   Read<RadianceImage> delta_, real_virtual_;
   Read<CoverageImage> coverage_;
+  Read<GBuffer> gbuffer_;
   Read<colormap::ColorMapping> mapping_;
+  bool camera_look_;
+  Read<colormap::CameraLook> look_;
   Write<ColorImage> composite_;
 };
 

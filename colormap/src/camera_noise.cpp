@@ -1,0 +1,105 @@
+#include "relight/colormap/camera_noise.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace relight::colormap {
+
+namespace {
+
+constexpr float kBandWidth = 256.f / kNoiseBands;
+/// median |x| of a unit Gaussian, and the operator's response sigma per unit of noise sigma
+constexpr float kMedianAbsGaussian = 0.6745f;
+constexpr float kOperatorGain = 6.f;
+
+float channel(const Rgb8& p, int c) { return static_cast<float>(c == 0 ? p.r : c == 1 ? p.g : p.b); }
+float luma(const Rgb8& p) { return 0.299f * p.r + 0.587f * p.g + 0.114f * p.b; }
+
+}  // namespace
+
+bool NoiseProfile::valid() const {
+  return std::any_of(samples.begin(), samples.end(), [](int n) { return n > 0; });
+}
+
+float NoiseProfile::at(float code, int channel_index) const {
+  const float position = std::clamp(code / kBandWidth - 0.5f, 0.f, float(kNoiseBands - 1));
+  const int low = std::min(static_cast<int>(position), kNoiseBands - 2);
+  const float t = position - static_cast<float>(low);
+  const auto c = static_cast<std::size_t>(channel_index);
+  return (1.f - t) * sigma[static_cast<std::size_t>(low)][c] + t * sigma[static_cast<std::size_t>(low + 1)][c];
+}
+
+NoiseProfile estimate_camera_noise(const ColorImage& image, const NoiseEstimationOptions& options) {
+  NoiseProfile profile;
+  const int width = image.width(), height = image.height();
+  if (width < 5 || height < 5) return profile;
+  // Per band and channel, the operator's |response| at flat pixels.
+  // The luma's 3x3 means give each pixel's level and, by their Sobel gradient, its flatness.
+  Image<float> means(width, height);
+  {
+    Image<float> rows(width, height);
+    for (int r = 0; r < height; ++r)
+      for (int c = 1; c < width - 1; ++c)
+        rows(r, c) = luma(image(r, c - 1)) + luma(image(r, c)) + luma(image(r, c + 1));
+    for (int r = 1; r < height - 1; ++r)
+      for (int c = 1; c < width - 1; ++c) means(r, c) = (rows(r - 1, c) + rows(r, c) + rows(r + 1, c)) / 9.f;
+  }
+  // Per band and channel, the operator's |response| at flat pixels.
+  std::array<std::array<std::vector<float>, 3>, kNoiseBands> responses;
+  const int stride = std::max(1, options.stride);
+  const float flat = static_cast<float>(options.flat_gradient);
+  for (int r = 2; r < height - 2; r += stride) {
+    for (int c = 2; c < width - 2; c += stride) {
+      const auto m = [&](int i, int j) { return means(r + i, c + j); };
+      const float gx = (m(-1, 1) + 2 * m(0, 1) + m(1, 1)) - (m(-1, -1) + 2 * m(0, -1) + m(1, -1));
+      const float gy = (m(1, -1) + 2 * m(1, 0) + m(1, 1)) - (m(-1, -1) + 2 * m(-1, 0) + m(-1, 1));
+      if (std::hypot(gx, gy) / 8.f > flat) continue;
+      bool clipped = false;
+      for (int i = -1; i <= 1 && !clipped; ++i) {
+        for (int j = -1; j <= 1; ++j) {
+          const Rgb8 p = image(r + i, c + j);
+          clipped = clipped || std::max({p.r, p.g, p.b}) == 255 || std::min({p.r, p.g, p.b}) == 0;
+        }
+      }
+      if (clipped) continue;
+      const int band = std::min(kNoiseBands - 1, static_cast<int>(m(0, 0) / kBandWidth));
+      for (int ch = 0; ch < 3; ++ch) {
+        const auto v = [&](int i, int j) { return channel(image(r + i, c + j), ch); };
+        const float response = v(-1, -1) - 2 * v(-1, 0) + v(-1, 1) - 2 * v(0, -1) + 4 * v(0, 0) - 2 * v(0, 1) +
+                               v(1, -1) - 2 * v(1, 0) + v(1, 1);
+        responses[static_cast<std::size_t>(band)][static_cast<std::size_t>(ch)].push_back(std::abs(response));
+      }
+    }
+  }
+  std::vector<int> measured;
+  for (int band = 0; band < kNoiseBands; ++band) {
+    auto& per_channel = responses[static_cast<std::size_t>(band)];
+    const int n = static_cast<int>(per_channel[0].size());
+    if (n < options.min_samples) continue;
+    profile.samples[static_cast<std::size_t>(band)] = n;
+    measured.push_back(band);
+    for (int ch = 0; ch < 3; ++ch) {
+      auto& values = per_channel[static_cast<std::size_t>(ch)];
+      const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+      std::nth_element(values.begin(), middle, values.end());
+      profile.sigma[static_cast<std::size_t>(band)][static_cast<std::size_t>(ch)] =
+          *middle / (kOperatorGain * kMedianAbsGaussian);
+    }
+  }
+  if (measured.empty()) return profile;
+  // Unmeasured bands: linear between the nearest measured ones, constant beyond them.
+  for (int band = 0; band < kNoiseBands; ++band) {
+    if (profile.samples[static_cast<std::size_t>(band)] > 0) continue;
+    const auto above = std::lower_bound(measured.begin(), measured.end(), band);
+    const int hi = above == measured.end() ? measured.back() : *above;
+    const int lo = above == measured.begin() ? measured.front() : *(above - 1);
+    const float t = hi == lo ? 0.f : float(band - lo) / float(hi - lo);
+    for (std::size_t ch = 0; ch < 3; ++ch)
+      profile.sigma[static_cast<std::size_t>(band)][ch] = (1.f - t) * profile.sigma[static_cast<std::size_t>(lo)][ch] +
+                                                          t * profile.sigma[static_cast<std::size_t>(hi)][ch];
+  }
+  return profile;
+}
+
+}  // namespace relight::colormap

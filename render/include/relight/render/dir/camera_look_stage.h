@@ -1,0 +1,73 @@
+#pragma once
+// Frame-graph stage that measures the camera's look every frame, for the composites to put on
+// the virtual layer (colormap/camera_look.h; dissertation §6.4, Klein & Murray 2010).
+// Reads:  ColorImage "color" (the camera image), FrameInfo "frame" and its previous frame's
+//         version (poses, timestamps), GBuffer "dir_gbuffer" (what each pixel sees, world frame),
+//         the previous frame's CameraLook "camera_look" (temporal smoothing).
+// Writes: CameraLook "camera_look":
+//   - blur: the camera's point spread (camera_blur.h; edges along the image motion only, so motion
+//     blur is not taken for defocus), smoothed over frames; the virtual layer gets the Gaussian of
+//     sqrt(sigma_camera^2 - sigma_render^2), the render's own pixel footprint taken out;
+//   - motion: each pixel's image motion between the previous pose and this one, scaled to the
+//     exposure time (exposure / frame interval, at most 1): the point the pixel sees is projected
+//     into both cameras. None on the first frame, without poses, or across a gap of frames;
+//   - noise: the camera's noise profile (camera_noise.h), smoothed over frames; the frame index
+//     seeds the virtual layer's noise.
+#include <string>
+
+#include "relight/colormap/camera_look.h"
+#include "relight/core/frame_graph.h"
+#include "relight/core/rgbd_frame.h"
+#include "relight/render/dir/gbuffer.h"
+
+namespace relight::render {
+
+struct CameraLookOptions {
+  colormap::CameraArtefacts artefacts;
+  double exposure_time_s = 1.0 / 30.0;  ///< the camera's exposure: how much of the motion one frame integrates
+  double smoothing = 0.25;              ///< weight of this frame's estimates in the running ones
+  /// Variance (px^2) of the render's own point spread: DIR point-samples each pixel's centre.
+  double render_variance_px2 = 0.0;
+  colormap::BlurEstimationOptions blur;
+  colormap::NoiseEstimationOptions noise;
+};
+
+/// The image motion over the exposure for every cell of `cell` pixels: the G-buffer's world point
+/// of the cell's centre (the median depth of the seen cells where it sees nothing) projected by
+/// both poses. Empty when either pose is missing or the timestamps do not give an interval of
+/// (0, 0.25] s.
+[[nodiscard]] colormap::MotionField image_motion(const GBuffer& gbuffer, const FrameInfo& frame,
+                                                 const FrameInfo& previous, double exposure_time_s, int cell = 8);
+
+/// What the stage measured over a run (report.json's "camera_look").
+struct CameraLookSummary {
+  colormap::CameraArtefacts artefacts;
+  int frames = 0;
+  double blur_sigma_px = 0.0;     ///< the camera's, last frame (smoothed)
+  double applied_sigma_px = 0.0;  ///< the Gaussian the layer got, last frame
+  int blur_edges = 0;             ///< edges of the last frame's estimate
+  int frames_with_motion = 0;     ///< frames with a motion field
+  double max_motion_px = 0.0;     ///< the longest image motion over an exposure
+  colormap::NoiseProfile noise;   ///< last frame's (smoothed)
+};
+
+class CameraLookStage final : public Stage {
+ public:
+  explicit CameraLookStage(CameraLookOptions options) : options_(options) { summary_.artefacts = options.artefacts; }
+  [[nodiscard]] std::string name() const override { return "camera_look"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+  [[nodiscard]] const CameraLookSummary& summary() const { return summary_; }
+
+ private:
+  CameraLookOptions options_;
+  CameraLookSummary summary_;
+  Read<ColorImage> color_;
+  Read<FrameInfo> frame_;
+  ReadPrevious<FrameInfo> previous_frame_;
+  Read<GBuffer> gbuffer_;
+  ReadPrevious<colormap::CameraLook> previous_look_;
+  Write<colormap::CameraLook> look_;
+};
+
+}  // namespace relight::render
