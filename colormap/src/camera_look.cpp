@@ -8,115 +8,162 @@
 
 #include "relight/colormap/color_space.h"
 #include "relight/core/error.h"
+#include "relight/core/gaussian_blur.h"
 #include "relight/core/parallel.h"
 
 namespace relight::colormap {
 
 namespace {
 
-/// Linear display values below this change no 8-bit sRGB code (the steepest part of the curve,
-/// near black, needs ~0.0003 per code).
-constexpr float kNegligible = 1e-4f;
+constexpr int kTile = 16;  // pixels per side of the blur's work tiles
+/// Linear display values: a tile whose differential varies by less than this (and which the
+/// virtual object does not cover) is smooth, and blurring it would change no 8-bit code by more
+/// than a fraction: it is left as it is (the indirect light a virtual object adds everywhere).
+constexpr float kSmoothRange = 2e-3f;
 
-struct Box {
-  int row0 = 0, row1 = 0, col0 = 0, col1 = 0;  // half-open
-  [[nodiscard]] bool empty() const { return row0 >= row1 || col0 >= col1; }
-};
-
-bool touched(const VirtualLayer& layer, std::size_t i) {
-  const Float3& d = layer.delta.pixels()[i];
-  return layer.coverage.pixels()[i] > 0.f || std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}) > kNegligible;
-}
-
-/// The pixels the layer touches, grown by `reach` and clipped to the image.
-Box touched_box(const VirtualLayer& layer, int reach) {
+/// Tiles of the layer whose blur matters: covered by the virtual object, or with a differential
+/// that changes within them (a shadow's edge), grown by `reach` pixels. Indexed row-major.
+std::vector<std::uint8_t> active_tiles(const VirtualLayer& layer, int reach, int columns, int rows) {
   const int width = layer.coverage.width(), height = layer.coverage.height();
-  Box box{height, 0, width, 0};
-  for (int r = 0; r < height; ++r) {
-    for (int c = 0; c < width; ++c) {
-      if (!touched(layer, static_cast<std::size_t>(r) * static_cast<std::size_t>(width) + static_cast<std::size_t>(c)))
-        continue;
-      box.row0 = std::min(box.row0, r);
-      box.row1 = std::max(box.row1, r + 1);
-      box.col0 = std::min(box.col0, c);
-      box.col1 = std::max(box.col1, c + 1);
+  std::vector<std::uint8_t> active(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows), 0);
+  for (int ty = 0; ty < rows; ++ty)
+    for (int tx = 0; tx < columns; ++tx) {
+      bool covered = false;
+      Float3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
+      for (int r = ty * kTile; r < std::min(height, (ty + 1) * kTile) && !covered; ++r)
+        for (int c = tx * kTile; c < std::min(width, (tx + 1) * kTile); ++c) {
+          if (layer.coverage(r, c) > 0.f) {
+            covered = true;
+            break;
+          }
+          const Float3& d = layer.delta(r, c);
+          lo = {std::min(lo.x, d.x), std::min(lo.y, d.y), std::min(lo.z, d.z)};
+          hi = {std::max(hi.x, d.x), std::max(hi.y, d.y), std::max(hi.z, d.z)};
+        }
+      const Float3 range = hi - lo;
+      if (covered || std::max({range.x, range.y, range.z}) > kSmoothRange)
+        active[static_cast<std::size_t>(ty) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(tx)] = 1;
     }
-  }
-  if (box.empty()) return box;
-  return {std::max(0, box.row0 - reach), std::min(height, box.row1 + reach), std::max(0, box.col0 - reach),
-          std::min(width, box.col1 + reach)};
-}
-
-std::vector<float> gaussian_weights(float sigma) {
-  const int radius = static_cast<int>(std::ceil(3.f * sigma));
-  std::vector<float> weights(static_cast<std::size_t>(2 * radius + 1));
-  float sum = 0.f;
-  for (int i = -radius; i <= radius; ++i) {
-    const float w = std::exp(-0.5f * float(i * i) / (sigma * sigma));
-    weights[static_cast<std::size_t>(i + radius)] = w;
-    sum += w;
-  }
-  for (float& w : weights) w /= sum;
-  return weights;
-}
-
-/// Separable Gaussian over `box` (reads beyond the box within the image, clamped at its edges).
-template <class T>
-void gaussian(Image<T>& image, const Box& box, const std::vector<float>& weights, int threads) {
-  const int radius = static_cast<int>(weights.size() / 2);
-  const int width = image.width(), height = image.height();
-  const int rows0 = std::max(0, box.row0 - radius), rows1 = std::min(height, box.row1 + radius);
-  Image<T> horizontal(box.col1 - box.col0, rows1 - rows0);
-  parallel_for_each_row(rows1 - rows0, threads, [&](int r) {
-    for (int c = box.col0; c < box.col1; ++c) {
-      T sum{};
-      for (int k = -radius; k <= radius; ++k)
-        sum = sum + weights[static_cast<std::size_t>(k + radius)] * image(rows0 + r, std::clamp(c + k, 0, width - 1));
-      horizontal(r, c - box.col0) = sum;
+  const int grow = (reach + kTile - 1) / kTile;
+  std::vector<std::uint8_t> grown(active.size(), 0);
+  for (int ty = 0; ty < rows; ++ty)
+    for (int tx = 0; tx < columns; ++tx) {
+      bool any = false;
+      for (int y = std::max(0, ty - grow); y <= std::min(rows - 1, ty + grow) && !any; ++y)
+        for (int x = std::max(0, tx - grow); x <= std::min(columns - 1, tx + grow); ++x)
+          any = any ||
+                active[static_cast<std::size_t>(y) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(x)];
+      grown[static_cast<std::size_t>(ty) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(tx)] = any;
     }
-  });
-  parallel_for_each_row(box.row1 - box.row0, threads, [&](int r) {
-    const int row = box.row0 + r;
-    for (int c = box.col0; c < box.col1; ++c) {
-      T sum{};
-      for (int k = -radius; k <= radius; ++k)
-        sum = sum + weights[static_cast<std::size_t>(k + radius)] *
-                        horizontal(std::clamp(row + k, rows0, rows1 - 1) - rows0, c - box.col0);
-      image(row, c) = sum;
-    }
-  });
+  return grown;
 }
 
 template <class T>
 T bilinear(const Image<T>& image, float row, float col) {
   const float r = std::clamp(row, 0.f, float(image.height() - 1)), c = std::clamp(col, 0.f, float(image.width() - 1));
-  const int r0 = std::min(static_cast<int>(r), image.height() - 2 < 0 ? 0 : image.height() - 2);
-  const int c0 = std::min(static_cast<int>(c), image.width() - 2 < 0 ? 0 : image.width() - 2);
+  const int r0 = std::min(static_cast<int>(r), std::max(0, image.height() - 2));
+  const int c0 = std::min(static_cast<int>(c), std::max(0, image.width() - 2));
   const int r1 = std::min(r0 + 1, image.height() - 1), c1 = std::min(c0 + 1, image.width() - 1);
   const float fr = r - float(r0), fc = c - float(c0);
   return (1.f - fr) * ((1.f - fc) * image(r0, c0) + fc * image(r0, c1)) +
          fr * ((1.f - fc) * image(r1, c0) + fc * image(r1, c1));
 }
 
-/// Box filter along each pixel's motion, centred on the pixel (the render is of the frame's pose,
-/// the middle of the exposure as far as the pose says).
+/// One tile's share of a filter: `filter(row, col)` of every pixel of the tile, computed from
+/// the unchanged image and written back once every tile is done.
+struct TileBox {
+  int row0, row1, col0, col1;
+};
+
+/// The separable Gaussian of `weights` over the tile (borders clamp to the image's edge).
 template <class T>
-void motion_blur(Image<T>& image, const Box& box, const MotionField& motion, int threads) {
-  const Image<T> source = image;
-  parallel_for_each_row(box.row1 - box.row0, threads, [&](int r) {
-    const int row = box.row0 + r;
-    for (int c = box.col0; c < box.col1; ++c) {
-      const Float3 m = motion.at(float(row), float(c));
-      const int samples = std::max(1, static_cast<int>(std::ceil(std::hypot(m.x, m.y))) + 1);
-      if (samples == 1) continue;
+std::vector<T> gaussian_tile(const Image<T>& image, const TileBox& box, const std::vector<float>& weights) {
+  const int radius = static_cast<int>(weights.size() / 2);
+  const int width = image.width(), height = image.height();
+  const int tile_width = box.col1 - box.col0, rows0 = box.row0 - radius, tall = box.row1 - box.row0 + 2 * radius;
+  std::vector<T> horizontal(static_cast<std::size_t>(tall) * static_cast<std::size_t>(tile_width));
+  for (int i = 0; i < tall; ++i) {
+    const int row = std::clamp(rows0 + i, 0, height - 1);
+    for (int j = 0; j < tile_width; ++j) {
+      T sum{};
+      for (std::size_t k = 0; k < weights.size(); ++k)
+        sum = sum + weights[k] * image(row, std::clamp(box.col0 + j + static_cast<int>(k) - radius, 0, width - 1));
+      horizontal[static_cast<std::size_t>(i) * static_cast<std::size_t>(tile_width) + static_cast<std::size_t>(j)] =
+          sum;
+    }
+  }
+  std::vector<T> out(static_cast<std::size_t>(box.row1 - box.row0) * static_cast<std::size_t>(tile_width));
+  for (int i = 0; i < box.row1 - box.row0; ++i)
+    for (int j = 0; j < tile_width; ++j) {
+      T sum{};
+      for (std::size_t k = 0; k < weights.size(); ++k)
+        sum = sum + weights[k] * horizontal[(static_cast<std::size_t>(i) + k) * static_cast<std::size_t>(tile_width) +
+                                            static_cast<std::size_t>(j)];
+      out[static_cast<std::size_t>(i) * static_cast<std::size_t>(tile_width) + static_cast<std::size_t>(j)] = sum;
+    }
+  return out;
+}
+
+/// A box filter along each pixel's motion, centred on the pixel (the render is of the frame's
+/// pose, the middle of the exposure as far as the pose says).
+template <class T>
+std::vector<T> motion_tile(const Image<T>& image, const TileBox& box, const MotionField& motion) {
+  std::vector<T> out;
+  out.reserve(static_cast<std::size_t>(box.row1 - box.row0) * static_cast<std::size_t>(box.col1 - box.col0));
+  for (int row = box.row0; row < box.row1; ++row)
+    for (int col = box.col0; col < box.col1; ++col) {
+      const Float3 m = motion.at(float(row), float(col));
+      const int samples = std::max(1, static_cast<int>(std::ceil(std::sqrt(m.x * m.x + m.y * m.y))) + 1);
+      if (samples == 1) {
+        out.push_back(image(row, col));
+        continue;
+      }
       T sum{};
       for (int k = 0; k < samples; ++k) {
         const float t = (float(k) + 0.5f) / float(samples) - 0.5f;
-        sum = sum + bilinear(source, float(row) + t * m.y, float(c) + t * m.x);
+        sum = sum + bilinear(image, float(row) + t * m.y, float(col) + t * m.x);
       }
-      image(row, c) = (1.f / float(samples)) * sum;
+      out.push_back((1.f / float(samples)) * sum);
     }
-  });
+  return out;
+}
+
+/// Applies `filter(image, box)` to the three parts of the layer over the active tiles: every
+/// tile reads the unchanged layer, then all are written back.
+template <class Filter>
+void filter_active_tiles(VirtualLayer& layer, const std::vector<std::uint8_t>& active, int columns, int threads,
+                         const Filter& filter) {
+  const int width = layer.coverage.width(), height = layer.coverage.height();
+  std::vector<TileBox> boxes;
+  for (std::size_t t = 0; t < active.size(); ++t) {
+    if (!active[t]) continue;
+    const int ty = static_cast<int>(t) / columns, tx = static_cast<int>(t) % columns;
+    boxes.push_back({ty * kTile, std::min(height, (ty + 1) * kTile), tx * kTile, std::min(width, (tx + 1) * kTile)});
+  }
+  struct Result {
+    std::vector<Float3> colour;
+    std::vector<float> coverage;
+    std::vector<Float3> delta;
+  };
+  std::vector<Result> results(boxes.size());
+  parallel_for_each_row(
+      static_cast<int>(boxes.size()), threads,
+      [&](int b) {
+        const TileBox& box = boxes[static_cast<std::size_t>(b)];
+        results[static_cast<std::size_t>(b)] = {filter(layer.virtual_color, box), filter(layer.coverage, box),
+                                                filter(layer.delta, box)};
+      },
+      1);
+  for (std::size_t b = 0; b < boxes.size(); ++b) {
+    const TileBox& box = boxes[b];
+    std::size_t i = 0;
+    for (int row = box.row0; row < box.row1; ++row)
+      for (int col = box.col0; col < box.col1; ++col, ++i) {
+        layer.virtual_color(row, col) = results[b].colour[i];
+        layer.coverage(row, col) = results[b].coverage[i];
+        layer.delta(row, col) = results[b].delta[i];
+      }
+  }
 }
 
 std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
@@ -126,14 +173,45 @@ std::uint64_t mix(std::uint64_t x) {  // splitmix64's finaliser
   return x ^ (x >> 31);
 }
 
-/// Three unit Gaussians for one pixel of one frame (Box-Muller on hashed uniforms: the same for
-/// any thread count).
+constexpr std::size_t kQuantiles = 4096;
+
+/// Phi^-1((k + 0.5) / kQuantiles): a unit Gaussian from 12 random bits (bisection on erfc, once).
+const std::array<float, kQuantiles>& gaussian_quantiles() {
+  static const std::array<float, kQuantiles> table = [] {
+    std::array<float, kQuantiles> out{};
+    for (std::size_t k = 0; k < kQuantiles; ++k) {
+      const double p = (static_cast<double>(k) + 0.5) / static_cast<double>(kQuantiles);
+      double lo = -8.0, hi = 8.0;
+      for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (0.5 * std::erfc(-mid / std::numbers::sqrt2) < p ? lo : hi) = mid;
+      }
+      out[k] = static_cast<float>(0.5 * (lo + hi));
+    }
+    return out;
+  }();
+  return table;
+}
+
+/// Three unit Gaussians for one pixel of one frame (hashed, so the same for any thread count).
 std::array<float, 3> gaussians(std::uint64_t seed, std::size_t pixel) {
-  const auto uniform = [](std::uint64_t bits) { return (static_cast<double>(bits >> 11) + 0.5) * 0x1.0p-53; };
-  const std::uint64_t a = mix(seed ^ mix(2 * pixel)), b = mix(seed ^ mix(2 * pixel + 1));
-  const double radius1 = std::sqrt(-2.0 * std::log(uniform(a))), angle1 = 2.0 * std::numbers::pi * uniform(mix(a));
-  const double radius2 = std::sqrt(-2.0 * std::log(uniform(b))), angle2 = 2.0 * std::numbers::pi * uniform(mix(b));
-  return {float(radius1 * std::cos(angle1)), float(radius1 * std::sin(angle1)), float(radius2 * std::cos(angle2))};
+  const std::array<float, kQuantiles>& q = gaussian_quantiles();
+  const std::uint64_t bits = mix(seed ^ mix(pixel));
+  return {q[bits & (kQuantiles - 1)], q[(bits >> 16) & (kQuantiles - 1)], q[(bits >> 32) & (kQuantiles - 1)]};
+}
+
+/// 255 linear_to_srgb(c) for c in [0, 1], linear between 4096 table points (the noise's
+/// intensity and code: a hundredth of a code off at most).
+float srgb_code(float linear) {
+  static const std::array<float, 4097> table = [] {
+    std::array<float, 4097> out{};
+    for (std::size_t i = 0; i < out.size(); ++i) out[i] = 255.f * linear_to_srgb(float(i) / 4096.f);
+    return out;
+  }();
+  const float x = std::clamp(linear, 0.f, 1.f) * 4096.f;
+  const auto i = std::min<std::size_t>(static_cast<std::size_t>(x), 4095);
+  const float t = x - static_cast<float>(i);
+  return table[i] + t * (table[i + 1] - table[i]);
 }
 
 }  // namespace
@@ -153,8 +231,11 @@ CameraArtefacts parse_camera_artefacts(const std::string& text) {
     else if (item == "noise")
       out.noise = true;
     else
-      throw Error("camera artefacts: unknown '" + item + "' in '" + text +
-                  "' (choices: all, none, or a comma-separated list of blur, motion, noise)");
+      throw Error(std::string("camera artefacts: unknown '")
+                      .append(item)
+                      .append("' in '")
+                      .append(text)
+                      .append("' (choices: all, none, or a comma-separated list of blur, motion, noise)"));
     any = true;
   }
   if (!any) throw Error("camera artefacts: empty list (choices: all, none, or blur,motion,noise)");
@@ -167,7 +248,10 @@ std::string to_string(const CameraArtefacts& artefacts) {
   std::string out;
   for (const auto& [on, name] :
        {std::pair{artefacts.blur, "blur"}, {artefacts.motion, "motion"}, {artefacts.noise, "noise"}})
-    if (on) out += (out.empty() ? "" : ",") + std::string(name);
+    if (on) {
+      if (!out.empty()) out += ',';
+      out += name;
+    }
   return out;
 }
 
@@ -189,18 +273,17 @@ void blur_layer(VirtualLayer& layer, float sigma_px, const MotionField* motion, 
   if (!defocus && !moving) return;
   const int reach = (defocus ? static_cast<int>(std::ceil(3.f * sigma_px)) : 0) +
                     (moving ? static_cast<int>(std::ceil(0.5f * motion->max_length())) : 0) + 1;
-  const Box box = touched_box(layer, reach);
-  if (box.empty()) return;
+  const int columns = (layer.coverage.width() + kTile - 1) / kTile,
+            rows = (layer.coverage.height() + kTile - 1) / kTile;
+  const std::vector<std::uint8_t> active = active_tiles(layer, reach, columns, rows);
   if (defocus) {
-    const std::vector<float> weights = gaussian_weights(sigma_px);
-    gaussian(layer.virtual_color, box, weights, threads);
-    gaussian(layer.coverage, box, weights, threads);
-    gaussian(layer.delta, box, weights, threads);
+    const std::vector<float> weights = gaussian_kernel(sigma_px);
+    filter_active_tiles(layer, active, columns, threads,
+                        [&](const auto& image, const TileBox& box) { return gaussian_tile(image, box, weights); });
   }
   if (moving) {
-    motion_blur(layer.virtual_color, box, *motion, threads);
-    motion_blur(layer.coverage, box, *motion, threads);
-    motion_blur(layer.delta, box, *motion, threads);
+    filter_active_tiles(layer, active, columns, threads,
+                        [&](const auto& image, const TileBox& box) { return motion_tile(image, box, *motion); });
   }
 }
 
@@ -230,9 +313,7 @@ ColorImage composite_layer(const ColorImage& camera, VirtualLayer layer, const C
         out.pixels()[i] = encode_srgb8(linear);
         continue;
       }
-      const float codes[3] = {255.f * linear_to_srgb(std::clamp(linear.x, 0.f, 1.f)),
-                              255.f * linear_to_srgb(std::clamp(linear.y, 0.f, 1.f)),
-                              255.f * linear_to_srgb(std::clamp(linear.z, 0.f, 1.f))};
+      const float codes[3] = {srgb_code(linear.x), srgb_code(linear.y), srgb_code(linear.z)};
       const float luma = 0.299f * codes[0] + 0.587f * codes[1] + 0.114f * codes[2];
       const float share = std::sqrt(std::max(0.f, 1.f - (1.f - c) * (1.f - c)));
       const std::array<float, 3> g = gaussians(look->seed, i);

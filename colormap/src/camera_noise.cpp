@@ -27,7 +27,7 @@ float NoiseProfile::at(float code, int channel_index) const {
   const int low = std::min(static_cast<int>(position), kNoiseBands - 2);
   const float t = position - static_cast<float>(low);
   const auto c = static_cast<std::size_t>(channel_index);
-  return (1.f - t) * sigma[static_cast<std::size_t>(low)][c] + t * sigma[static_cast<std::size_t>(low + 1)][c];
+  return (1.f - t) * sigma[static_cast<std::size_t>(low)][c] + t * sigma[static_cast<std::size_t>(low) + 1][c];
 }
 
 NoiseProfile estimate_camera_noise(const ColorImage& image, const NoiseEstimationOptions& options) {
@@ -35,35 +35,36 @@ NoiseProfile estimate_camera_noise(const ColorImage& image, const NoiseEstimatio
   const int width = image.width(), height = image.height();
   if (width < 5 || height < 5) return profile;
   // Per band and channel, the operator's |response| at flat pixels.
-  // The luma's 3x3 means give each pixel's level and, by their Sobel gradient, its flatness.
-  Image<float> means(width, height);
-  {
-    Image<float> rows(width, height);
-    for (int r = 0; r < height; ++r)
-      for (int c = 1; c < width - 1; ++c)
-        rows(r, c) = luma(image(r, c - 1)) + luma(image(r, c)) + luma(image(r, c + 1));
-    for (int r = 1; r < height - 1; ++r)
-      for (int c = 1; c < width - 1; ++c) means(r, c) = (rows(r - 1, c) + rows(r, c) + rows(r + 1, c)) / 9.f;
-  }
   // Per band and channel, the operator's |response| at flat pixels.
   std::array<std::array<std::vector<float>, 3>, kNoiseBands> responses;
   const int stride = std::max(1, options.stride);
   const float flat = static_cast<float>(options.flat_gradient);
   for (int r = 2; r < height - 2; r += stride) {
     for (int c = 2; c < width - 2; c += stride) {
-      const auto m = [&](int i, int j) { return means(r + i, c + j); };
-      const float gx = (m(-1, 1) + 2 * m(0, 1) + m(1, 1)) - (m(-1, -1) + 2 * m(0, -1) + m(1, -1));
-      const float gy = (m(1, -1) + 2 * m(1, 0) + m(1, 1)) - (m(-1, -1) + 2 * m(-1, 0) + m(-1, 1));
-      if (std::hypot(gx, gy) / 8.f > flat) continue;
+      // The 3x3 means of the luma around (r, c) give the local level and, by their Sobel
+      // gradient, the flatness.
+      std::array<std::array<float, 5>, 5> l{};
       bool clipped = false;
-      for (int i = -1; i <= 1 && !clipped; ++i) {
-        for (int j = -1; j <= 1; ++j) {
-          const Rgb8 p = image(r + i, c + j);
-          clipped = clipped || std::max({p.r, p.g, p.b}) == 255 || std::min({p.r, p.g, p.b}) == 0;
+      for (std::size_t i = 0; i < 5; ++i)
+        for (std::size_t j = 0; j < 5; ++j) {
+          const Rgb8 p = image(r + static_cast<int>(i) - 2, c + static_cast<int>(j) - 2);
+          l[i][j] = luma(p);
+          const bool inner = i >= 1 && i <= 3 && j >= 1 && j <= 3;
+          clipped = clipped || (inner && (std::max({p.r, p.g, p.b}) == 255 || std::min({p.r, p.g, p.b}) == 0));
         }
-      }
       if (clipped) continue;
-      const int band = std::min(kNoiseBands - 1, static_cast<int>(m(0, 0) / kBandWidth));
+      std::array<std::array<float, 3>, 3> m{};
+      for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) {
+          float sum = 0.f;
+          for (std::size_t a = 0; a < 3; ++a)
+            for (std::size_t b = 0; b < 3; ++b) sum += l[i + a][j + b];
+          m[i][j] = sum / 9.f;
+        }
+      const float gx = (m[0][2] + 2 * m[1][2] + m[2][2]) - (m[0][0] + 2 * m[1][0] + m[2][0]);
+      const float gy = (m[2][0] + 2 * m[2][1] + m[2][2]) - (m[0][0] + 2 * m[0][1] + m[0][2]);
+      if (gx * gx + gy * gy > 64.f * flat * flat) continue;
+      const int band = std::min(kNoiseBands - 1, static_cast<int>(m[1][1] / kBandWidth));
       for (int ch = 0; ch < 3; ++ch) {
         const auto v = [&](int i, int j) { return channel(image(r + i, c + j), ch); };
         const float response = v(-1, -1) - 2 * v(-1, 0) + v(-1, 1) - 2 * v(0, -1) + 4 * v(0, 0) - 2 * v(0, 1) +

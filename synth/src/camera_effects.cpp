@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <vector>
 
 #include "random.h"
+#include "relight/core/gaussian_blur.h"
 #include "relight/core/parallel.h"
 
 namespace relight::synth {
@@ -17,25 +17,7 @@ constexpr std::uint64_t kColorNoiseStream = 0x636f6c6f72ULL;  // "color"
 }  // namespace
 
 RadianceImage blur_radiance(const RadianceImage& radiance, double sigma_px) {
-  if (!(sigma_px > 0.0)) return radiance;
-  const int radius = static_cast<int>(std::ceil(4.0 * sigma_px));
-  std::vector<float> weights;
-  float total = 0.f;
-  for (int k = -radius; k <= radius; ++k)
-    total += weights.emplace_back(static_cast<float>(std::exp(-0.5 * k * k / (sigma_px * sigma_px))));
-  for (float& w : weights) w /= total;
-  const int width = radiance.width(), height = radiance.height();
-  RadianceImage horizontal(width, height), out(width, height);
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c)
-      for (int k = -radius; k <= radius; ++k)
-        horizontal(r, c) +=
-            weights[static_cast<std::size_t>(k + radius)] * radiance(r, std::clamp(c + k, 0, width - 1));
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c)
-      for (int k = -radius; k <= radius; ++k)
-        out(r, c) += weights[static_cast<std::size_t>(k + radius)] * horizontal(std::clamp(r + k, 0, height - 1), c);
-  return out;
+  return gaussian_blur(radiance, sigma_px, 4.0);
 }
 
 ColorImage add_color_noise(const ColorImage& image, const ColorCameraEffects& effects, std::uint64_t seed,

@@ -10,6 +10,7 @@
 
 #include "relight/colormap/color_space.h"
 #include "relight/core/error.h"
+#include "relight/synth/camera_effects.h"
 
 namespace relight::colormap {
 namespace {
@@ -27,6 +28,7 @@ RadianceImage shapes(std::uint64_t seed) {
     float level;
   };
   std::vector<Shape> list;
+  list.reserve(40);
   for (int i = 0; i < 40; ++i)
     list.push_back({unit(random) < 0.5, unit(random) * kWidth, unit(random) * kHeight, 8 + 30 * unit(random),
                     8 + 30 * unit(random), float(0.03 + 0.6 * unit(random))});
@@ -54,29 +56,9 @@ RadianceImage shapes(std::uint64_t seed) {
   return out;
 }
 
-/// A Gaussian of sigma (pixels) along x and y, then a box of `motion` pixels along x.
+/// A Gaussian of sigma (pixels), then a box of `motion` pixels along x.
 RadianceImage blurred(const RadianceImage& image, double sigma, double motion = 0.0) {
-  const int radius = static_cast<int>(std::ceil(4 * sigma));
-  std::vector<float> w(static_cast<std::size_t>(2 * radius + 1));
-  float total = 0.f;
-  for (int k = -radius; k <= radius; ++k)
-    total += w[std::size_t(k + radius)] = float(std::exp(-0.5 * k * k / (sigma * sigma)));
-  for (float& v : w) v /= total;
-  const auto pass = [&](const RadianceImage& in, bool along_x) {
-    RadianceImage out(in.width(), in.height());
-    for (int r = 0; r < in.height(); ++r)
-      for (int c = 0; c < in.width(); ++c) {
-        Float3 sum;
-        for (int k = -radius; k <= radius; ++k) {
-          const int rr = along_x ? r : std::clamp(r + k, 0, in.height() - 1);
-          const int cc = along_x ? std::clamp(c + k, 0, in.width() - 1) : c;
-          sum += w[std::size_t(k + radius)] * in(rr, cc);
-        }
-        out(r, c) = sum;
-      }
-    return out;
-  };
-  RadianceImage out = pass(pass(image, true), false);
+  RadianceImage out = synth::blur_radiance(image, sigma);
   if (motion <= 0.0) return out;
   const RadianceImage source = out;
   const int samples = 4 * static_cast<int>(std::ceil(motion));

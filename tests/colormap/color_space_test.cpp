@@ -79,5 +79,28 @@ TEST(ColorSpace, SrgbCurveMatchesTheStandardAndRoundTrips8Bit) {
   EXPECT_EQ(encode_srgb8({-1.f, 2.f, 0.5f}), (Rgb8{0, 255, 188}));  // clamped; linear 0.5 -> 187.52
 }
 
+// The encoder searches thresholds instead of calling pow; it must give pow's byte for every
+// float: at each threshold and its neighbouring floats, and for a million random values.
+TEST(ColorSpace, EncodingBySearchGivesTheBytePowGives) {
+  const auto by_pow = [](float c) { return static_cast<int>(std::lround(255.f * linear_to_srgb(c))); };
+  for (int v = 0; v < 256; ++v) {
+    float x = srgb8_to_linear(static_cast<std::uint8_t>(v));
+    for (int step = 0; step < 4; ++step) x = std::nextafter(x, -1.f);
+    for (int step = 0; step < 8; ++step, x = std::nextafter(x, 2.f)) ASSERT_EQ(encode_srgb8_channel(x), by_pow(x)) << x;
+    // Half-way between codes, where rounding flips.
+    float mid = srgb_to_linear((static_cast<float>(v) + 0.5f) / 255.f);
+    for (int step = 0; step < 4; ++step) mid = std::nextafter(mid, -1.f);
+    for (int step = 0; step < 8; ++step, mid = std::nextafter(mid, 2.f))
+      ASSERT_EQ(encode_srgb8_channel(mid), by_pow(mid)) << mid;
+  }
+  std::uint64_t state = 12345;
+  for (int i = 0; i < 1000000; ++i) {
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    const float x = static_cast<float>(static_cast<double>(state >> 11) * 0x1.0p-53 * 1.2 - 0.1);
+    ASSERT_EQ(encode_srgb8_channel(x), by_pow(x)) << x;
+  }
+  EXPECT_EQ(encode_srgb8_channel(std::nanf("")), 0);
+}
+
 }  // namespace
 }  // namespace relight::colormap

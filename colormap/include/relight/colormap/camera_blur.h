@@ -28,7 +28,7 @@ struct BlurEstimationOptions {
   double pre_blur_sigma = 0.8;  ///< pixels: both gradients on the image blurred by this (noise)
   double min_contrast = 0.04;   ///< linear luminance step across the edge (+-3 px), at least
   double max_sigma = 5.0;       ///< pixels: wider estimates are not steps (shading, soft shadows)
-  int max_edges = 4000;         ///< edges measured per image, at most (an even stride over them)
+  int max_edges = 2000;         ///< candidate 2x2 blocks measured per image, at most (an even share)
   /// With a motion direction: |cos| between the edge's gradient and the motion, at most.
   double max_motion_cosine = 0.34;
 };

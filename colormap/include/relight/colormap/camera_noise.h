@@ -22,7 +22,7 @@ namespace relight::colormap {
 inline constexpr int kNoiseBands = 8;  ///< intensity bands of 32 code values
 
 struct NoiseEstimationOptions {
-  int stride = 3;              ///< pixels: every stride-th pixel of every stride-th row
+  int stride = 6;              ///< pixels: every stride-th pixel of every stride-th row
   double flat_gradient = 6.0;  ///< code values per pixel of the 3x3 mean's Sobel gradient, at most
   int min_samples = 64;        ///< flat pixels a band needs for its own estimate
 };

@@ -83,7 +83,9 @@ using LabPixel = Float3;
 /// 8-bit sRGB -> linear through a 256-entry table (exact to float rounding).
 [[nodiscard]] float srgb8_to_linear(std::uint8_t encoded);
 [[nodiscard]] Float3 decode_srgb8(const Rgb8& pixel);
-/// Linear -> 8-bit sRGB, clamped to [0, 1] and rounded to nearest.
+/// Linear -> 8-bit sRGB, clamped to [0, 1] and rounded to nearest: exactly
+/// lround(255 linear_to_srgb(c)), by a search over the 255 thresholds between codes (no pow).
+[[nodiscard]] std::uint8_t encode_srgb8_channel(float linear);
 [[nodiscard]] Rgb8 encode_srgb8(const Float3& linear);
 
 }  // namespace relight::colormap
