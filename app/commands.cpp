@@ -168,6 +168,12 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
         }
       })
       ->capture_default_str();
+  add_choice_option(command, "--composite", options.composite, render::kCompositeRuleNames,
+                    "How the rendered change reaches the camera image where it sees the real scene: additive "
+                    "(camera + TM(L_rv) - TM(L_r)) or multiplicative (camera * TM(L_rv) / TM(L_r): a shadow "
+                    "darkens the camera's own colour even where the measured light does not reproduce it). "
+                    "Default: additive; multiplicative for the main job, whose stand-in probe is not the desk's "
+                    "light");
   command
       .add_option("--exposure-time", options.exposure_time_s,
                   "Seconds the colour camera exposes each frame (its motion blur; at most the frame interval)")

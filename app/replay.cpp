@@ -139,7 +139,8 @@ BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayO
   mapping.channel_swap = options.channel_swap;
   mapping.model = options.colormap_model;
   pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping));
-  pipeline.graph->emplace<render::MappedCompositeStage>(camera_look);
+  pipeline.graph->emplace<render::MappedCompositeStage>(camera_look,
+                                                        options.composite.value_or(render::CompositeRule::Additive));
   pipeline.graph->keep(kCompositeMapped);
   return kCompositeMapped;
 }
@@ -197,6 +198,8 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   look.artefacts = colormap::parse_camera_artefacts(options.camera_artefacts);
   look.exposure_time_s = options.exposure_time_s;
   dir.camera_look = look;
+  dir.composite = options.composite.value_or(render::CompositeRule::Additive);
+  pipeline.composite_rule = dir.composite;
   dir.environment = options.environment;
   dir.materials_buffer = brdf::kMaterials;
   dir.real_lights_buffer = lights::kLights;
@@ -304,6 +307,7 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
   if (pipeline.renders) {
     report["environment"] = {{"mode", name_of(render::kEnvironmentLightNames, options.environment)},
                              {"extracted_lights", pipeline.extracted_lights}};
+    report["composite"] = {{"rule", name_of(render::kCompositeRuleNames, pipeline.composite_rule)}};
   }
   if (pipeline.camera_look) report["camera_look"] = camera_look_json(pipeline.camera_look->summary());
   report["latency_ms"] = pipeline.latency->summary();
@@ -323,6 +327,9 @@ ReplayOptions with_main_job_defaults(ReplayOptions options) {
   // The sample was recorded without a light probe: the shipped Grace Cathedral probe stands in.
   if (options.lights.empty() && options.probe.empty()) {
     options.probe = (data_folder() / "probes" / "grace_latlong.hdr").string();
+    // Its orange light does not reproduce the neutral desk the camera filmed: an additive shadow
+    // would subtract that orange and leave a cyan patch; the ratio darkens the desk's own colour.
+    if (!options.composite) options.composite = render::CompositeRule::Multiplicative;
   }
   return options;
 }

@@ -95,6 +95,8 @@ struct ReplayOptions {
   /// The camera's artefacts on the virtual layer (--camera-artefacts, colormap/camera_look.h).
   std::string camera_artefacts = "all";
   double exposure_time_s = 1.0 / 30.0;         ///< the colour camera's exposure (motion blur)
+  /// --composite (render/dir/composite.h); unset: additive, or multiplicative for the main job.
+  std::optional<render::CompositeRule> composite;
   bool write_buffers = false;                  ///< L_rv and L_r per frame as EXR
   /// Colour mapping of the rendered light to the camera (colormap/).
   colormap::ColorMapMethod colormap = colormap::ColorMapMethod::Statistics;
@@ -126,6 +128,7 @@ struct ReplayPipeline {
   app::LatencyStage* latency = nullptr;           ///< capture to final picture, every frame
   lights::ProbeStreamStage* probe = nullptr;      ///< set when the real lights come from a probe
   brdf::LightEstimationStage* light_estimation = nullptr;  ///< set with --lights estimate
+  render::CompositeRule composite_rule = render::CompositeRule::Additive;  ///< as resolved for this run
   render::CameraLookStage* camera_look = nullptr;          ///< set with --camera-artefacts other than none
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph

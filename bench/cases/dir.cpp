@@ -9,7 +9,8 @@
 // TM(L_r)), and the path tracer's composite RMSE when it gets DIR's wall time (equal time).
 // The renderer measured is the Vulkan one (VPL generation included in its time); the CPU DIR
 // with exact visibility (reference/dir_exact.h) reports the same fields under "cpu_exact_visibility".
-// dir/gbuffer_640x480: the first Vulkan stage of DIR against its ray-cast reference.
+// dir/gbuffer_640x480: the first Vulkan stage of DIR against its ray-cast reference, and the
+// anti-aliased outlines on top of it (edge_coverage_ms, with_edges_ratio: goal <= 1.5).
 // dir/frame_640x480_64vpl, dir/frame_640x480_256vpl: one whole frame at 640x480 (VPLs on the
 // CPU, then G-buffer, shadow maps, ISMs and shading on the GPU), with the GPU time per step.
 // dir/one_vs_two_pass: one render writing L_rv and L_r against two renders of the same
@@ -27,6 +28,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <tuple>
 #include <utility>
@@ -34,6 +36,7 @@
 #include "bench.h"
 #include "relight/lights/light_stages.h"
 #include "relight/render/dir/dir_vk.h"
+#include "relight/render/dir/edge_coverage.h"
 #include "relight/render/dir/gbuffer_vk.h"
 #include "relight/render/reference/dir_exact.h"
 #include "relight/render/reference/path_tracer.h"
@@ -334,6 +337,37 @@ bench::Json gbuffer_640x480(const bench::Options& options) {
   bench::Json json = bench::comparison_json(c, "embree_ray_cast");
   json["gpu_ms"] = renderer.last_gpu_ms();
   json["device"] = context->device_info().name;
+  // The anti-aliased outlines on top (edge_coverage.h): the virtual meshes' tracer and 16 rays
+  // per outline pixel; goal: G-buffer + outlines <= 1.5 x the G-buffer alone.
+  const render::GBuffer gbuffer = render::gbuffer_cpu(tracer, camera);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  PositionMap real(640, 480, Float3{nan, nan, nan});
+  const Eigen::Vector3f origin = camera.camera_to_world.translation().cast<float>();
+  const Pose world_to_camera = camera.camera_to_world.inverse();
+  for (int r = 0; r < 480; ++r)
+    for (int col = 0; col < 640; ++col) {
+      const Eigen::Vector3f d =
+          (camera.camera_to_world.linear() * camera.intrinsics.ray(col, r).normalized()).cast<float>();
+      if (const auto hit = tracer.intersect(render::Layer::Real, origin, d)) {
+        const Eigen::Vector3d p = world_to_camera * hit->point.cast<double>();
+        real(r, col) = {float(p.x()), float(p.y()), float(p.z())};
+      }
+    }
+  render::CoverageImage coverage(640, 480);
+  int outline = 0;
+  const double edge_ms = bench::median_ms(
+      [&] {
+        const render::RayTracer virtual_tracer(render::virtual_part(scene), render::RayTracer::Build::Fast);
+        outline = render::refine_edge_coverage(coverage, gbuffer, real, virtual_tracer, camera);
+      },
+      options.repetitions);
+  const render::RayTracer prebuilt(render::virtual_part(scene), render::RayTracer::Build::Fast);
+  json["edge_rays_ms"] = bench::median_ms(
+      [&] { outline = render::refine_edge_coverage(coverage, gbuffer, real, prebuilt, camera); }, options.repetitions);
+  json["edge_outline_ms"] = bench::median_ms([&] { (void)render::outline_pixels(gbuffer); }, options.repetitions);
+  json["edge_coverage_ms"] = edge_ms;
+  json["outline_pixels"] = outline;
+  json["with_edges_ratio"] = (c.ms + edge_ms) / c.ms;
   return json;
 }
 

@@ -2,7 +2,10 @@
 #include "relight/brdf/brdf_stages.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
+#include "relight/brdf/diffuse.h"
 #include "relight/brdf/kmeans_vk.h"
 #include "relight/brdf/specular_objective_vk.h"
 #include "relight/core/error.h"
@@ -41,6 +44,46 @@ std::size_t gather_points(const RadianceImage& kd, const Mask& valid, std::vecto
     }
   }
   return static_cast<std::size_t>(std::count(valid.pixels().begin(), valid.pixels().end(), std::uint8_t{1}));
+}
+
+void fill_clipped_labels(LabelImage& ids, const Mask& valid, const PositionMap& positions) {
+  if (!ids.same_shape(valid) || !ids.same_shape(positions))
+    throw Error("brdf: the labels, the k_d validity and the positions differ in size");
+  const int width = ids.width(), height = ids.height();
+  constexpr float kUnreached = std::numeric_limits<float>::infinity();
+  std::vector<float> distance(ids.size(), kUnreached);
+  bool any_clipped = false;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (ids.pixels()[i] != 0) distance[i] = 0.f;
+    any_clipped = any_clipped || valid.pixels()[i] == kKdMarkClipped;
+  }
+  if (!any_clipped) return;
+  const auto depth = [&](int r, int c) { return positions(r, c).z; };
+  // Relaxes clipped pixel (r, c) from neighbour (r + dr, c + dc), one step of length `step`.
+  const auto relax = [&](int r, int c, int dr, int dc, float step) {
+    const int nr = r + dr, nc = c + dc;
+    if (nr < 0 || nc < 0 || nr >= height || nc >= width) return;
+    const auto i = static_cast<std::size_t>(r) * static_cast<std::size_t>(width) + static_cast<std::size_t>(c);
+    const auto n = static_cast<std::size_t>(nr) * static_cast<std::size_t>(width) + static_cast<std::size_t>(nc);
+    if (ids.pixels()[n] == 0 || distance[n] + step >= distance[i]) return;
+    const float a = depth(r, c), b = depth(nr, nc);
+    if (!is_valid_depth(a) || !is_valid_depth(b) || std::abs(a - b) > 0.03f * std::min(a, b) + 0.005f) return;
+    distance[i] = distance[n] + step;
+    ids.pixels()[i] = ids.pixels()[n];
+  };
+  constexpr float kDiagonal = 1.41421356f;
+  for (int sweep = 0; sweep < 2; ++sweep) {
+    for (int r = 0; r < height; ++r)
+      for (int c = 0; c < width; ++c) {
+        if (valid(r, c) != kKdMarkClipped) continue;
+        relax(r, c, 0, -1, 1.f), relax(r, c, -1, -1, kDiagonal), relax(r, c, -1, 0, 1.f), relax(r, c, -1, 1, kDiagonal);
+      }
+    for (int r = height - 1; r >= 0; --r)
+      for (int c = width - 1; c >= 0; --c) {
+        if (valid(r, c) != kKdMarkClipped) continue;
+        relax(r, c, 0, 1, 1.f), relax(r, c, 1, 1, kDiagonal), relax(r, c, 1, 0, 1.f), relax(r, c, 1, -1, kDiagonal);
+      }
+  }
 }
 
 Materials materials_from_clusters(const KMeansResult& result, const std::vector<std::uint32_t>& pixels, int width,
@@ -103,6 +146,7 @@ void estimate_brdf(const ColorImage& color, const PositionMap& positions, const 
   const std::size_t clustered = gather_points(out.kd, out.kd_valid, points, pixels);
   const KMeansResult result = tracker.run(engine, points, clustered);
   out.materials = materials_from_clusters(result, pixels, color.width(), color.height());
+  fill_clipped_labels(out.materials.ids, out.kd_valid, positions);
   fit_materials(color, &out.highlights, positions, normals, lights, options, solver, out.materials);
 }
 
@@ -168,6 +212,7 @@ KMeansStage::~KMeansStage() = default;
 void KMeansStage::declare(StageBuilder& builder) {
   kd_ = builder.read(buffers_.kd);
   valid_ = builder.read(buffers_.kd_valid);
+  positions_ = builder.read(buffers_.positions);
   previous_tracker_ = builder.read_previous(buffers_.kmeans_history);
   tracker_ = builder.write(buffers_.kmeans_history);
   clusters_ = builder.write(buffers_.clusters);
@@ -182,7 +227,9 @@ void KMeansStage::run(StageContext& context) {
   tracker = previous ? *previous : first_tracker_;
   result_ = tracker.run(*engine_, points_, clustered);
   if (auto* gpu = dynamic_cast<KMeansVk*>(engine_.get()); gpu && gpu->gpu_ms()) context.report_device_ms(*gpu->gpu_ms());
-  context.get(clusters_) = materials_from_clusters(result_, pixels_, kd.width(), kd.height());
+  Materials& materials = context.get(clusters_);
+  materials = materials_from_clusters(result_, pixels_, kd.width(), kd.height());
+  fill_clipped_labels(materials.ids, context.get(valid_), context.get(positions_));
 }
 
 SpecularFitStage::SpecularFitStage(vk::VulkanContext* context, BrdfOptions options, BrdfBuffers buffers)

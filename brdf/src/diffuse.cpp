@@ -147,6 +147,12 @@ void estimate_diffuse(const ColorImage& color, const PositionMap& positions, con
         }
       },
       positions, normals, lights, options, kd, valid);
+  for (std::size_t i = 0; i < color.size(); ++i) {
+    const Rgb8 p = color.pixels()[i];
+    if (valid.pixels()[i] == kKdMarkInvalid || std::max({p.r, p.g, p.b}) < options.clip_code) continue;
+    valid.pixels()[i] = kKdMarkClipped;
+    kd.pixels()[i] = {};
+  }
 }
 
 void estimate_diffuse(const RadianceImage& linear, const PositionMap& positions, const NormalMap& normals,

@@ -129,7 +129,7 @@ TEST(EdgeCoverage, TheCompositesOutlineMatchesTheSupersampledPathTracerWithoutAH
   const RayTracer virtual_tracer(virtual_part(scene), RayTracer::Build::Fast);
   (void)refine_edge_coverage(dir.virtual_coverage, gbuffer, real_positions(tracer, camera), virtual_tracer, camera);
   const ColorImage smooth = differential_composite(camera_image, dir.real_virtual, dir.real, dir.virtual_coverage,
-                                                   tone_map, nullptr, &gbuffer.virtual_surface);
+                                                   tone_map, {.virtual_centre = &gbuffer.virtual_surface});
   const ColorImage truth = differential_composite(camera_image, reference.real_virtual, reference.real,
                                                   reference.virtual_coverage, tone_map);
 

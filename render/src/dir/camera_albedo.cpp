@@ -3,6 +3,7 @@
 
 #include <algorithm>
 
+#include "relight/brdf/diffuse.h"
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
 
@@ -24,7 +25,7 @@ Mask modulated_pixels(const GBuffer& gbuffer, const MrScene& scene, const Mask& 
   Mask out(valid.width(), valid.height());
   for (std::size_t i = 0; i < out.size(); ++i) {
     const std::uint16_t label = gbuffer.material.pixels()[i];
-    out.pixels()[i] = label != 0 && !gbuffer.virtual_surface.pixels()[i] && valid.pixels()[i] &&
+    out.pixels()[i] = label != 0 && !gbuffer.virtual_surface.pixels()[i] && brdf::has_kd(valid.pixels()[i]) &&
                               scene.materials.at(label - 1u).ks == 0.f
                           ? 1
                           : 0;

@@ -1,5 +1,6 @@
 #include "relight/render/dir/composite.h"
 
+#include <algorithm>
 #include <optional>
 
 #include "relight/colormap/color_space.h"
@@ -60,26 +61,47 @@ colormap::VirtualLayer separated_layer(const CoverageImage& coverage, const Mask
   return layer;
 }
 
+/// The real differential of one channel: `with` - `without` (additive) or camera * (with /
+/// without - 1) (multiplicative; additive where `without` is too dark for a ratio).
+float real_difference(CompositeRule rule, float camera, float with, float without) {
+  if (rule == CompositeRule::Additive || without < 1e-3f) return with - without;
+  return camera * (std::min(with / without, kMaxCompositeRatio) - 1.f);
+}
+
+Float3 real_difference(CompositeRule rule, const Rgb8& camera, const Float3& with, const Float3& without) {
+  if (rule == CompositeRule::Additive) return with - without;
+  const Float3 c = colormap::decode_srgb8(camera);
+  return {real_difference(rule, c.x, with.x, without.x), real_difference(rule, c.y, with.y, without.y),
+          real_difference(rule, c.z, with.z, without.z)};
+}
+
 }  // namespace
 
 ColorImage differential_composite(const ColorImage& camera, const RadianceImage& real_virtual,
                                   const RadianceImage& real, const CoverageImage& virtual_coverage,
-                                  const colormap::ToneMap& tone_map, const colormap::CameraLook* look,
-                                  const Mask* virtual_centre) {
+                                  const colormap::ToneMap& tone_map, const CompositeOptions& options) {
   require_camera_size(camera, {&real_virtual, &real}, virtual_coverage);
   const auto with = [&](std::size_t i) { return colormap::tone_map(real_virtual.pixels()[i], tone_map); };
-  const auto difference = [&](std::size_t i) { return with(i) - colormap::tone_map(real.pixels()[i], tone_map); };
-  return colormap::composite_layer(camera, separated_layer(virtual_coverage, virtual_centre, with, difference), look);
+  const auto difference = [&](std::size_t i) {
+    return real_difference(options.rule, camera.pixels()[i], with(i), colormap::tone_map(real.pixels()[i], tone_map));
+  };
+  return colormap::composite_layer(camera, separated_layer(virtual_coverage, options.virtual_centre, with, difference),
+                                   options.look);
 }
 
 ColorImage mapped_differential_composite(const ColorImage& camera, const RadianceImage& delta,
                                          const RadianceImage& real_virtual, const CoverageImage& virtual_coverage,
-                                         const colormap::ColorMapping& mapping, const colormap::CameraLook* look,
-                                         const Mask* virtual_centre) {
+                                         const colormap::ColorMapping& mapping, const CompositeOptions& options) {
   require_camera_size(camera, {&delta, &real_virtual}, virtual_coverage);
   const auto mapped = [&](std::size_t i) { return mapping(real_virtual.pixels()[i]); };
-  const auto difference = [&](std::size_t i) { return delta.pixels()[i]; };
-  return colormap::composite_layer(camera, separated_layer(virtual_coverage, virtual_centre, mapped, difference), look);
+  // delta_L = tau(TM(L_rv)) - tau(TM(L_r)) (colormap_stages.h), so tau(TM(L_r)) = mapped - delta.
+  const auto difference = [&](std::size_t i) {
+    if (options.rule == CompositeRule::Additive) return delta.pixels()[i];
+    const Float3 with = mapped(i);
+    return real_difference(options.rule, camera.pixels()[i], with, with - delta.pixels()[i]);
+  };
+  return colormap::composite_layer(
+      camera, separated_layer(virtual_coverage, options.virtual_centre, mapped, difference), options.look);
 }
 
 ColorImage tone_mapped_preview(const RadianceImage& radiance, const colormap::ToneMap& tone_map) {

@@ -52,7 +52,7 @@ CameraLookStage* add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanCo
   graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
   const bool camera_look = options.camera_look && options.camera_look->artefacts.any();
   CameraLookStage* look = camera_look ? &graph.emplace<CameraLookStage>(*options.camera_look) : nullptr;
-  graph.emplace<DifferentialCompositeStage>(options.tone_map, camera_look);
+  graph.emplace<DifferentialCompositeStage>(options.tone_map, camera_look, options.composite);
   return look;
 }
 
@@ -251,9 +251,9 @@ void DifferentialCompositeStage::run(StageContext& context) {
     throw Error("differential_composite: the colour image (" + std::to_string(color.width()) + "x" +
                 std::to_string(color.height()) + ") and the rendered image (" + std::to_string(real_virtual.width()) +
                 "x" + std::to_string(real_virtual.height()) + ") differ in size");
-  context.get(composite_) =
-      differential_composite(color, real_virtual, context.get(real_), context.get(coverage_), tone_map_,
-                             camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface);
+  context.get(composite_) = differential_composite(
+      color, real_virtual, context.get(real_), context.get(coverage_), tone_map_,
+      {rule_, camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface});
 }
 
 }  // namespace relight::render

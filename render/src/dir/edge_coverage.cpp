@@ -46,19 +46,20 @@ float real_distance_at(const PositionMap& positions, float u, float v) {
 }  // namespace
 
 Mask outline_pixels(const GBuffer& gbuffer) {
+  // A pixel's 3x3 window holds both kinds exactly when a neighbour is of the other kind: walk the
+  // virtual pixels (few) and mark each with its non-virtual neighbours.
   const int width = gbuffer.distance.width(), height = gbuffer.distance.height();
   Mask out(width, height);
   for (int row = 0; row < height; ++row) {
     for (int col = 0; col < width; ++col) {
-      const bool centre = seen_virtual(gbuffer, row, col);
-      bool mixed = false;
-      for (int i = -1; i <= 1 && !mixed; ++i)
-        for (int j = -1; j <= 1 && !mixed; ++j) {
+      if (!seen_virtual(gbuffer, row, col)) continue;
+      for (int i = -1; i <= 1; ++i)
+        for (int j = -1; j <= 1; ++j) {
           const int r = row + i, c = col + j;
-          if (r < 0 || c < 0 || r >= height || c >= width) continue;
-          mixed = seen_virtual(gbuffer, r, c) != centre;
+          if (r < 0 || c < 0 || r >= height || c >= width || seen_virtual(gbuffer, r, c)) continue;
+          out(r, c) = 1;
+          out(row, col) = 1;
         }
-      out(row, col) = mixed ? 1 : 0;
     }
   }
   return out;

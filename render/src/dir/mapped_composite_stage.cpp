@@ -21,7 +21,8 @@ void MappedCompositeStage::declare(StageBuilder& builder) {
 void MappedCompositeStage::run(StageContext& context) {
   context.get(composite_) = mapped_differential_composite(
       context.get(camera_), context.get(delta_), context.get(real_virtual_), context.get(coverage_),
-      context.get(mapping_), camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface);
+      context.get(mapping_),
+      {rule_, camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface});
 }
 
 }  // namespace relight::render

@@ -7,7 +7,9 @@
 //                      LightSet "lights", FrameInfo "frame" (camera_to_world; identity when unknown)
 //                      writes RadianceImage "kd", Mask "kd_valid"
 //   kmeans (CPU|Vulkan) reads "kd", "kd_valid" (clusters the pixels marked 1, assigns those
-//                      marked 2); writes Materials "clusters" (centres as k_d,
+//                      marked 2), "positions" (the clipped pixels, marked 3, take the label
+//                      of the nearest clustered pixel of their surface, fill_clipped_labels);
+//                      writes Materials "clusters" (centres as k_d,
 //                      k_s = 0, ids = cluster + 1 on valid pixels); warm-started from its own
 //                      previous result (KMeansTracker)
 //   specular_fit       reads "clusters", "color", "highlight_mask", "positions", "normals",
@@ -126,6 +128,7 @@ class KMeansStage final : public Stage {
   BrdfBuffers buffers_;
   Read<RadianceImage> kd_;
   Read<Mask> valid_;
+  Read<PositionMap> positions_;
   ReadPrevious<KMeansTracker> previous_tracker_;
   Write<KMeansTracker> tracker_;
   Write<Materials> clusters_;
@@ -186,6 +189,12 @@ void estimate_brdf(const ColorImage& color, const PositionMap& positions, const 
 void fit_materials(const ColorImage& color, const Mask* highlights, const PositionMap& positions,
                    const NormalMap& normals, const ShadingLights& lights, const BrdfOptions& options,
                    const SpecularSolver& solver, Materials& materials, SpecularObjectiveVk* gpu_start = nullptr);
+
+/// Gives every clipped pixel (kd_valid kKdMarkClipped, diffuse.h) the label of the nearest labelled
+/// pixel reachable over its own surface (neighbours whose depths differ by less than 3 % + 5 mm;
+/// a chamfer distance by two raster sweeps, twice): the camera's value there is only a lower
+/// bound, the surface's unclipped parts know its albedo. Clipped pixels no path reaches keep 0.
+void fill_clipped_labels(LabelImage& ids, const Mask& valid, const PositionMap& positions);
 
 /// Materials from a K-means result on the pixels `pixels` (indices into a width x height image).
 [[nodiscard]] Materials materials_from_clusters(const KMeansResult& result, const std::vector<std::uint32_t>& pixels,

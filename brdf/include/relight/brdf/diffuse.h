@@ -23,16 +23,34 @@
 // clusters only the pixels marked 1 and then assigns the others to the nearest centre, so that
 // sheen cannot take a cluster of its own. 0.8 (37 degrees) keeps n = 20 lobes below ~1 % of
 // their peak outside the cone; 1 marks nothing.
+//
+// A pixel of an 8-bit image with a channel at or above clip_code is marked 3 (clipped), k_d 0:
+// where the camera saturates (an over-exposed white desk) its value is only a lower bound, and
+// the ratio would take a clipped channel's deficit for the surface's colour (a cyan "white").
+// K-means leaves it out, and it takes the material of the nearest clustered pixel of its surface
+// (fill_clipped_labels), so the renderer shades it with the albedo of its unclipped parts.
+#include <cstdint>
+
 #include "relight/brdf/shading.h"
 #include "relight/core/image.h"
 
 namespace relight::brdf {
+
+/// The values of the k_d validity mask.
+inline constexpr std::uint8_t kKdMarkInvalid = 0;
+inline constexpr std::uint8_t kKdMarkValid = 1;
+inline constexpr std::uint8_t kKdMarkNearLobe = 2;  ///< valid, in a light's specular lobe
+inline constexpr std::uint8_t kKdMarkClipped = 3;   ///< the camera saturated: k_d unknown
+[[nodiscard]] inline bool has_kd(std::uint8_t validity) {
+  return validity == kKdMarkValid || validity == kKdMarkNearLobe;
+}
 
 struct DiffuseOptions {
   float min_shading = 0.02f;     ///< radiance units (luminance of D)
   float min_brightness = 0.004f;  ///< linear luminance of the pixel colour
   float max_kd = 2.f;            ///< k_d channels are clamped to [0, max_kd]
   float lobe_cos_min = 0.8f;     ///< <omega_o . r_l> above which a valid pixel is marked 2
+  int clip_code = 250;           ///< 8-bit inputs: a channel at or above this is clipped (mark 3)
   int threads = 0;
 };
 

@@ -14,23 +14,47 @@
 // the virtual colour of its virtual-centre neighbours with the real differential of its
 // real-centre ones (see separated_layer in composite.cpp).
 //
+// The multiplicative rule (Debevec 1998's alternative; TVCG 2013 eq. 2, alpha = CI / L_r) scales
+// the camera instead of adding to it where the camera sees the real scene:
+//
+//   L_final = L_cam TM(L_rv) / TM(L_r)          (per channel; TM(L_r) < 1e-3: the additive rule)
+//
+// so a virtual shadow darkens the camera's own colour whatever hue the rendered real scene has:
+// where the measured lights and albedos do not reproduce the camera (an orange probe over a
+// neutral white desk, a clipped channel), the additive rule subtracts the render's hue and
+// tints the shadow; the ratio only needs the render's relative change. The ratio is capped at
+// kMaxCompositeRatio (light a virtual object adds to a dark real surface).
+//
 // With a CameraLook both composites put the camera's blur, motion blur and noise on the rendered
 // layer (colormap/camera_look.h, composite_layer): the virtual objects and the differential
 // effects they cause, not the camera image, which has them already.
+#include <array>
+
 #include "relight/colormap/camera_look.h"
 #include "relight/colormap/color_mapping.h"
 #include "relight/colormap/tone_map.h"
 #include "relight/core/image.h"
+#include "relight/core/named_values.h"
 #include "relight/render/differential_images.h"
 
 namespace relight::render {
+
+enum class CompositeRule { Additive, Multiplicative };
+inline constexpr std::array<NamedValue<CompositeRule>, 2> kCompositeRuleNames{
+    {{"additive", CompositeRule::Additive}, {"multiplicative", CompositeRule::Multiplicative}}};
+inline constexpr float kMaxCompositeRatio = 8.f;
+
+struct CompositeOptions {
+  CompositeRule rule = CompositeRule::Additive;
+  const colormap::CameraLook* look = nullptr;  ///< the camera's artefacts for the rendered layer
+  const Mask* virtual_centre = nullptr;        ///< pixels whose centre sample saw a virtual object
+};
 
 /// Throws relight::Error when the images differ in size.
 [[nodiscard]] ColorImage differential_composite(const ColorImage& camera, const RadianceImage& real_virtual,
                                                 const RadianceImage& real, const CoverageImage& virtual_coverage,
                                                 const colormap::ToneMap& tone_map,
-                                                const colormap::CameraLook* look = nullptr,
-                                                const Mask* virtual_centre = nullptr);
+                                                const CompositeOptions& options = {});
 
 /// The colour-mapped composite (eqs. 4.28-4.29 with the coverage blend above):
 ///   c tau(TM(L_rv)) + (1 - c)(L_cam + delta_L),   delta_L = tau(TM(L_rv)) - tau(TM(L_r)),
@@ -40,8 +64,7 @@ namespace relight::render {
                                                        const RadianceImage& real_virtual,
                                                        const CoverageImage& virtual_coverage,
                                                        const colormap::ColorMapping& mapping,
-                                                       const colormap::CameraLook* look = nullptr,
-                                                       const Mask* virtual_centre = nullptr);
+                                                       const CompositeOptions& options = {});
 
 /// TM(L) as an 8-bit sRGB picture (for looking at L_rv or L_r on their own).
 [[nodiscard]] ColorImage tone_mapped_preview(const RadianceImage& radiance, const colormap::ToneMap& tone_map);

@@ -64,6 +64,7 @@
 #include "relight/lights/light_set.h"
 #include "relight/render/buffers.h"
 #include "relight/render/dir/camera_look_stage.h"
+#include "relight/render/dir/composite.h"
 #include "relight/render/dir/dir_vk.h"
 #include "relight/render/dir/temporal_smoothing.h"
 #include "relight/render/scene/depth_mesh.h"
@@ -113,6 +114,7 @@ struct DirStageOptions {
   /// Anti-aliased outlines (edge_coverage.h): edge_samples^2 sub-pixel rays per outline pixel
   /// give its fractional virtual coverage; 0: the centre sample's 0 or 1.
   int edge_samples = 4;
+  CompositeRule composite = CompositeRule::Additive;  ///< composite.h
   /// The camera's look on the virtual layer (camera_look_stage.h): with any artefact on, a
   /// camera_look stage, and the composite reads it; none (or no artefact): the sharp render.
   std::optional<CameraLookOptions> camera_look;
@@ -238,8 +240,9 @@ class IndirectSmoothingStage final : public Stage {
 class DifferentialCompositeStage final : public Stage {
  public:
   /// With `camera_look`, also reads colormap::CameraLook "camera_look" (camera_look_stage.h).
-  explicit DifferentialCompositeStage(colormap::ToneMap tone_map, bool camera_look = false)
-      : tone_map_(tone_map), camera_look_(camera_look) {}
+  explicit DifferentialCompositeStage(colormap::ToneMap tone_map, bool camera_look = false,
+                                      CompositeRule rule = CompositeRule::Additive)
+      : tone_map_(tone_map), camera_look_(camera_look), rule_(rule) {}
   [[nodiscard]] std::string name() const override { return "differential_composite"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
@@ -247,6 +250,7 @@ class DifferentialCompositeStage final : public Stage {
  private:
   colormap::ToneMap tone_map_;
   bool camera_look_;
+  CompositeRule rule_;
   Read<ColorImage> color_;
   Read<RadianceImage> real_virtual_;
   Read<RadianceImage> real_;

@@ -12,13 +12,15 @@
 #include "relight/colormap/color_mapping.h"
 #include "relight/core/frame_graph.h"
 #include "relight/render/differential_images.h"
+#include "relight/render/dir/composite.h"
 #include "relight/render/dir/gbuffer.h"
 
 namespace relight::render {
 
 class MappedCompositeStage final : public Stage {
  public:
-  explicit MappedCompositeStage(bool camera_look = false) : camera_look_(camera_look) {}
+  explicit MappedCompositeStage(bool camera_look = false, CompositeRule rule = CompositeRule::Additive)
+      : camera_look_(camera_look), rule_(rule) {}
   [[nodiscard]] std::string name() const override { return "mapped_composite"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
@@ -30,6 +32,7 @@ class MappedCompositeStage final : public Stage {
   Read<GBuffer> gbuffer_;
   Read<colormap::ColorMapping> mapping_;
   bool camera_look_;
+  CompositeRule rule_;
   Read<colormap::CameraLook> look_;
   Write<ColorImage> composite_;
 };
