@@ -112,8 +112,14 @@ std::vector<T> motion_tile(const Image<T>& image, const TileBox& box, const Moti
   out.reserve(static_cast<std::size_t>(box.row1 - box.row0) * static_cast<std::size_t>(box.col1 - box.col0));
   for (int row = box.row0; row < box.row1; ++row)
     for (int col = box.col0; col < box.col1; ++col) {
-      const Float3 m = motion.at(float(row), float(col));
-      const int samples = std::max(1, static_cast<int>(std::ceil(std::sqrt(m.x * m.x + m.y * m.y))) + 1);
+      Float3 m = motion.at(float(row), float(col));
+      if (!std::isfinite(m.x) || !std::isfinite(m.y)) {
+        out.push_back(image(row, col));
+        continue;
+      }
+      const float full = std::sqrt(m.x * m.x + m.y * m.y), length = std::min(full, kMaxMotionPx);
+      if (full > length) m = (length / full) * m;
+      const int samples = std::max(1, static_cast<int>(std::ceil(length)) + 1);
       if (samples == 1) {
         out.push_back(image(row, col));
         continue;
@@ -208,7 +214,7 @@ float srgb_code(float linear) {
     for (std::size_t i = 0; i < out.size(); ++i) out[i] = 255.f * linear_to_srgb(float(i) / 4096.f);
     return out;
   }();
-  const float x = std::clamp(linear, 0.f, 1.f) * 4096.f;
+  const float x = (linear > 0.f ? std::min(linear, 1.f) : 0.f) * 4096.f;  // NaN: 0
   const auto i = std::min<std::size_t>(static_cast<std::size_t>(x), 4095);
   const float t = x - static_cast<float>(i);
   return table[i] + t * (table[i + 1] - table[i]);
@@ -269,10 +275,11 @@ float MotionField::max_length() const {
 
 void blur_layer(VirtualLayer& layer, float sigma_px, const MotionField* motion, int threads) {
   const bool defocus = sigma_px > 0.05f;
-  const bool moving = motion && !motion->empty() && motion->max_length() > 0.5f;
+  const float longest = motion && !motion->empty() ? std::min(motion->max_length(), kMaxMotionPx) : 0.f;
+  const bool moving = longest > 0.5f;
   if (!defocus && !moving) return;
   const int reach = (defocus ? static_cast<int>(std::ceil(3.f * sigma_px)) : 0) +
-                    (moving ? static_cast<int>(std::ceil(0.5f * motion->max_length())) : 0) + 1;
+                    (moving ? static_cast<int>(std::ceil(0.5f * longest)) : 0) + 1;
   const int columns = (layer.coverage.width() + kTile - 1) / kTile,
             rows = (layer.coverage.height() + kTile - 1) / kTile;
   const std::vector<std::uint8_t> active = active_tiles(layer, reach, columns, rows);

@@ -226,6 +226,17 @@ TEST(CameraLookComposite, MotionBlurSmearsTheLayerAlongTheMotion) {
   EXPECT_GT(share(61, 150), 0.9);
 }
 
+TEST(CameraLookComposite, AHugeOrBrokenMotionIsCutNotAHang) {
+  CameraLook look;
+  look.artefacts = parse_camera_artefacts("motion");
+  look.motion.motion = Image<Float3>(kWidth / look.motion.cell, kHeight / look.motion.cell, Float3{1e9f, 0.f, 0.f});
+  look.motion.motion(3, 3) = {std::nanf(""), 0.f, 0.f};
+  const ColorImage out = composite_layer(ColorImage(kWidth, kHeight, Rgb8{40, 40, 40}), square_layer(0.6f), &look);
+  // The square smears at most kMaxMotionPx / 2 beyond its left edge (column 100).
+  EXPECT_EQ(out(120, 100 - static_cast<int>(kMaxMotionPx / 2) - 2).r, 40);
+  EXPECT_GT(out(120, 100 - static_cast<int>(kMaxMotionPx / 2) + 4).r, 40);
+}
+
 TEST(CameraLookComposite, NoiseMatchesTheProfileAndChangesEveryFrame) {
   CameraLook look;
   look.artefacts = parse_camera_artefacts("noise");

@@ -59,7 +59,10 @@ colormap::MotionField image_motion(const GBuffer& gbuffer, const FrameInfo& fram
       const Eigen::Vector3d in_previous = world_to_previous * world;
       if (in_previous.z() <= 1e-3) continue;
       const Eigen::Vector2d before = k.project(in_previous);
-      field.motion(r, c) = {float(scale * (u - before.x())), float(scale * (v - before.y())), 0.f};
+      Eigen::Vector2d moved = scale * (Eigen::Vector2d(u, v) - before);
+      if (!moved.allFinite()) continue;
+      if (moved.norm() > colormap::kMaxMotionPx) moved *= colormap::kMaxMotionPx / moved.norm();
+      field.motion(r, c) = {float(moved.x()), float(moved.y()), 0.f};
     }
   }
   return field;

@@ -43,6 +43,10 @@ struct CameraArtefacts {
 [[nodiscard]] CameraArtefacts parse_camera_artefacts(const std::string& text);
 [[nodiscard]] std::string to_string(const CameraArtefacts& artefacts);
 
+/// Pixels: longer image motion over one exposure is cut to this length (a pose jump, a frame
+/// skipped: the blur would smear the object across the picture and cost its length per pixel).
+inline constexpr float kMaxMotionPx = 64.f;
+
 /// The image motion of each pixel over the exposure, in pixels, on a grid of `cell`-pixel cells
 /// (camera motion moves the image smoothly; bilinear between cell centres).
 struct MotionField {

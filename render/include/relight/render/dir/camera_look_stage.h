@@ -9,8 +9,8 @@
 //     blur is not taken for defocus), smoothed over frames; the virtual layer gets the Gaussian of
 //     sqrt(sigma_camera^2 - sigma_render^2), the render's own pixel footprint taken out;
 //   - motion: each pixel's image motion between the previous pose and this one, scaled to the
-//     exposure time (exposure / frame interval, at most 1): the point the pixel sees is projected
-//     into both cameras. None on the first frame, without poses, or across a gap of frames;
+//     exposure time (exposure / frame interval, at most 1; at most kMaxMotionPx long): the point the pixel sees is
+//     projected into both cameras. None on the first frame, without poses, or across a gap of frames;
 //   - noise: the camera's noise profile (camera_noise.h), smoothed over frames; the frame index
 //     seeds the virtual layer's noise.
 #include <string>
