@@ -26,7 +26,8 @@ struct CameraLookOptions {
   colormap::CameraArtefacts artefacts;
   double exposure_time_s = 1.0 / 30.0;  ///< the camera's exposure: how much of the motion one frame integrates
   double smoothing = 0.25;              ///< weight of this frame's estimates in the running ones
-  /// Variance (px^2) of the render's own point spread: DIR point-samples each pixel's centre.
+  /// Variance (px^2) of the render's own point spread: DIR shades each pixel's centre (only the
+  /// outlines' coverage is a 4x4 box, edge_coverage.h, whose 1/12 px^2 is left in the camera's).
   double render_variance_px2 = 0.0;
   colormap::BlurEstimationOptions blur;
   colormap::NoiseEstimationOptions noise;
