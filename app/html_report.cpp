@@ -71,7 +71,7 @@ void summary_section(std::ostringstream& html, const Json& timing) {
     html << "<tr><td>" << key << "<td class=l>" << html_escape(text);
   }
   // Summaries of one level: "key = value; ..." (lists as their length: the report.json has them).
-  for (const char* section : {"latency_ms", "tracking", "marker_pose"}) {
+  for (const char* section : {"latency_ms", "tracking", "marker_pose", "camera_look", "composite"}) {
     if (!timing.contains(section) || !timing[section].is_object()) continue;
     html << "<tr><td>" << section << "<td class=l>";
     for (const auto& [key, value] : timing[section].items()) {
