@@ -177,7 +177,7 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command
       .add_option("--exposure-time", options.exposure_time_s,
                   "Seconds the colour camera exposes each frame (its motion blur; at most the frame interval)")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Range(1e-5, 10.0))
       ->default_str("0.0333");
   add_choice_option(command, "--colormap", options.colormap, colormap::kColorMapMethodNames,
                     "Map the rendered colours to the camera's: stats (CIELab statistics), sample (colour samples "
