@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <sstream>
 #include <vector>
 
@@ -104,38 +105,81 @@ std::vector<T> gaussian_tile(const Image<T>& image, const TileBox& box, const st
   return out;
 }
 
-/// A box filter along each pixel's motion, centred on the pixel (the render is of the frame's
-/// pose, the middle of the exposure as far as the pose says).
+/// One tile's filtered parts of the layer, row-major over the tile.
+struct TileResult {
+  std::vector<Float3> colour;
+  std::vector<float> coverage;
+  std::vector<Float3> delta;
+};
+
+/// A bilinear sample of the layer: the four pixel indices and the weights along row and column.
+struct Tap {
+  std::size_t i00, i01, i10, i11;
+  float fr, fc;
+};
+
+Tap tap_at(int width, int height, float row, float col) {
+  const float r = std::clamp(row, 0.f, float(height - 1)), c = std::clamp(col, 0.f, float(width - 1));
+  const int r0 = std::min(static_cast<int>(r), std::max(0, height - 2)),
+            c0 = std::min(static_cast<int>(c), std::max(0, width - 2));
+  const int r1 = std::min(r0 + 1, height - 1), c1 = std::min(c0 + 1, width - 1);
+  const auto index = [width](int y, int x) {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+  };
+  return {index(r0, c0), index(r0, c1), index(r1, c0), index(r1, c1), r - float(r0), c - float(c0)};
+}
+
 template <class T>
-std::vector<T> motion_tile(const Image<T>& image, const TileBox& box, const MotionField& motion) {
-  std::vector<T> out;
-  out.reserve(static_cast<std::size_t>(box.row1 - box.row0) * static_cast<std::size_t>(box.col1 - box.col0));
+T sample(std::span<const T> pixels, const Tap& t) {
+  return (1.f - t.fr) * ((1.f - t.fc) * pixels[t.i00] + t.fc * pixels[t.i01]) +
+         t.fr * ((1.f - t.fc) * pixels[t.i10] + t.fc * pixels[t.i11]);
+}
+
+/// A box filter along each pixel's motion, centred on the pixel (the render is of the frame's
+/// pose, the middle of the exposure as far as the pose says): the taps are found once per pixel
+/// and applied to the three parts of the layer.
+TileResult motion_tile(const VirtualLayer& layer, const TileBox& box, const MotionField& motion) {
+  const int width = layer.coverage.width(), height = layer.coverage.height();
+  TileResult out;
+  const auto size = static_cast<std::size_t>(box.row1 - box.row0) * static_cast<std::size_t>(box.col1 - box.col0);
+  out.colour.reserve(size);
+  out.coverage.reserve(size);
+  out.delta.reserve(size);
+  std::vector<Tap> taps;
   for (int row = box.row0; row < box.row1; ++row)
     for (int col = box.col0; col < box.col1; ++col) {
       Float3 m = motion.at(float(row), float(col));
-      if (!std::isfinite(m.x) || !std::isfinite(m.y)) {
-        out.push_back(image(row, col));
-        continue;
-      }
       const float full = std::sqrt(m.x * m.x + m.y * m.y), length = std::min(full, kMaxMotionPx);
-      if (full > length) m = (length / full) * m;
-      const int samples = std::max(1, static_cast<int>(std::ceil(length)) + 1);
+      const int samples = std::isfinite(full) ? std::max(1, static_cast<int>(std::ceil(length)) + 1) : 1;
       if (samples == 1) {
-        out.push_back(image(row, col));
+        out.colour.push_back(layer.virtual_color(row, col));
+        out.coverage.push_back(layer.coverage(row, col));
+        out.delta.push_back(layer.delta(row, col));
         continue;
       }
-      T sum{};
+      if (full > length) m = (length / full) * m;
+      taps.clear();
       for (int k = 0; k < samples; ++k) {
         const float t = (float(k) + 0.5f) / float(samples) - 0.5f;
-        sum = sum + bilinear(image, float(row) + t * m.y, float(col) + t * m.x);
+        taps.push_back(tap_at(width, height, float(row) + t * m.y, float(col) + t * m.x));
       }
-      out.push_back((1.f / float(samples)) * sum);
+      const float weight = 1.f / float(samples);
+      Float3 colour, delta;
+      float coverage = 0.f;
+      for (const Tap& t : taps) {
+        colour += sample(layer.virtual_color.pixels(), t);
+        coverage += sample(layer.coverage.pixels(), t);
+        delta += sample(layer.delta.pixels(), t);
+      }
+      out.colour.push_back(weight * colour);
+      out.coverage.push_back(weight * coverage);
+      out.delta.push_back(weight * delta);
     }
   return out;
 }
 
-/// Applies `filter(image, box)` to the three parts of the layer over the active tiles: every
-/// tile reads the unchanged layer, then all are written back.
+/// Applies `filter(layer, box)` (a TileResult) over the active tiles: every tile reads the
+/// unchanged layer, then all are written back.
 template <class Filter>
 void filter_active_tiles(VirtualLayer& layer, const std::vector<std::uint8_t>& active, int columns, int threads,
                          const Filter& filter) {
@@ -146,20 +190,10 @@ void filter_active_tiles(VirtualLayer& layer, const std::vector<std::uint8_t>& a
     const int ty = static_cast<int>(t) / columns, tx = static_cast<int>(t) % columns;
     boxes.push_back({ty * kTile, std::min(height, (ty + 1) * kTile), tx * kTile, std::min(width, (tx + 1) * kTile)});
   }
-  struct Result {
-    std::vector<Float3> colour;
-    std::vector<float> coverage;
-    std::vector<Float3> delta;
-  };
-  std::vector<Result> results(boxes.size());
+  std::vector<TileResult> results(boxes.size());
   parallel_for_each_row(
       static_cast<int>(boxes.size()), threads,
-      [&](int b) {
-        const TileBox& box = boxes[static_cast<std::size_t>(b)];
-        results[static_cast<std::size_t>(b)] = {filter(layer.virtual_color, box), filter(layer.coverage, box),
-                                                filter(layer.delta, box)};
-      },
-      1);
+      [&](int b) { results[static_cast<std::size_t>(b)] = filter(layer, boxes[static_cast<std::size_t>(b)]); }, 1);
   for (std::size_t b = 0; b < boxes.size(); ++b) {
     const TileBox& box = boxes[b];
     std::size_t i = 0;
@@ -285,12 +319,15 @@ void blur_layer(VirtualLayer& layer, float sigma_px, const MotionField* motion, 
   const std::vector<std::uint8_t> active = active_tiles(layer, reach, columns, rows);
   if (defocus) {
     const std::vector<float> weights = gaussian_kernel(sigma_px);
-    filter_active_tiles(layer, active, columns, threads,
-                        [&](const auto& image, const TileBox& box) { return gaussian_tile(image, box, weights); });
+    filter_active_tiles(layer, active, columns, threads, [&](const VirtualLayer& source, const TileBox& box) {
+      return TileResult{gaussian_tile(source.virtual_color, box, weights), gaussian_tile(source.coverage, box, weights),
+                        gaussian_tile(source.delta, box, weights)};
+    });
   }
   if (moving) {
-    filter_active_tiles(layer, active, columns, threads,
-                        [&](const auto& image, const TileBox& box) { return motion_tile(image, box, *motion); });
+    filter_active_tiles(layer, active, columns, threads, [&](const VirtualLayer& source, const TileBox& box) {
+      return motion_tile(source, box, *motion);
+    });
   }
 }
 
