@@ -111,6 +111,42 @@ TEST(CameraLookCli, ThePebbleCarriesTheCamerasNoiseAndBlurAndNoneKeepsItAsRender
   EXPECT_FALSE(report.contains("camera_look"));
 }
 
+// --composite multiplicative through replay: the report says which rule ran; the two rules agree
+// wherever the virtual object changes nothing, and both darken its shadow.
+TEST(CameraLookCli, TheCompositeRuleReachesTheGraphAndTheReport) {
+  test::TempDir dir;
+  ASSERT_EQ(replay(dir.path() / "add", "--camera-artefacts none").exit_code, 0);
+  ASSERT_EQ(replay(dir.path() / "mul", "--camera-artefacts none --composite multiplicative").exit_code, 0);
+  const auto rule = [&](const char* run) {
+    return nlohmann::json::parse(read_text_file(dir.path() / run / "report.json"))["composite"]["rule"];
+  };
+  EXPECT_EQ(rule("add"), "additive");
+  EXPECT_EQ(rule("mul"), "multiplicative");
+  const auto frames = [&](const char* run, const char* suffix) {
+    return read_color(dir.path() / run / "frames" / (std::string("000002") + suffix));
+  };
+  const ColorImage add = frames("add", "_composite.png"), mul = frames("mul", "_composite.png");
+  const ColorImage camera = frames("add", "_color.png"), coverage = frames("add", "_virtual_coverage.png");
+  int unchanged = 0, same = 0, darker_both = 0, shadow = 0;
+  for (int r = 0; r < camera.height(); ++r)
+    for (int c = 0; c < camera.width(); ++c) {
+      if (coverage(r, c).r != 0) continue;
+      const int cam = camera(r, c).g, a = add(r, c).g, m = mul(r, c).g;
+      if (a == cam) {
+        ++unchanged;
+        same += std::abs(m - cam) <= 1;
+      }
+      if (a < cam - 10) {
+        ++shadow;
+        darker_both += m < cam - 5;
+      }
+    }
+  ASSERT_GT(unchanged, camera.width() * camera.height() / 2);
+  EXPECT_GT(same, unchanged * 99 / 100);
+  ASSERT_GT(shadow, 20) << "the pebble's shadow";
+  EXPECT_GT(darker_both, shadow * 9 / 10);
+}
+
 TEST(CameraLookCli, AnUnknownArtefactIsOneLine) {
   test::TempDir dir;
   expect_one_line_error(replay(dir.path() / "bad", "--camera-artefacts blur,grain"), 2);
