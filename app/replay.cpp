@@ -139,8 +139,7 @@ BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayO
   mapping.channel_swap = options.channel_swap;
   mapping.model = options.colormap_model;
   pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping));
-  pipeline.graph->emplace<render::MappedCompositeStage>(camera_look,
-                                                        options.composite.value_or(render::CompositeRule::Additive));
+  pipeline.graph->emplace<render::MappedCompositeStage>(camera_look, pipeline.composite_rule);
   pipeline.graph->keep(kCompositeMapped);
   return kCompositeMapped;
 }

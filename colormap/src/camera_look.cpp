@@ -59,17 +59,6 @@ std::vector<std::uint8_t> active_tiles(const VirtualLayer& layer, int reach, int
   return grown;
 }
 
-template <class T>
-T bilinear(const Image<T>& image, float row, float col) {
-  const float r = std::clamp(row, 0.f, float(image.height() - 1)), c = std::clamp(col, 0.f, float(image.width() - 1));
-  const int r0 = std::min(static_cast<int>(r), std::max(0, image.height() - 2));
-  const int c0 = std::min(static_cast<int>(c), std::max(0, image.width() - 2));
-  const int r1 = std::min(r0 + 1, image.height() - 1), c1 = std::min(c0 + 1, image.width() - 1);
-  const float fr = r - float(r0), fc = c - float(c0);
-  return (1.f - fr) * ((1.f - fc) * image(r0, c0) + fc * image(r0, c1)) +
-         fr * ((1.f - fc) * image(r1, c0) + fc * image(r1, c1));
-}
-
 /// One tile's share of a filter: `filter(row, col)` of every pixel of the tile, computed from
 /// the unchanged image and written back once every tile is done.
 struct TileBox {
@@ -79,29 +68,8 @@ struct TileBox {
 /// The separable Gaussian of `weights` over the tile (borders clamp to the image's edge).
 template <class T>
 std::vector<T> gaussian_tile(const Image<T>& image, const TileBox& box, const std::vector<float>& weights) {
-  const int radius = static_cast<int>(weights.size() / 2);
-  const int width = image.width(), height = image.height();
-  const int tile_width = box.col1 - box.col0, rows0 = box.row0 - radius, tall = box.row1 - box.row0 + 2 * radius;
-  std::vector<T> horizontal(static_cast<std::size_t>(tall) * static_cast<std::size_t>(tile_width));
-  for (int i = 0; i < tall; ++i) {
-    const int row = std::clamp(rows0 + i, 0, height - 1);
-    for (int j = 0; j < tile_width; ++j) {
-      T sum{};
-      for (std::size_t k = 0; k < weights.size(); ++k)
-        sum = sum + weights[k] * image(row, std::clamp(box.col0 + j + static_cast<int>(k) - radius, 0, width - 1));
-      horizontal[static_cast<std::size_t>(i) * static_cast<std::size_t>(tile_width) + static_cast<std::size_t>(j)] =
-          sum;
-    }
-  }
-  std::vector<T> out(static_cast<std::size_t>(box.row1 - box.row0) * static_cast<std::size_t>(tile_width));
-  for (int i = 0; i < box.row1 - box.row0; ++i)
-    for (int j = 0; j < tile_width; ++j) {
-      T sum{};
-      for (std::size_t k = 0; k < weights.size(); ++k)
-        sum = sum + weights[k] * horizontal[(static_cast<std::size_t>(i) + k) * static_cast<std::size_t>(tile_width) +
-                                            static_cast<std::size_t>(j)];
-      out[static_cast<std::size_t>(i) * static_cast<std::size_t>(tile_width) + static_cast<std::size_t>(j)] = sum;
-    }
+  std::vector<T> out(static_cast<std::size_t>(box.row1 - box.row0) * static_cast<std::size_t>(box.col1 - box.col0));
+  gaussian_blur_region(image, box.row0, box.row1, box.col0, box.col1, weights, std::span<T>(out));
   return out;
 }
 
@@ -133,6 +101,11 @@ template <class T>
 T sample(std::span<const T> pixels, const Tap& t) {
   return (1.f - t.fr) * ((1.f - t.fc) * pixels[t.i00] + t.fc * pixels[t.i01]) +
          t.fr * ((1.f - t.fc) * pixels[t.i10] + t.fc * pixels[t.i11]);
+}
+
+template <class T>
+T bilinear(const Image<T>& image, float row, float col) {
+  return sample(image.pixels(), tap_at(image.width(), image.height(), row, col));
 }
 
 /// A box filter along each pixel's motion, centred on the pixel (the render is of the frame's

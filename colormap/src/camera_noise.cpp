@@ -35,7 +35,6 @@ NoiseProfile estimate_camera_noise(const ColorImage& image, const NoiseEstimatio
   const int width = image.width(), height = image.height();
   if (width < 5 || height < 5) return profile;
   // Per band and channel, the operator's |response| at flat pixels.
-  // Per band and channel, the operator's |response| at flat pixels.
   std::array<std::array<std::vector<float>, 3>, kNoiseBands> responses;
   const int stride = std::max(1, options.stride);
   const float flat = static_cast<float>(options.flat_gradient);

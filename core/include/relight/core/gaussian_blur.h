@@ -2,8 +2,10 @@
 // The Gaussian point spread, separable, on any image of pixels that add and scale (float,
 // Float3): the camera's blur in synth, the estimators' pre-blur and the virtual layer's defocus.
 // Borders clamp to the edge pixel.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "relight/core/image.h"
@@ -23,30 +25,42 @@ namespace relight {
   return weights;
 }
 
+/// The Gaussian of `weights` (gaussian_kernel) over rows [row0, row1) x columns [col0, col1) of
+/// `image` (borders clamped to the edge pixel), written row-major to `out`, which holds the
+/// region: horizontally over the region's columns and the rows it reaches, then vertically.
+template <class ImageType>
+void gaussian_blur_region(const ImageType& image, int row0, int row1, int col0, int col1,
+                          const std::vector<float>& weights, std::span<typename ImageType::value_type> out) {
+  using Pixel = typename ImageType::value_type;
+  const int radius = static_cast<int>(weights.size() / 2);
+  const int width = image.width(), height = image.height();
+  const auto columns = static_cast<std::size_t>(col1 - col0);
+  const int tall = row1 - row0 + 2 * radius;
+  std::vector<Pixel> horizontal(static_cast<std::size_t>(tall) * columns);
+  for (int i = 0; i < tall; ++i) {
+    const int row = std::clamp(row0 - radius + i, 0, height - 1);
+    for (int j = 0; j < col1 - col0; ++j) {
+      Pixel sum{};
+      for (std::size_t k = 0; k < weights.size(); ++k)
+        sum = sum + weights[k] * image(row, std::clamp(col0 + j + static_cast<int>(k) - radius, 0, width - 1));
+      horizontal[static_cast<std::size_t>(i) * columns + static_cast<std::size_t>(j)] = sum;
+    }
+  }
+  for (std::size_t i = 0; i < static_cast<std::size_t>(row1 - row0); ++i)
+    for (std::size_t j = 0; j < columns; ++j) {
+      Pixel sum{};
+      for (std::size_t k = 0; k < weights.size(); ++k) sum = sum + weights[k] * horizontal[(i + k) * columns + j];
+      out[i * columns + j] = sum;
+    }
+}
+
 /// The image blurred by a Gaussian of `sigma` pixels (itself when sigma <= 0); any Image<Pixel>
 /// or image type derived from one (RadianceImage, ...).
 template <class ImageType>
 [[nodiscard]] ImageType gaussian_blur(const ImageType& image, double sigma, double reach = 3.0) {
-  using Pixel = typename ImageType::value_type;
   if (!(sigma > 0.0)) return image;
-  const std::vector<float> weights = gaussian_kernel(sigma, reach);
-  const int radius = static_cast<int>(weights.size() / 2);
-  const int width = image.width(), height = image.height();
-  ImageType horizontal(width, height), out(width, height);
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c) {
-      Pixel sum{};
-      for (std::size_t k = 0; k < weights.size(); ++k)
-        sum = sum + weights[k] * image(r, std::clamp(c + static_cast<int>(k) - radius, 0, width - 1));
-      horizontal(r, c) = sum;
-    }
-  for (int r = 0; r < height; ++r)
-    for (int c = 0; c < width; ++c) {
-      Pixel sum{};
-      for (std::size_t k = 0; k < weights.size(); ++k)
-        sum = sum + weights[k] * horizontal(std::clamp(r + static_cast<int>(k) - radius, 0, height - 1), c);
-      out(r, c) = sum;
-    }
+  ImageType out(image.width(), image.height());
+  gaussian_blur_region(image, 0, image.height(), 0, image.width(), gaussian_kernel(sigma, reach), out.pixels());
   return out;
 }
 
