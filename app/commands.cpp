@@ -151,8 +151,25 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   add_choice_option(command, "--real-albedo", options.real_albedo, kRealAlbedoNames,
                     "The k_d that real surfaces are rendered with: pixel (each camera pixel's own estimate, so "
                     "that the real-only render matches the camera's colours) or cluster (its material cluster's)");
-  command.add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light")
+  add_choice_option(command, "--tone-map", options.tone_map, colormap::kToneOperatorNames,
+                    "How rendered light becomes the camera's range: exposure (clamp(--exposure * L, 0, 1)) or "
+                    "reinhard (Reinhard's photographic operator, its key adapted to the rendered scene's average "
+                    "luminance over --tone-adaptation seconds: highlights roll off instead of clipping, for cameras "
+                    "that do not clip them either)");
+  command
+      .add_option("--exposure", options.exposure, "Tone-mapping exposure of the rendered light (--tone-map exposure)")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command
+      .add_option("--tone-key", options.tone_key,
+                  "--tone-map reinhard: the key, what the scene's log-average luminance maps to (0.18: middle grey)")
+      ->check(CLI::Range(0.001, 1.0))
+      ->default_str("0.18");
+  command
+      .add_option("--tone-adaptation", options.tone_adaptation_s,
+                  "--tone-map reinhard: seconds over which the key follows a change of the scene's light "
+                  "(exponential time constant; 0: every frame on its own)")
+      ->check(CLI::Range(0.0, 60.0))
       ->capture_default_str();
   command
       .add_option("--camera-artefacts", options.camera_artefacts,

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "mixed_reality_scene.h"
+#include "option_values.h"
 #include "relight/capture/tum_sequence.h"
 #include "relight/colormap/color_space.h"
 #include "relight/core/atomic_file.h"
@@ -24,6 +25,7 @@
 #include "relight/render/scene/scene_lights.h"
 #include "relight/synth/light_animation.h"
 #include "relight/truth/scene_from_synth.h"
+#include "tone_map_json.h"
 
 namespace relight::app {
 
@@ -46,7 +48,7 @@ struct RenderReferenceOptions {
   int max_bounces = 4;
   std::uint64_t seed = 1;
   int downsample = 1;
-  float exposure = 1.f;
+  colormap::ToneMapOptions tone_map;  ///< Reinhard's key from this frame's L_rv (nothing to adapt from)
   int threads = 0;
   fs::path out;
   bool quiet = false;
@@ -146,7 +148,8 @@ int run_render_reference(const RenderReferenceOptions& command) {
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const render::DifferentialImages images = tracer.images();
 
-  const colormap::ToneMap tone_map{command.exposure};
+  const colormap::ToneMap tone_map =
+      colormap::adapt_tone_map(command.tone_map, colormap::scene_luminance(images.real_virtual), nullptr, 0.0);
   const ColorImage composite = render::differential_composite(downsample_color(frame.color, command.downsample),
                                                               images.real_virtual, images.real, images.virtual_coverage,
                                                               tone_map);
@@ -154,22 +157,23 @@ int run_render_reference(const RenderReferenceOptions& command) {
   write_radiance(sibling(command.out, ".Lr.exr"), images.real);
   write_color(sibling(command.out, ".composite.png"), composite);
   const double mrays = static_cast<double>(tracer.rays_traced()) / 1e6 / seconds;
-  nlohmann::ordered_json summary = {
-      {"sequence", fs::absolute(command.sequence).string()},
-      {"frame", command.frame},
-      {"width", camera.intrinsics.width},
-      {"height", camera.intrinsics.height},
-      {"object", command.object.empty() ? "" : fs::absolute(command.object).string()},
-      {"placement", placement_text},
-      {"samples_per_pixel", images.samples_per_pixel},
-      {"max_bounces", command.max_bounces},
-      {"seed", command.seed},
-      {"seconds", seconds},
-      {"rays", tracer.rays_traced()},
-      {"mrays_per_s", mrays},
-      {"tone_map", {{"operator", "clamp(exposure * L, 0, 1)"}, {"exposure", command.exposure}}},
-      {"outputs", {{"L_rv", command.out.filename().string()}, {"L_r", sibling(command.out, ".Lr.exr").filename().string()},
-                   {"composite", sibling(command.out, ".composite.png").filename().string()}}}};
+  nlohmann::ordered_json summary = {{"sequence", fs::absolute(command.sequence).string()},
+                                    {"frame", command.frame},
+                                    {"width", camera.intrinsics.width},
+                                    {"height", camera.intrinsics.height},
+                                    {"object", command.object.empty() ? "" : fs::absolute(command.object).string()},
+                                    {"placement", placement_text},
+                                    {"samples_per_pixel", images.samples_per_pixel},
+                                    {"max_bounces", command.max_bounces},
+                                    {"seed", command.seed},
+                                    {"seconds", seconds},
+                                    {"rays", tracer.rays_traced()},
+                                    {"mrays_per_s", mrays},
+                                    {"tone_map", tone_map_json(command.tone_map, tone_map)},
+                                    {"outputs",
+                                     {{"L_rv", command.out.filename().string()},
+                                      {"L_r", sibling(command.out, ".Lr.exr").filename().string()},
+                                      {"composite", sibling(command.out, ".composite.png").filename().string()}}}};
   write_file_atomically(sibling(command.out, ".json"), summary.dump(2) + "\n");
   if (!command.quiet)
     std::cerr << "relight render-reference: " << images.samples_per_pixel << " spp at " << camera.intrinsics.width << "x"
@@ -206,9 +210,15 @@ void register_render_reference(CLI::App& app, Runners& runners) {
   command->add_option("--downsample", options->downsample, "Render at 1/N of the camera resolution")
       ->check(CLI::IsMember({1, 2, 4, 8}))
       ->capture_default_str();
-  command->add_option("--exposure", options->exposure, "Tone-mapping exposure for the composite")
+  add_choice_option(*command, "--tone-map", options->tone_map.op, colormap::kToneOperatorNames,
+                    "The composite's tone mapping: exposure (clamp(--exposure * L, 0, 1)) or reinhard (Reinhard's "
+                    "operator with --tone-key over this frame's log-average luminance of L_rv), as relight replay");
+  command->add_option("--exposure", options->tone_map.exposure, "Tone-mapping exposure for the composite (exposure)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  command->add_option("--tone-key", options->tone_map.key, "--tone-map reinhard: the key (0.18: middle grey)")
+      ->check(CLI::Range(0.001, 1.0))
+      ->default_str("0.18");
   command->add_option("--threads", options->threads, "Render threads (0 = all cores)")->check(CLI::NonNegativeNumber);
   command->add_option("--out", options->out,
                       "L_rv as OUT.exr; beside it OUT.Lr.exr, OUT.composite.png and OUT.json (spp, time, Mrays/s)")

@@ -29,6 +29,7 @@
 #include "relight/capture/source_stage.h"
 #include "relight/capture/tum_sequence.h"
 #include "relight/colormap/colormap_stages.h"
+#include "relight/colormap/tone_map_stage.h"
 #include "relight/core/atomic_file.h"
 #include "relight/core/buffers.h"
 #include "relight/core/error.h"
@@ -48,6 +49,7 @@
 #include "relight/vk/transfer.h"
 #include "report.h"
 #include "report_collector_stage.h"
+#include "tone_map_json.h"
 #include "video_writer_stage.h"
 #include "view_stage.h"
 
@@ -131,14 +133,15 @@ std::optional<capture::TagLayout> marker_layout(const ReplayOptions& options) {
 /// The colour mapping between DIR's L_rv/L_r and the camera, and its composite; returns the
 /// buffer that holds the final picture (DIR's own composite when there is no mapping).
 BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel,
-                                         const colormap::ToneMap& tone_map, bool camera_look) {
+                                         bool camera_look) {
   const auto method = options.colormap;
   if (method == colormap::ColorMapMethod::None) return kComposite;  // DIR's own composite is unmapped
   colormap::SampleMappingOptions mapping;
-  mapping.tone_map = tone_map;
   mapping.channel_swap = options.channel_swap;
   mapping.model = options.colormap_model;
-  pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping));
+  colormap::ColorMapBuffers buffers;
+  buffers.tone_map = colormap::kToneMap;  // the tone_map stage's, every frame
+  pipeline.graph->add(colormap::make_color_map_stage(method, per_pixel, pipeline.vulkan.get(), mapping, buffers));
   pipeline.graph->emplace<render::MappedCompositeStage>(camera_look, pipeline.composite_rule);
   pipeline.graph->keep(kCompositeMapped);
   return kCompositeMapped;
@@ -192,7 +195,10 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.bounces = options.vpl_bounces;
   dir.vpls.bounce_method = options.bounce_method;
   dir.vpls.source = options.vpl_source;
-  dir.tone_map.exposure = options.exposure;
+  dir.tone_map = {.op = options.tone_map,
+                  .exposure = options.exposure,
+                  .key = options.tone_key,
+                  .adaptation_s = options.tone_adaptation_s};
   render::CameraLookOptions look;
   look.artefacts = colormap::parse_camera_artefacts(options.camera_artefacts);
   look.exposure_time_s = options.exposure_time_s;
@@ -209,9 +215,12 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.renderer.shadow_tile = 256;
   // DIR rasterises: on Vulkan wherever a device exists, lavapipe included (vk::StageKind).
   const Backend rendering = vk::choose_backend(vk::StageKind::Rasterisation, pipeline.vulkan.get(), options.backend);
-  pipeline.camera_look = render::add_dir_stages(graph, rendering, pipeline.vulkan.get(), std::move(content), dir);
+  const render::DirStages stages =
+      render::add_dir_stages(graph, rendering, pipeline.vulkan.get(), std::move(content), dir);
+  pipeline.camera_look = stages.camera_look;
+  pipeline.tone_map = stages.tone_map;
   graph.keep(kComposite);
-  pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, dir.tone_map, look.artefacts.any());
+  pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, look.artefacts.any());
   if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", pipeline.final_composite);
   pipeline.renders = true;
 }
@@ -309,6 +318,7 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
     report["composite"] = {{"rule", name_of(render::kCompositeRuleNames, pipeline.composite_rule)}};
   }
   if (pipeline.camera_look) report["camera_look"] = camera_look_json(pipeline.camera_look->summary());
+  if (pipeline.tone_map) report["tone_map"] = tone_map_json(pipeline.tone_map->options(), pipeline.tone_map->last());
   report["latency_ms"] = pipeline.latency->summary();
   if (pipeline.placement) {
     report["placements"] = pipeline.placement->summary();

@@ -91,7 +91,10 @@ struct ReplayOptions {
   render::BounceMethod bounce_method = render::BounceMethod::RayTraced;  ///< how bounces >= 2 find surfaces
   render::VplSource vpl_source = render::VplSource::RayTraced;           ///< where spot lights' first VPLs come from
   RealAlbedo real_albedo = RealAlbedo::Pixel;
-  float exposure = 1.f;                        ///< tone mapping of the rendered light
+  float exposure = 1.f;  ///< tone mapping of the rendered light (exposure operator)
+  colormap::ToneOperator tone_map = colormap::ToneOperator::Exposure;  ///< --tone-map (colormap/tone_map.h)
+  double tone_key = 0.18;                                              ///< Reinhard's key a
+  double tone_adaptation_s = 0.5;                                      ///< Reinhard's adaptation time constant
   /// The camera's artefacts on the virtual layer (--camera-artefacts, colormap/camera_look.h).
   std::string camera_artefacts = "all";
   double exposure_time_s = 1.0 / 30.0;         ///< the colour camera's exposure (motion blur)
@@ -130,6 +133,7 @@ struct ReplayPipeline {
   brdf::LightEstimationStage* light_estimation = nullptr;  ///< set with --lights estimate
   render::CompositeRule composite_rule = render::CompositeRule::Additive;  ///< as resolved for this run
   render::CameraLookStage* camera_look = nullptr;          ///< set with --camera-artefacts other than none
+  colormap::ToneMapStage* tone_map = nullptr;              ///< set when the DIR stage is in the graph
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
   int extracted_lights = 0;                       ///< lights extracted per frame (probe or estimate); 0: none

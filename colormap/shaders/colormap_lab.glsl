@@ -13,7 +13,13 @@ const float kDelta = 6.0 / 29.0;
 const float kDeltaCubed = kDelta * kDelta * kDelta;
 const float kLinearSlope = 1.0 / (3.0 * kDelta * kDelta);
 
-vec3 tone_map(vec3 linear, float exposure) { return clamp(exposure * linear, 0.0, 1.0); }
+// tone_map.h: clamp(s * c * (1 + L / L_white^2) / (1 + L), 0, 1) with L = k * max channel of s * c.
+vec3 tone_map(vec3 linear, ColormapToneMap tm) {
+  const vec3 scaled = tm.exposure * linear;
+  const float l = max(0.0, tm.compression * max(max(scaled.x, scaled.y), scaled.z));
+  const float f = (1.0 + l * tm.inverse_white_squared) / (1.0 + l);
+  return clamp(scaled * f, 0.0, 1.0);
+}
 
 float lab_g(float t) { return t > kDeltaCubed ? pow(t, 1.0 / 3.0) : t * kLinearSlope + 4.0 / 29.0; }
 float lab_g_inverse(float u) { return u > kDelta ? u * u * u : (u - 4.0 / 29.0) / kLinearSlope; }

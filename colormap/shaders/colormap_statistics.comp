@@ -30,7 +30,7 @@ void main() {
     const vec3 r = vec3(real[3 * pixel], real[3 * pixel + 1], real[3 * pixel + 2]);
     const vec3 rv = vec3(real_virtual[3 * pixel], real_virtual[3 * pixel + 1], real_virtual[3 * pixel + 2]);
     const uvec3 c = uvec3(camera_byte(3 * pixel), camera_byte(3 * pixel + 1), camera_byte(3 * pixel + 2));
-    const vec3 mapped = tone_map(r, params.exposure);
+    const vec3 mapped = tone_map(r, params.tone_map);
     const bool valid = is_finite(r.x) && is_finite(r.y) && is_finite(r.z) && all(equal(r, rv)) &&
                        any(notEqual(c, uvec3(0))) && any(greaterThan(mapped, vec3(0.0)));
     if (valid) {

@@ -12,7 +12,7 @@ layout(std430, set = 0, binding = 2) writeonly buffer Delta { float delta[]; };
 layout(push_constant) uniform Push { ColormapTransferParams params; };
 
 vec3 tau_st(vec3 radiance) {
-  const vec3 lab = linear_srgb_to_lab(tone_map(radiance, params.exposure));
+  const vec3 lab = linear_srgb_to_lab(tone_map(radiance, params.tone_map));
   const vec3 scale = vec3(params.scale[0], params.scale[1], params.scale[2]);
   const vec3 offset = vec3(params.offset[0], params.offset[1], params.offset[2]);
   return lab_to_linear_srgb(scale * lab + offset);

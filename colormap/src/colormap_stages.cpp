@@ -6,35 +6,33 @@
 
 namespace relight::colormap {
 
-namespace {
-
-struct Inputs {
-  Read<RadianceImage> real, real_virtual;
-  Read<ColorImage> camera;
-};
-
-Inputs declare_inputs(StageBuilder& builder, const ColorMapBuffers& buffers) {
-  return {builder.read(buffers.real), builder.read(buffers.real_virtual), builder.read(buffers.camera)};
+ColorMapInputs ColorMapInputs::declare(StageBuilder& builder, const ColorMapBuffers& buffers, bool camera) {
+  ColorMapInputs inputs;
+  inputs.real = builder.read(buffers.real);
+  inputs.real_virtual = builder.read(buffers.real_virtual);
+  if (camera) inputs.camera = builder.read(buffers.camera);
+  if (buffers.tone_map) inputs.tone_map = builder.read(*buffers.tone_map);
+  return inputs;
 }
 
-}  // namespace
+ToneMap ColorMapInputs::frame_tone_map(StageContext& context, const ToneMap& fixed) const {
+  return tone_map ? context.get(*tone_map) : fixed;
+}
 
 StatisticsColorMapCpuStage::StatisticsColorMapCpuStage(ToneMap tm, ColorMapBuffers buffers)
     : tm_(tm), buffers_(std::move(buffers)) {}
 
 void StatisticsColorMapCpuStage::declare(StageBuilder& builder) {
-  const Inputs inputs = declare_inputs(builder, buffers_);
-  real_ = inputs.real;
-  real_virtual_ = inputs.real_virtual;
-  camera_ = inputs.camera;
+  inputs_ = ColorMapInputs::declare(builder, buffers_);
   delta_ = builder.write(buffers_.delta);
   mapping_ = builder.write(buffers_.mapping);
 }
 
 void StatisticsColorMapCpuStage::run(StageContext& context) {
-  transfer_ = statistics_color_map(context.get(real_), context.get(real_virtual_), context.get(camera_), tm_,
-                                   context.get(delta_));
-  context.get(mapping_) = ColorMapping::of_statistics(transfer_, tm_);
+  const ToneMap tm = inputs_.frame_tone_map(context, tm_);
+  transfer_ = statistics_color_map(context.get(inputs_.real), context.get(inputs_.real_virtual),
+                                   context.get(inputs_.camera), tm, context.get(delta_));
+  context.get(mapping_) = ColorMapping::of_statistics(transfer_, tm);
 }
 
 StatisticsColorMapVkStage::StatisticsColorMapVkStage(vk::VulkanContext& context, ToneMap tm, ColorMapBuffers buffers)
@@ -43,23 +41,22 @@ StatisticsColorMapVkStage::StatisticsColorMapVkStage(vk::VulkanContext& context,
 }
 
 void StatisticsColorMapVkStage::declare(StageBuilder& builder) {
-  const Inputs inputs = declare_inputs(builder, buffers_);
-  real_ = inputs.real;
-  real_virtual_ = inputs.real_virtual;
-  camera_ = inputs.camera;
+  inputs_ = ColorMapInputs::declare(builder, buffers_);
   delta_ = builder.write(buffers_.delta);
   mapping_ = builder.write(buffers_.mapping);
 }
 
 void StatisticsColorMapVkStage::run(StageContext& context) {
-  const RadianceImage& real_shape = context.shape_of(real_);
+  mapper_.set_tone_map(inputs_.frame_tone_map(context, mapper_.tone_map()));
+  const RadianceImage& real_shape = context.shape_of(inputs_.real);
   const int width = real_shape.width(), height = real_shape.height();
-  if (!real_shape.same_shape(context.shape_of(real_virtual_)) || !real_shape.same_shape(context.shape_of(camera_))) {
+  if (!real_shape.same_shape(context.shape_of(inputs_.real_virtual)) ||
+      !real_shape.same_shape(context.shape_of(inputs_.camera))) {
     throw Error("colormap_statistics: L_r, L_rv and the camera image must have the same size");
   }
-  auto& real = context.device_read<vk::VulkanBuffer>(real_);
-  auto& real_virtual = context.device_read<vk::VulkanBuffer>(real_virtual_);
-  auto& camera = context.device_read<vk::VulkanBuffer>(camera_);
+  auto& real = context.device_read<vk::VulkanBuffer>(inputs_.real);
+  auto& real_virtual = context.device_read<vk::VulkanBuffer>(inputs_.real_virtual);
+  auto& camera = context.device_read<vk::VulkanBuffer>(inputs_.camera);
   auto& delta = context.device_write<vk::VulkanBuffer>(delta_, [&](RadianceImage& out) { out.resize(width, height); });
   transfer_ = mapper_.run(real, real_virtual, camera, delta, width, height);
   context.get(mapping_) = ColorMapping::of_statistics(transfer_, mapper_.tone_map());
@@ -70,17 +67,15 @@ SampleColorMapStage::SampleColorMapStage(SampleMappingOptions options, ColorMapB
     : mapper_(options), buffers_(std::move(buffers)) {}
 
 void SampleColorMapStage::declare(StageBuilder& builder) {
-  const Inputs inputs = declare_inputs(builder, buffers_);
-  real_ = inputs.real;
-  real_virtual_ = inputs.real_virtual;
-  camera_ = inputs.camera;
+  inputs_ = ColorMapInputs::declare(builder, buffers_);
   delta_ = builder.write(buffers_.delta);
   mapping_ = builder.write(buffers_.mapping);
 }
 
 void SampleColorMapStage::run(StageContext& context) {
-  const ColorMatrix& coefficients =
-      mapper_.map(context.get(real_), context.get(real_virtual_), context.get(camera_), context.get(delta_));
+  mapper_.set_tone_map(inputs_.frame_tone_map(context, mapper_.options().tone_map));
+  const ColorMatrix& coefficients = mapper_.map(context.get(inputs_.real), context.get(inputs_.real_virtual),
+                                                context.get(inputs_.camera), context.get(delta_));
   context.get(mapping_) = ColorMapping::of_matrix(coefficients, mapper_.options().tone_map);
 }
 
@@ -88,15 +83,16 @@ IdentityColorMapStage::IdentityColorMapStage(ToneMap tm, ColorMapBuffers buffers
     : tm_(tm), buffers_(std::move(buffers)) {}
 
 void IdentityColorMapStage::declare(StageBuilder& builder) {
-  real_ = builder.read(buffers_.real);
-  real_virtual_ = builder.read(buffers_.real_virtual);
+  inputs_ = ColorMapInputs::declare(builder, buffers_, false);
   delta_ = builder.write(buffers_.delta);
   mapping_ = builder.write(buffers_.mapping);
 }
 
 void IdentityColorMapStage::run(StageContext& context) {
-  sample_delta(context.get(real_), context.get(real_virtual_), identity_color_matrix(), tm_, context.get(delta_));
-  context.get(mapping_) = ColorMapping::of_matrix(identity_color_matrix(), tm_);
+  const ToneMap tm = inputs_.frame_tone_map(context, tm_);
+  sample_delta(context.get(inputs_.real), context.get(inputs_.real_virtual), identity_color_matrix(), tm,
+               context.get(delta_));
+  context.get(mapping_) = ColorMapping::of_matrix(identity_color_matrix(), tm);
 }
 
 void ColorMapCompositeStage::declare(StageBuilder& builder) {

@@ -20,6 +20,10 @@ namespace {
 constexpr std::uint32_t kGroup = RELIGHT_COLORMAP_STATS_GROUP;
 constexpr std::uint32_t kStride = RELIGHT_COLORMAP_SUMS_STRIDE;
 
+gpu::ColormapToneMap shader_tone_map(const ToneMap& tm) {
+  return {tm.exposure, compression(tm), tm.inverse_white_squared};
+}
+
 std::uint32_t checked_pixels(int width, int height) {
   if (width < 0 || height < 0) throw Error("colormap (Vulkan): negative image size");
   const auto pixels = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
@@ -72,7 +76,7 @@ LabSums StatisticsColorMapVk::reduce(const vk::VulkanBuffer& real, const vk::Vul
   const std::uint32_t groups = vk::ComputePipeline::group_count(pixels, kGroup);
   const std::size_t sums_bytes = static_cast<std::size_t>(groups) * kStride * sizeof(float);
   if (!pipelines_->sums || pipelines_->sums->size_bytes() < sums_bytes) pipelines_->sums.emplace(context_, sums_bytes);
-  const gpu::ColormapStatisticsParams params{pixels, tm_.exposure};
+  const gpu::ColormapStatisticsParams params{pixels, shader_tone_map(tm_)};
   const auto set = pipelines_->statistics.bind({&real, &real_virtual, &camera, &*pipelines_->sums});
   context_.submit([&](VkCommandBuffer cmd) {
     pipelines_->timer.start(cmd);
@@ -106,7 +110,7 @@ void StatisticsColorMapVk::transfer(const vk::VulkanBuffer& real, const vk::Vulk
   if (pixels == 0) return;
   gpu::ColormapTransferParams params{};
   params.pixels = pixels;
-  params.exposure = tm_.exposure;
+  params.tone_map = shader_tone_map(tm_);
   for (int k = 0; k < 3; ++k) {
     params.scale[k] = transfer.scale[k];
     params.offset[k] = transfer.offset[k];

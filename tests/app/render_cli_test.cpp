@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
@@ -40,6 +41,39 @@ TEST(RenderReferenceCli, WritesLrvLrCompositeAndSummary) {
   const auto summary = nlohmann::json::parse(read_text_file(dir.path() / "nested" / "ref.json"));
   EXPECT_EQ(summary["samples_per_pixel"], 2);
   EXPECT_GT(summary["mrays_per_s"].get<double>(), 0.0);
+}
+
+// The path tracer's composite takes the same operators as replay's: Reinhard's key from the
+// traced L_rv itself (eq. 1 over its lit pixels), the highlight rolled off below the clamp's.
+TEST(RenderReferenceCli, ReinhardTakesItsKeyFromTheTracedImage) {
+  test::TempDir dir;
+  const std::string common = "render-reference --quiet --sequence " + synthetic_sequence().string() + " --object " +
+                             (kData / "models" / "glossy_pebble.gltf").string() + " --spp 2 --downsample 8";
+  ASSERT_EQ(relight(common + " --out " + (dir.path() / "clamp.exr").string()).exit_code, 0);
+  const auto result =
+      relight(common + " --tone-map reinhard --tone-key 0.25 --out " + (dir.path() / "rh.exr").string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto tm = nlohmann::json::parse(read_text_file(dir.path() / "rh.json"))["tone_map"];
+  EXPECT_EQ(tm["operator"], "reinhard") << tm.dump();
+  const RadianceImage lrv = read_radiance(dir.path() / "rh.exr");
+  double log_sum = 0.0, brightest = 0.0;
+  int lit = 0;
+  for (const Float3& p : lrv.pixels()) {
+    const double y = luminance(p);
+    if (!(y > 0.0)) continue;
+    log_sum += std::log(1e-6 + y), ++lit;
+    brightest = std::max<double>({brightest, p.x, p.y, p.z});
+  }
+  ASSERT_GT(lit, 100);
+  // The summary's log average is over every second pixel of every second row: within a few %.
+  EXPECT_NEAR(tm["log_average_luminance"].get<double>(), std::exp(log_sum / lit), 0.05 * std::exp(log_sum / lit));
+  EXPECT_NEAR(tm["scale"].get<double>(), 0.25 / tm["log_average_luminance"].get<double>(), 1e-4);
+  EXPECT_LE(tm["white"].get<double>(), brightest + 1e-4);
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(dir.path() / "clamp.json"))["tone_map"]["operator"], "exposure");
+  const ColorImage reinhard = read_color(dir.path() / "rh.composite.png");
+  int full = 0;
+  for (const Rgb8& p : reinhard.pixels()) full += std::max({p.r, p.g, p.b}) == 255;
+  EXPECT_LT(full, 8) << "at most the white's pixels reach 255";
 }
 
 TEST(RenderReferenceCli, VirtualLightBrightensOnlyLrv) {

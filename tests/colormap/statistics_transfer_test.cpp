@@ -159,37 +159,53 @@ void expect_statistics_near(const LabStatistics& fast, const LabStatistics& refe
   }
 }
 
+void expect_fast_mapping_matches_reference(const truth::SyntheticTriple& triple, const ToneMap& tm) {
+  const ReinhardTransfer reference = ReinhardTransfer::from(
+      statistics_from_sums(test::masked_lab_sums_reference(triple.real, triple.real_virtual, triple.camera, tm)));
+  const RadianceImage reference_delta =
+      test::statistics_delta_reference(triple.real, triple.real_virtual, reference, tm);
+  RadianceImage delta;
+  const ReinhardTransfer fast = statistics_color_map(triple.real, triple.real_virtual, triple.camera, tm, delta);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_NEAR(fast.scale[k], reference.scale[k], 1e-5f * reference.scale[k]) << k;
+    EXPECT_NEAR(fast.offset[k], reference.offset[k], 1e-3f) << k;
+  }
+  float worst = 0.f;
+  for (std::size_t i = 0; i < delta.size(); ++i) {
+    const Float3 d = delta.pixels()[i] - reference_delta.pixels()[i];
+    worst = std::max({worst, std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
+  }
+  EXPECT_LT(worst, 1e-5f);
+  EXPECT_NEAR(test::virtual_delta_e(triple, delta), test::virtual_delta_e(triple, reference_delta), 1e-3);
+}
+
+/// Both operators of tone_map.h: the exposure clamp, and Reinhard's with a scale and a white that
+/// compress the triples' range (so the eight-lane and GLSL versions of the factor are exercised).
+std::vector<ToneMap> both_tone_maps() {
+  return {ToneMap{}, ToneMap{.op = ToneOperator::Reinhard, .exposure = 1.7f, .inverse_white_squared = 0.25f}};
+}
+
 TEST(StatisticsTransfer, FastStatisticsMatchThePlainReference) {
-  for (const truth::SyntheticTriple& triple : {test::orange_triple(), test::green_triple(), triple_with_invalid_pixels()}) {
-    const TransferStatistics reference =
-        statistics_from_sums(test::masked_lab_sums_reference(triple.real, triple.real_virtual, triple.camera, {}));
-    const TransferStatistics fast = masked_lab_statistics(triple.real, triple.real_virtual, triple.camera, {});
-    ASSERT_GT(reference.source.count, 1000);
-    // Lab units: fast_cbrt's 5e-7 relative is at most 116 * 5e-7 = 6e-5 in L* per pixel.
-    expect_statistics_near(fast.source, reference.source, 1e-4);
-    expect_statistics_near(fast.target, reference.target, 1e-4);
+  for (const ToneMap& tm : both_tone_maps()) {
+    for (const truth::SyntheticTriple& triple :
+         {test::orange_triple(), test::green_triple(), triple_with_invalid_pixels()}) {
+      const TransferStatistics reference =
+          statistics_from_sums(test::masked_lab_sums_reference(triple.real, triple.real_virtual, triple.camera, tm));
+      const TransferStatistics fast = masked_lab_statistics(triple.real, triple.real_virtual, triple.camera, tm);
+      ASSERT_GT(reference.source.count, 1000);
+      // Lab units: fast_cbrt's 5e-7 relative is at most 116 * 5e-7 = 6e-5 in L* per pixel.
+      expect_statistics_near(fast.source, reference.source, 1e-4);
+      expect_statistics_near(fast.target, reference.target, 1e-4);
+    }
   }
 }
 
 TEST(StatisticsTransfer, FastMappingMatchesThePlainReference) {
-  for (const truth::SyntheticTriple* triple : {&test::orange_triple(), &test::green_triple()}) {
-    const ReinhardTransfer reference = ReinhardTransfer::from(
-        statistics_from_sums(test::masked_lab_sums_reference(triple->real, triple->real_virtual, triple->camera, {})));
-    const RadianceImage reference_delta =
-        test::statistics_delta_reference(triple->real, triple->real_virtual, reference, {});
-    RadianceImage delta;
-    const ReinhardTransfer fast = statistics_color_map(triple->real, triple->real_virtual, triple->camera, {}, delta);
-    for (std::size_t k = 0; k < 3; ++k) {
-      EXPECT_NEAR(fast.scale[k], reference.scale[k], 1e-5f * reference.scale[k]) << k;
-      EXPECT_NEAR(fast.offset[k], reference.offset[k], 1e-3f) << k;
+  for (const ToneMap& tm : both_tone_maps()) {
+    for (const truth::SyntheticTriple* triple : {&test::orange_triple(), &test::green_triple()}) {
+      SCOPED_TRACE(tm.op == ToneOperator::Reinhard ? "reinhard" : "exposure");
+      expect_fast_mapping_matches_reference(*triple, tm);
     }
-    float worst = 0.f;
-    for (std::size_t i = 0; i < delta.size(); ++i) {
-      const Float3 d = delta.pixels()[i] - reference_delta.pixels()[i];
-      worst = std::max({worst, std::fabs(d.x), std::fabs(d.y), std::fabs(d.z)});
-    }
-    EXPECT_LT(worst, 1e-5f);
-    EXPECT_NEAR(test::virtual_delta_e(*triple, delta), test::virtual_delta_e(*triple, reference_delta), 1e-3);
   }
 }
 
@@ -219,20 +235,20 @@ TEST(StatisticsTransfer, MismatchedSizesAreAClearError) {
 
 class StatisticsTransferVulkan : public ::relight::test::VulkanTest {};
 
-TEST_F(StatisticsTransferVulkan, ReductionAndTransferMatchTheCpuReference) {
-  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+void expect_vulkan_matches_cpu(vk::VulkanContext& context, const ToneMap& tm) {
   const auto& triple = test::orange_triple();
   StatisticsColorMapVk vulkan(context);
+  vulkan.set_tone_map(tm);
   RadianceImage gpu_delta;
   const ReinhardTransfer gpu = vulkan.run(triple.real, triple.real_virtual, triple.camera, gpu_delta);
-  const TransferStatistics cpu_stats = masked_lab_statistics(triple.real, triple.real_virtual, triple.camera, {});
+  const TransferStatistics cpu_stats = masked_lab_statistics(triple.real, triple.real_virtual, triple.camera, tm);
   const ReinhardTransfer cpu = ReinhardTransfer::from(cpu_stats);
   for (int k = 0; k < 3; ++k) {
     EXPECT_NEAR(gpu.scale[k], cpu.scale[k], 1e-4f * std::fabs(cpu.scale[k])) << k;
     EXPECT_NEAR(gpu.offset[k], cpu.offset[k], 2e-3f) << k;
   }
   RadianceImage cpu_delta;
-  statistics_delta(triple.real, triple.real_virtual, cpu, {}, cpu_delta);
+  statistics_delta(triple.real, triple.real_virtual, cpu, tm, cpu_delta);
   ASSERT_TRUE(gpu_delta.same_shape(cpu_delta));
   float worst = 0.f;
   for (std::size_t i = 0; i < cpu_delta.size(); ++i) {
@@ -241,6 +257,14 @@ TEST_F(StatisticsTransferVulkan, ReductionAndTransferMatchTheCpuReference) {
   }
   EXPECT_LT(worst, 1e-4f);
   EXPECT_GT(test::virtual_delta_e(triple, cpu_delta), 0.0);
+}
+
+TEST_F(StatisticsTransferVulkan, ReductionAndTransferMatchTheCpuReference) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  for (const ToneMap& tm : both_tone_maps()) {
+    SCOPED_TRACE(tm.op == ToneOperator::Reinhard ? "reinhard" : "exposure");
+    expect_vulkan_matches_cpu(context, tm);
+  }
 }
 
 TEST_F(StatisticsTransferVulkan, CountsAreExactWithAPartialLastWorkGroup) {

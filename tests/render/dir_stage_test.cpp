@@ -57,7 +57,7 @@ StageRun run_stage(vk::VulkanContext* context, std::optional<EnvironmentLight> e
   graph.keep("vpls");
   graph.compile();
   EXPECT_EQ(graph.execution_order(),
-            (std::vector<std::string>{"synthetic_frame", "mr_scene", "vpls", "dir", "indirect_smoothing",
+            (std::vector<std::string>{"synthetic_frame", "mr_scene", "vpls", "dir", "indirect_smoothing", "tone_map",
                                       "differential_composite"}));
   EXPECT_TRUE(graph.run_frame());
   const MrScene& scene = *graph.find<MrScene>("mr_scene");

@@ -48,8 +48,6 @@ std::vector<Vpl> make_vpls(const MrScene& scene, int count) {
   return generate_vpls(scene, RayTracer(scene), options);
 }
 
-float luminance(const Float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 // Interleaved sampling (n = 4) and the merge against every pixel seeing every VPL (n = 1), on
 // the CPU mirror: the merged indirect light's mean relative error where the 4 x 4 window crosses
 // an edge (a neighbour on another surface), and elsewhere. Measured (160x120, 64 light

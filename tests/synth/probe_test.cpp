@@ -26,8 +26,6 @@ const ProbeFixture& fixture() {
   return f;
 }
 
-double luminance(const Float3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
-
 TEST(Probe, BrightestPixelsLieInTheDirectionOfTheLights) {
   const ProbeFixture& f = fixture();
   std::vector<std::pair<double, int>> ranked;

@@ -104,10 +104,4 @@ ColorImage mapped_differential_composite(const ColorImage& camera, const Radianc
       camera, separated_layer(virtual_coverage, options.virtual_centre, mapped, difference), options.look);
 }
 
-ColorImage tone_mapped_preview(const RadianceImage& radiance, const colormap::ToneMap& tone_map) {
-  ColorImage out(radiance.width(), radiance.height());
-  for (std::size_t i = 0; i < out.size(); ++i) out.pixels()[i] = colormap::encode_srgb8(colormap::tone_map(radiance.pixels()[i], tone_map));
-  return out;
-}
-
 }  // namespace relight::render

@@ -1,6 +1,7 @@
 #include "relight/render/dir/dir_stage.h"
 
 #include "relight/colormap/buffers.h"
+#include "relight/colormap/tone_map_stage.h"
 #include "relight/core/error.h"
 #include "relight/render/dir/camera_albedo.h"
 #include "relight/render/dir/composite.h"
@@ -43,17 +44,19 @@ MrCamera frame_camera(const FrameInfo& frame, int width, int height) {
 
 }  // namespace
 
-CameraLookStage* add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* given_context,
-                                DirSceneContent content, const DirStageOptions& options) {
+DirStages add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* given_context, DirSceneContent content,
+                         const DirStageOptions& options) {
   vk::VulkanContext* context = context_for_backend(backend, given_context, "add_dir_stages");
   graph.emplace<MrSceneStage>(std::move(content), options);
   graph.emplace<VplStage>(options.vpls, context);
   graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffers, options.edge_samples);
   graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
   const bool camera_look = options.camera_look && options.camera_look->artefacts.any();
-  CameraLookStage* look = camera_look ? &graph.emplace<CameraLookStage>(*options.camera_look) : nullptr;
-  graph.emplace<DifferentialCompositeStage>(options.tone_map, camera_look, options.composite);
-  return look;
+  DirStages stages;
+  if (camera_look) stages.camera_look = &graph.emplace<CameraLookStage>(*options.camera_look);
+  stages.tone_map = &graph.emplace<colormap::ToneMapStage>(options.tone_map);
+  graph.emplace<DifferentialCompositeStage>(camera_look, options.composite);
+  return stages;
 }
 
 // ---- mr_scene ----------------------------------------------------------------------------------
@@ -240,6 +243,7 @@ void DifferentialCompositeStage::declare(StageBuilder& builder) {
   real_ = builder.read(kRealRadiance);
   coverage_ = builder.read(kVirtualCoverage);
   gbuffer_ = builder.read(kDirGBuffer);
+  tone_map_ = builder.read(colormap::kToneMap);
   if (camera_look_) look_ = builder.read(colormap::kCameraLook);
   composite_ = builder.write(kComposite);
 }
@@ -252,7 +256,7 @@ void DifferentialCompositeStage::run(StageContext& context) {
                 std::to_string(color.height()) + ") and the rendered image (" + std::to_string(real_virtual.width()) +
                 "x" + std::to_string(real_virtual.height()) + ") differ in size");
   context.get(composite_) = differential_composite(
-      color, real_virtual, context.get(real_), context.get(coverage_), tone_map_,
+      color, real_virtual, context.get(real_), context.get(coverage_), context.get(tone_map_),
       {rule_, camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface});
 }
 

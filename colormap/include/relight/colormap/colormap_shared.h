@@ -16,23 +16,31 @@ namespace relight::gpu {
 using uint = std::uint32_t;
 #endif
 
-/// Push constants of colormap_statistics.comp (std430: 8 bytes).
-struct ColormapStatisticsParams {
-  uint pixels;     ///< width * height
-  float exposure;  ///< ToneMap::exposure
+/// The tone-mapping operator (tone_map.h's ToneMap) as the shaders take it (std430: 12 bytes).
+struct ColormapToneMap {
+  float exposure;               ///< ToneMap::exposure
+  float compression;            ///< k of tone_map.h: 1 Reinhard, 0 Exposure
+  float inverse_white_squared;  ///< ToneMap::inverse_white_squared
 };
 
-/// Push constants of colormap_statistics_transfer.comp (std430: 32 bytes).
+/// Push constants of colormap_statistics.comp (std430: 16 bytes).
+struct ColormapStatisticsParams {
+  uint pixels;  ///< width * height
+  ColormapToneMap tone_map;
+};
+
+/// Push constants of colormap_statistics_transfer.comp (std430: 40 bytes).
 struct ColormapTransferParams {
   uint pixels;
-  float exposure;
+  ColormapToneMap tone_map;
   float scale[3];   ///< ReinhardTransfer::scale (L, a, b)
   float offset[3];  ///< ReinhardTransfer::offset
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(ColormapStatisticsParams) == 8);
-static_assert(sizeof(ColormapTransferParams) == 32);
+static_assert(sizeof(ColormapToneMap) == 12);
+static_assert(sizeof(ColormapStatisticsParams) == 16);
+static_assert(sizeof(ColormapTransferParams) == 40);
 }  // namespace relight::gpu
 #endif
 

@@ -9,8 +9,11 @@
 //   RadianceImage "delta_L" = tau(TM(L_rv)) - tau(TM(L_r)) in camera-linear sRGB, and
 //   ColorMapping  "color_mapping" = this frame's tau (color_mapping.h).
 // The composite stage reads "color" and "delta_L" and writes ColorImage "color_mapped" =
-// sRGB(L_cam + delta_L). Names are configurable through ColorMapBuffers.
+// sRGB(L_cam + delta_L). Names are configurable through ColorMapBuffers. With
+// ColorMapBuffers::tone_map (ToneMap "tone_map", tone_map_stage.h) the mapping stages read each
+// frame's operator from the graph; without it they keep the one they were made with.
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "relight/colormap/buffers.h"
@@ -36,6 +39,18 @@ struct ColorMapBuffers {
   BufferName<RadianceImage> delta = kDeltaRadiance;
   BufferName<ColorMapping> mapping = kColorMapping;
   BufferName<ColorImage> mapped = kColorMapped;
+  std::optional<BufferName<ToneMap>> tone_map;  ///< the per-frame operator, when a stage writes one
+};
+
+/// The inputs every mapping stage reads.
+struct ColorMapInputs {
+  Read<RadianceImage> real, real_virtual;
+  Read<ColorImage> camera;
+  std::optional<Read<ToneMap>> tone_map;
+
+  static ColorMapInputs declare(StageBuilder& builder, const ColorMapBuffers& buffers, bool camera = true);
+  /// This frame's operator: the graph's, or `fixed` without a tone_map buffer.
+  [[nodiscard]] ToneMap frame_tone_map(StageContext& context, const ToneMap& fixed) const;
 };
 
 /// Statistics-based, CPU (statistics_transfer.h).
@@ -50,8 +65,7 @@ class StatisticsColorMapCpuStage final : public Stage {
  private:
   ToneMap tm_;
   ColorMapBuffers buffers_;
-  Read<RadianceImage> real_, real_virtual_;
-  Read<ColorImage> camera_;
+  ColorMapInputs inputs_;
   Write<RadianceImage> delta_;
   Write<ColorMapping> mapping_;
   ReinhardTransfer transfer_;
@@ -71,8 +85,7 @@ class StatisticsColorMapVkStage final : public Stage {
  private:
   StatisticsColorMapVk mapper_;
   ColorMapBuffers buffers_;
-  Read<RadianceImage> real_, real_virtual_;
-  Read<ColorImage> camera_;
+  ColorMapInputs inputs_;
   Write<RadianceImage> delta_;
   Write<ColorMapping> mapping_;
   ReinhardTransfer transfer_;
@@ -90,8 +103,7 @@ class SampleColorMapStage final : public Stage {
  private:
   SampleColorMapper mapper_;
   ColorMapBuffers buffers_;
-  Read<RadianceImage> real_, real_virtual_;
-  Read<ColorImage> camera_;
+  ColorMapInputs inputs_;
   Write<RadianceImage> delta_;
   Write<ColorMapping> mapping_;
 };
@@ -107,7 +119,7 @@ class IdentityColorMapStage final : public Stage {
  private:
   ToneMap tm_;
   ColorMapBuffers buffers_;
-  Read<RadianceImage> real_, real_virtual_;
+  ColorMapInputs inputs_;
   Write<RadianceImage> delta_;
   Write<ColorMapping> mapping_;
 };

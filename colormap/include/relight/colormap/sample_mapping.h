@@ -84,6 +84,8 @@ class SampleColorMapper {
                          RadianceImage& delta);
   [[nodiscard]] const ColorMatrix& coefficients() const { return coefficients_; }
   [[nodiscard]] const SampleMappingOptions& options() const { return options_; }
+  /// The operator of the next frames (the pipeline's changes every frame, tone_map_stage.h).
+  void set_tone_map(const ToneMap& tm) { options_.tone_map = tm; }
   void reset() { fitted_ = false; coefficients_ = identity_color_matrix(); }
 
  private:

@@ -25,6 +25,8 @@ inline Float3 operator-(const Float3& a, const Float3& b) { return {a.x - b.x, a
 inline Float3 operator*(float s, const Float3& a) { return {s * a.x, s * a.y, s * a.z}; }
 inline float dot(const Float3& a, const Float3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 inline float length(const Float3& a) { return std::sqrt(dot(a, a)); }
+/// Relative luminance Y of a linear sRGB (Rec. 709 primaries) colour.
+inline float luminance(const Float3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 /// Depth in metres; 0 (and anything non-finite or negative) marks a missing measurement.
 inline bool is_valid_depth(float metres) { return std::isfinite(metres) && metres > 0.f; }

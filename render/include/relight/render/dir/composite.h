@@ -66,7 +66,4 @@ struct CompositeOptions {
                                                        const colormap::ColorMapping& mapping,
                                                        const CompositeOptions& options = {});
 
-/// TM(L) as an 8-bit sRGB picture (for looking at L_rv or L_r on their own).
-[[nodiscard]] ColorImage tone_mapped_preview(const RadianceImage& radiance, const colormap::ToneMap& tone_map);
-
 }  // namespace relight::render

@@ -1,6 +1,6 @@
 #pragma once
 // Differential instant radiosity (dir_vk.h) as frame-graph stages, one per step, so that the
-// graph times each step and keeps each step's output (add_dir_stages() adds all five, and camera_look when asked):
+// graph times each step and keeps each step's output (add_dir_stages() adds all six, and camera_look when asked):
 //
 //   mr_scene                 reads  FrameInfo "frame" (camera_to_world: identity when absent),
 //                                   PositionMap "positions" and NormalMap "normals" (camera frame,
@@ -34,9 +34,12 @@
 //                                   5.11-5.15); with it on, also TemporalHistory
 //                                   "indirect_history" (G-buffer, camera, indirect light), whose
 //                                   previous frame's version it reads; unchanged when off
+//   tone_map                 reads  RadianceImage "L_rv", FrameInfo "frame" (Reinhard only)
+//                            writes colormap::ToneMap "tone_map" (colormap/tone_map_stage.h)
 //   differential_composite   reads  ColorImage "color", RadianceImage "L_rv", "L_r",
 //                                   CoverageImage "virtual_coverage", GBuffer "dir_gbuffer"
-//                                   (which pixel centres are virtual); with `camera_look` also
+//                                   (which pixel centres are virtual), colormap::ToneMap
+//                                   "tone_map"; with `camera_look` also
 //                                   colormap::CameraLook "camera_look" (camera_look_stage.h)
 //                            writes ColorImage "composite" (composite.h, eq. 5.1)
 //
@@ -55,7 +58,7 @@
 #include <vector>
 
 #include "relight/brdf/materials.h"
-#include "relight/colormap/tone_map.h"
+#include "relight/colormap/adaptive_tone_map.h"
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/named_values.h"
@@ -72,6 +75,10 @@
 #include "relight/render/vpl/cone_search_vk.h"
 #include "relight/render/vpl/reflective_shadow_map_vk.h"
 #include "relight/render/vpl/vpl.h"
+
+namespace relight::colormap {
+class ToneMapStage;
+}  // namespace relight::colormap
 
 namespace relight::render {
 
@@ -97,7 +104,7 @@ struct DirStageOptions {
   VplOptions vpls{.count = 64};
   DepthMeshOptions mesh{.stride = 2};
   PhongMaterial reconstruction_material{{{0.5f, 0.5f, 0.5f}, 0.f, 1.f}, "reconstruction", {0.f, 0.f, 0.f}};
-  colormap::ToneMap tone_map{};
+  colormap::ToneMapOptions tone_map{};  ///< the operator of the composites (and the colour mappings)
   EnvironmentLight environment = EnvironmentLight::Directional;
   std::optional<BufferName<brdf::Materials>> materials_buffer;  ///< none: no Materials input
   /// ObjectPlacements of the objects (virtual_model.h), e.g. resolved on a real surface at the
@@ -126,11 +133,16 @@ struct DirSceneContent {
   std::vector<std::pair<VirtualModel, Placement>> objects;
 };
 
-/// Adds the five stages above (and camera_look with DirStageOptions::camera_look) for `backend` (core/stage_backend.h:
-/// Backend::Cpu renders without a GPU, Backend::Vulkan needs `context`, which must outlive the graph). Returns the
-/// camera_look stage when it added one (for its summary), else nullptr.
-CameraLookStage* add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* context, DirSceneContent content,
-                                const DirStageOptions& options = {});
+/// The stages of add_dir_stages whose summaries the report shows.
+struct DirStages {
+  CameraLookStage* camera_look = nullptr;  ///< none without DirStageOptions::camera_look
+  colormap::ToneMapStage* tone_map = nullptr;
+};
+
+/// Adds the six stages above (and camera_look with DirStageOptions::camera_look) for `backend` (core/stage_backend.h:
+/// Backend::Cpu renders without a GPU, Backend::Vulkan needs `context`, which must outlive the graph).
+DirStages add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* context, DirSceneContent content,
+                         const DirStageOptions& options = {});
 
 /// Step 1 (scene): the mixed-reality scene of the frame.
 class MrSceneStage final : public Stage {
@@ -240,17 +252,16 @@ class IndirectSmoothingStage final : public Stage {
 class DifferentialCompositeStage final : public Stage {
  public:
   /// With `camera_look`, also reads colormap::CameraLook "camera_look" (camera_look_stage.h).
-  explicit DifferentialCompositeStage(colormap::ToneMap tone_map, bool camera_look = false,
-                                      CompositeRule rule = CompositeRule::Additive)
-      : tone_map_(tone_map), camera_look_(camera_look), rule_(rule) {}
+  explicit DifferentialCompositeStage(bool camera_look = false, CompositeRule rule = CompositeRule::Additive)
+      : camera_look_(camera_look), rule_(rule) {}
   [[nodiscard]] std::string name() const override { return "differential_composite"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
  private:
-  colormap::ToneMap tone_map_;
   bool camera_look_;
   CompositeRule rule_;
+  Read<colormap::ToneMap> tone_map_;
   Read<ColorImage> color_;
   Read<RadianceImage> real_virtual_;
   Read<RadianceImage> real_;
