@@ -106,5 +106,40 @@ TEST(CompositeRule, MultiplicativeKeepsTheShadowsHueWhereTheMeasuredLightIsWrong
   }
 }
 
+// A camera pixel that clipped its red channel (the true value ~1.4) under a virtual shadow that
+// halves the light: both rules reconstruct red from the render's chromaticity and halve all
+// three channels, so the shadow keeps the surface's hue instead of staying at red 255.
+TEST(ClippedCamera, ShadowOverAClippedChannelScalesTheReconstructedValue) {
+  const Float3 truth{1.4f, 0.8f, 0.5f};  // what an unclipped camera would record
+  const Float3 camera_linear{1.f, truth.y, truth.z};
+  ColorImage camera(2, 1, colormap::encode_srgb8(camera_linear));
+  const Float3 recorded = colormap::decode_srgb8(camera(0, 0));
+  RadianceImage real(2, 1, Float3{0.7f, 0.4f, 0.25f});  // the render: half the truth, same hue
+  RadianceImage real_virtual = real;
+  real_virtual(0, 1) = 0.5f * real(0, 1);  // pixel 1 lies in the shadow, pixel 0 unchanged
+  const CoverageImage coverage(2, 1, 0.f);
+  for (const CompositeRule rule : {CompositeRule::Additive, CompositeRule::Multiplicative}) {
+    SCOPED_TRACE(static_cast<int>(rule));
+    const ColorImage out =
+        differential_composite(camera, real_virtual, real, coverage, colormap::ToneMap{}, {.rule = rule});
+    EXPECT_EQ(out(0, 0), camera(0, 0)) << "unchanged pixels keep the camera's value";
+    const Float3 shadow = colormap::decode_srgb8(out(0, 1));
+    // Scale of the render to the camera from the unclipped channels: (0.8 + 0.5) / (0.4 + 0.25).
+    const float k = (recorded.y + recorded.z) / 0.65f;
+    EXPECT_NEAR(shadow.x, 0.5f * k * 0.7f, 0.01f);
+    EXPECT_NEAR(shadow.y, 0.5f * recorded.y, 0.01f);
+    EXPECT_NEAR(shadow.z, 0.5f * recorded.z, 0.01f);
+    EXPECT_LT(out(0, 1).r, 250);
+    // The mapped composite (identity mapping) does the same.
+    RadianceImage delta(2, 1);
+    delta(0, 1) = real_virtual(0, 1) - real(0, 1);
+    const ColorImage mapped = mapped_differential_composite(
+        camera, delta, real_virtual, real, coverage,
+        colormap::ColorMapping::of_matrix(colormap::identity_color_matrix(), {}), {.rule = rule});
+    EXPECT_EQ(mapped(0, 1), out(0, 1));
+    EXPECT_EQ(mapped(0, 0), camera(0, 0));
+  }
+}
+
 }  // namespace
 }  // namespace relight::render

@@ -28,14 +28,16 @@ TEST(MappedComposite, CoveredPixelsShowTheMappedObjectAndOthersTheCameraPlusDelt
   coverage(0, 2) = 0.5f;
   delta(0, 1) = delta(0, 2) = delta(0, 3) = Float3{-0.05f, 0.f, 0.f};  // e.g. a virtual shadow
   colormap::ColorMapping gain = colormap::ColorMapping::of_matrix(colormap::identity_color_matrix() * 2.0, {});
-  const ColorImage out = mapped_differential_composite(camera, delta, real_virtual, coverage, gain);
+  const ColorImage out = mapped_differential_composite(camera, delta, real_virtual, real_virtual, coverage, gain);
   EXPECT_EQ(out(0, 0), camera(0, 0));  // nothing virtual: bit for bit
   const Float3 object = gain(real_virtual(0, 1));
   EXPECT_EQ(out(0, 1), colormap::encode_srgb8(object));  // the red texture does not show through
   const Float3 background = colormap::decode_srgb8(camera(0, 2)) + delta(0, 2);
   EXPECT_EQ(out(0, 2), colormap::encode_srgb8(0.5f * object + 0.5f * background));
   EXPECT_EQ(out(0, 3), colormap::encode_srgb8(colormap::decode_srgb8(camera(0, 3)) + delta(0, 3)));
-  EXPECT_THROW((void)mapped_differential_composite(camera, RadianceImage(2, 2), real_virtual, coverage, gain), Error);
+  EXPECT_THROW(
+      (void)mapped_differential_composite(camera, RadianceImage(2, 2), real_virtual, real_virtual, coverage, gain),
+      Error);
 }
 
 TEST(MappedComposite, StatisticsMappingReachesTheColourGoalOnTheSyntheticCamera) {
@@ -43,9 +45,9 @@ TEST(MappedComposite, StatisticsMappingReachesTheColourGoalOnTheSyntheticCamera)
   const Mask object = colormap::virtual_mask(triple.real, triple.real_virtual);
   RadianceImage delta;
   const auto transfer = colormap::statistics_color_map(triple.real, triple.real_virtual, triple.camera, {}, delta);
-  const ColorImage mapped = mapped_differential_composite(triple.camera, delta, triple.real_virtual,
-                                                          coverage_of(object),
-                                                          colormap::ColorMapping::of_statistics(transfer, {}));
+  const ColorImage mapped =
+      mapped_differential_composite(triple.camera, delta, triple.real_virtual, triple.real, coverage_of(object),
+                                    colormap::ColorMapping::of_statistics(transfer, {}));
   const ColorImage unmapped = differential_composite(triple.camera, triple.real_virtual, triple.real,
                                                      coverage_of(object), {});
   const double before = truth::mean_delta_e(unmapped, triple.truth, object);

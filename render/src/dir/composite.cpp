@@ -1,6 +1,8 @@
 #include "relight/render/dir/composite.h"
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <optional>
 
 #include "relight/colormap/color_space.h"
@@ -75,6 +77,44 @@ Float3 real_difference(CompositeRule rule, const Rgb8& camera, const Float3& wit
           real_difference(rule, c.z, with.z, without.z)};
 }
 
+/// The camera's value at a real pixel where it clipped a channel, reconstructed from the
+/// rendered real radiance (composite.h); none where no channel is clipped.
+std::optional<Float3> unclipped_camera(const Rgb8& camera, const Float3& real, float scale) {
+  const std::array<std::uint8_t, 3> code{camera.r, camera.g, camera.b};
+  const Float3 linear = colormap::decode_srgb8(camera);
+  const std::array<float, 3> value{linear.x, linear.y, linear.z}, rendered{real.x, real.y, real.z};
+  float camera_sum = 0.f, rendered_sum = 0.f;
+  bool clipped = false;
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (code[k] >= kClippedCameraCode) {
+      clipped = true;
+    } else {
+      camera_sum += value[k];
+      rendered_sum += rendered[k];
+    }
+  }
+  if (!clipped) return std::nullopt;
+  // The render's brightness in camera units from the unclipped channels (all clipped: the scale).
+  const float k = rendered_sum > 1e-6f ? camera_sum / rendered_sum : scale;
+  std::array<float, 3> out = value;
+  for (std::size_t c = 0; c < 3; ++c)
+    if (code[c] >= kClippedCameraCode) out[c] = std::max(value[c], k * rendered[c]);
+  return Float3{out[0], out[1], out[2]};
+}
+
+/// The change of a real pixel whose camera value clipped: the reconstructed value scaled by the
+/// rendered ratio L_rv / L_r, minus the camera's value; none where the camera did not clip (or the
+/// objects change nothing there).
+std::optional<Float3> clipped_difference(const Rgb8& camera, const Float3& with, const Float3& without, float scale) {
+  if (with == without) return std::nullopt;
+  const std::optional<Float3> unclipped = unclipped_camera(camera, without, scale);
+  if (!unclipped) return std::nullopt;
+  const auto ratio = [](float w, float wo) { return wo > 1e-6f ? std::min(w / wo, kMaxCompositeRatio) : 1.f; };
+  const Float3 changed{unclipped->x * ratio(with.x, without.x), unclipped->y * ratio(with.y, without.y),
+                       unclipped->z * ratio(with.z, without.z)};
+  return changed - colormap::decode_srgb8(camera);
+}
+
 }  // namespace
 
 ColorImage differential_composite(const ColorImage& camera, const RadianceImage& real_virtual,
@@ -83,19 +123,25 @@ ColorImage differential_composite(const ColorImage& camera, const RadianceImage&
   require_camera_size(camera, {&real_virtual, &real}, virtual_coverage);
   const auto with = [&](std::size_t i) { return colormap::tone_map(real_virtual.pixels()[i], tone_map); };
   const auto difference = [&](std::size_t i) {
-    return real_difference(options.rule, camera.pixels()[i], with(i), colormap::tone_map(real.pixels()[i], tone_map));
+    const Float3 &lrv = real_virtual.pixels()[i], &lr = real.pixels()[i];
+    if (const auto clipped = clipped_difference(camera.pixels()[i], lrv, lr, tone_map.exposure)) return *clipped;
+    return real_difference(options.rule, camera.pixels()[i], with(i), colormap::tone_map(lr, tone_map));
   };
   return colormap::composite_layer(camera, separated_layer(virtual_coverage, options.virtual_centre, with, difference),
                                    options.look);
 }
 
 ColorImage mapped_differential_composite(const ColorImage& camera, const RadianceImage& delta,
-                                         const RadianceImage& real_virtual, const CoverageImage& virtual_coverage,
-                                         const colormap::ColorMapping& mapping, const CompositeOptions& options) {
-  require_camera_size(camera, {&delta, &real_virtual}, virtual_coverage);
+                                         const RadianceImage& real_virtual, const RadianceImage& real,
+                                         const CoverageImage& virtual_coverage, const colormap::ColorMapping& mapping,
+                                         const CompositeOptions& options) {
+  require_camera_size(camera, {&delta, &real_virtual, &real}, virtual_coverage);
   const auto mapped = [&](std::size_t i) { return mapping(real_virtual.pixels()[i]); };
   // delta_L = tau(TM(L_rv)) - tau(TM(L_r)) (colormap_stages.h), so tau(TM(L_r)) = mapped - delta.
   const auto difference = [&](std::size_t i) {
+    if (const auto clipped = clipped_difference(camera.pixels()[i], real_virtual.pixels()[i], real.pixels()[i],
+                                                mapping.tone_map.exposure))
+      return *clipped;
     if (options.rule == CompositeRule::Additive) return delta.pixels()[i];
     const Float3 with = mapped(i);
     return real_difference(options.rule, camera.pixels()[i], with, with - delta.pixels()[i]);

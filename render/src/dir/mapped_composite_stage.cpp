@@ -11,6 +11,7 @@ void MappedCompositeStage::declare(StageBuilder& builder) {
   camera_ = builder.read(kColor);
   delta_ = builder.read(kDeltaRadiance);
   real_virtual_ = builder.read(kRealVirtualRadiance);
+  real_ = builder.read(kRealRadiance);
   coverage_ = builder.read(kVirtualCoverage);
   mapping_ = builder.read(colormap::kColorMapping);
   gbuffer_ = builder.read(kDirGBuffer);
@@ -20,7 +21,7 @@ void MappedCompositeStage::declare(StageBuilder& builder) {
 
 void MappedCompositeStage::run(StageContext& context) {
   context.get(composite_) = mapped_differential_composite(
-      context.get(camera_), context.get(delta_), context.get(real_virtual_), context.get(coverage_),
+      context.get(camera_), context.get(delta_), context.get(real_virtual_), context.get(real_), context.get(coverage_),
       context.get(mapping_),
       {rule_, camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface});
 }

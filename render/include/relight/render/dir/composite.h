@@ -25,6 +25,16 @@
 // tints the shadow; the ratio only needs the render's relative change. The ratio is capped at
 // kMaxCompositeRatio (light a virtual object adds to a dark real surface).
 //
+// Where the camera clipped (a channel at or above kClippedCameraCode, as brdf/ marks it) neither
+// rule can work with the camera's value: it stands for "at least 1", the render's TM(L_r) clips
+// the same way, and a virtual shadow over a clipped table left the clipped channel at 1 while
+// the others darkened (a saturated, hue-shifted shadow). There both composites, and both rules,
+// first reconstruct the camera's unclipped value from the render - the clipped channels from
+// L_r's chromaticity scaled to the camera's unclipped channels (all clipped: s L_r, s the tone
+// map's scale, at least the camera's value) - and scale it by the rendered ratio L_rv / L_r, as
+// the camera, not clipped, would see the change. Pixels the virtual objects leave unchanged keep
+// the camera's value bit for bit.
+//
 // With a CameraLook both composites put the camera's blur, motion blur and noise on the rendered
 // layer (colormap/camera_look.h, composite_layer): the virtual objects and the differential
 // effects they cause, not the camera image, which has them already.
@@ -43,6 +53,8 @@ enum class CompositeRule { Additive, Multiplicative };
 inline constexpr std::array<NamedValue<CompositeRule>, 2> kCompositeRuleNames{
     {{"additive", CompositeRule::Additive}, {"multiplicative", CompositeRule::Multiplicative}}};
 inline constexpr float kMaxCompositeRatio = 8.f;
+/// A camera channel at or above this 8-bit code is clipped (brdf::DiffuseOptions::clip_code).
+inline constexpr int kClippedCameraCode = 250;
 
 struct CompositeOptions {
   CompositeRule rule = CompositeRule::Additive;
@@ -58,10 +70,11 @@ struct CompositeOptions {
 
 /// The colour-mapped composite (eqs. 4.28-4.29 with the coverage blend above):
 ///   c tau(TM(L_rv)) + (1 - c)(L_cam + delta_L),   delta_L = tau(TM(L_rv)) - tau(TM(L_r)),
-/// with delta_L and tau from a colour-mapping stage (colormap_stages.h). A pixel without coverage
+/// with delta_L and tau from a colour-mapping stage (colormap_stages.h); L_r for the clipped
+/// camera pixels only. A pixel without coverage
 /// and with a zero delta keeps the camera pixel bit for bit. Throws relight::Error on a size mismatch.
 [[nodiscard]] ColorImage mapped_differential_composite(const ColorImage& camera, const RadianceImage& delta,
-                                                       const RadianceImage& real_virtual,
+                                                       const RadianceImage& real_virtual, const RadianceImage& real,
                                                        const CoverageImage& virtual_coverage,
                                                        const colormap::ColorMapping& mapping,
                                                        const CompositeOptions& options = {});

@@ -2,7 +2,7 @@
 // Frame-graph stage of the colour-mapped differential composite (composite.h,
 // mapped_differential_composite): the picture of `relight replay --colormap sample|stats`.
 // Reads:  ColorImage "color" (camera), RadianceImage "delta_L" and ColorMapping "color_mapping"
-//         (a colour-mapping stage, colormap_stages.h), RadianceImage "L_rv" and CoverageImage
+//         (a colour-mapping stage, colormap_stages.h), RadianceImage "L_rv", "L_r" and CoverageImage
 //         "virtual_coverage" and GBuffer "dir_gbuffer" (the DIR stage, dir_stage.h); with `camera_look`, CameraLook
 //         "camera_look" (camera_look_stage.h), whose artefacts go on the virtual layer.
 // Writes: ColorImage "composite_mapped".
@@ -27,7 +27,7 @@ class MappedCompositeStage final : public Stage {
 
  private:
   Read<ColorImage> camera_;
-  Read<RadianceImage> delta_, real_virtual_;
+  Read<RadianceImage> delta_, real_virtual_, real_;
   Read<CoverageImage> coverage_;
   Read<GBuffer> gbuffer_;
   Read<colormap::ColorMapping> mapping_;
