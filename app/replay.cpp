@@ -295,6 +295,8 @@ nlohmann::ordered_json camera_look_json(const render::CameraLookSummary& summary
           {"blur_sigma_px", summary.blur_sigma_px},
           {"applied_blur_sigma_px", summary.applied_sigma_px},
           {"blur_edges", summary.blur_edges},
+          {"blur_estimates", summary.blur_estimates},
+          {"noise_estimates", summary.noise_estimates},
           {"frames_with_motion", summary.frames_with_motion},
           {"max_motion_px", summary.max_motion_px},
           {"noise", std::move(noise)}};

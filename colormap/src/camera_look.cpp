@@ -22,39 +22,54 @@ constexpr int kTile = 16;  // pixels per side of the blur's work tiles
 /// than a fraction: it is left as it is (the indirect light a virtual object adds everywhere).
 constexpr float kSmoothRange = 2e-3f;
 
-/// Tiles of the layer whose blur matters: covered by the virtual object, or with a differential
-/// that changes within them (a shadow's edge), grown by `reach` pixels. Indexed row-major.
-std::vector<std::uint8_t> active_tiles(const VirtualLayer& layer, int reach, int columns, int rows) {
+/// What a tile of the layer needs from the blur. Covered: the virtual object is within reach, so
+/// its colour and coverage are filtered too; Delta: only the differential (a shadow's edge).
+enum TileActivity : std::uint8_t { kInactive = 0, kDeltaOnly = 1, kCovered = 2 };
+
+/// The activity of every tile (row-major): covered by the virtual object, or with a differential
+/// that changes within it, grown by `reach` pixels. One pass over the layer, rows of tiles in
+/// parallel, each tile stopping as soon as it is known to be covered.
+std::vector<std::uint8_t> active_tiles(const VirtualLayer& layer, int reach, int columns, int rows, int threads) {
   const int width = layer.coverage.width(), height = layer.coverage.height();
-  std::vector<std::uint8_t> active(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows), 0);
-  for (int ty = 0; ty < rows; ++ty)
-    for (int tx = 0; tx < columns; ++tx) {
-      bool covered = false;
-      Float3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
-      for (int r = ty * kTile; r < std::min(height, (ty + 1) * kTile) && !covered; ++r)
-        for (int c = tx * kTile; c < std::min(width, (tx + 1) * kTile); ++c) {
-          if (layer.coverage(r, c) > 0.f) {
-            covered = true;
-            break;
+  const auto tile_index = [columns](int ty, int tx) {
+    return static_cast<std::size_t>(ty) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(tx);
+  };
+  std::vector<std::uint8_t> own(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows), kInactive);
+  parallel_for_each_row(
+      rows, threads,
+      [&](int ty) {
+        const int r1 = std::min(height, (ty + 1) * kTile);
+        for (int tx = 0; tx < columns; ++tx) {
+          const int c0 = tx * kTile, c1 = std::min(width, (tx + 1) * kTile);
+          bool covered = false;
+          Float3 lo{1e9f, 1e9f, 1e9f}, hi{-1e9f, -1e9f, -1e9f};
+          for (int r = ty * kTile; r < r1 && !covered; ++r) {
+            const auto coverage =
+                layer.coverage.row(r).subspan(static_cast<std::size_t>(c0), static_cast<std::size_t>(c1 - c0));
+            const auto delta =
+                layer.delta.row(r).subspan(static_cast<std::size_t>(c0), static_cast<std::size_t>(c1 - c0));
+            for (std::size_t k = 0; k < coverage.size(); ++k) {
+              covered = covered || coverage[k] > 0.f;
+              lo = {std::min(lo.x, delta[k].x), std::min(lo.y, delta[k].y), std::min(lo.z, delta[k].z)};
+              hi = {std::max(hi.x, delta[k].x), std::max(hi.y, delta[k].y), std::max(hi.z, delta[k].z)};
+            }
           }
-          const Float3& d = layer.delta(r, c);
-          lo = {std::min(lo.x, d.x), std::min(lo.y, d.y), std::min(lo.z, d.z)};
-          hi = {std::max(hi.x, d.x), std::max(hi.y, d.y), std::max(hi.z, d.z)};
+          const Float3 range = hi - lo;
+          own[tile_index(ty, tx)] = covered                                                ? kCovered
+                                    : std::max({range.x, range.y, range.z}) > kSmoothRange ? kDeltaOnly
+                                                                                           : kInactive;
         }
-      const Float3 range = hi - lo;
-      if (covered || std::max({range.x, range.y, range.z}) > kSmoothRange)
-        active[static_cast<std::size_t>(ty) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(tx)] = 1;
-    }
+      },
+      1);
   const int grow = (reach + kTile - 1) / kTile;
-  std::vector<std::uint8_t> grown(active.size(), 0);
+  std::vector<std::uint8_t> grown(own.size(), kInactive);
   for (int ty = 0; ty < rows; ++ty)
     for (int tx = 0; tx < columns; ++tx) {
-      bool any = false;
-      for (int y = std::max(0, ty - grow); y <= std::min(rows - 1, ty + grow) && !any; ++y)
+      std::uint8_t most = kInactive;
+      for (int y = std::max(0, ty - grow); y <= std::min(rows - 1, ty + grow); ++y)
         for (int x = std::max(0, tx - grow); x <= std::min(columns - 1, tx + grow); ++x)
-          any = any ||
-                active[static_cast<std::size_t>(y) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(x)];
-      grown[static_cast<std::size_t>(ty) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(tx)] = any;
+          most = std::max(most, own[tile_index(y, x)]);
+      grown[tile_index(ty, tx)] = most;
     }
   return grown;
 }
@@ -63,6 +78,7 @@ std::vector<std::uint8_t> active_tiles(const VirtualLayer& layer, int reach, int
 /// the unchanged image and written back once every tile is done.
 struct TileBox {
   int row0, row1, col0, col1;
+  bool covered;  ///< the virtual object is within reach: its colour and coverage are filtered too
 };
 
 /// The separable Gaussian of `weights` over the tile (borders clamp to the image's edge).
@@ -115,8 +131,10 @@ TileResult motion_tile(const VirtualLayer& layer, const TileBox& box, const Moti
   const int width = layer.coverage.width(), height = layer.coverage.height();
   TileResult out;
   const auto size = static_cast<std::size_t>(box.row1 - box.row0) * static_cast<std::size_t>(box.col1 - box.col0);
-  out.colour.reserve(size);
-  out.coverage.reserve(size);
+  if (box.covered) {
+    out.colour.reserve(size);
+    out.coverage.reserve(size);
+  }
   out.delta.reserve(size);
   std::vector<Tap> taps;
   for (int row = box.row0; row < box.row1; ++row)
@@ -125,8 +143,10 @@ TileResult motion_tile(const VirtualLayer& layer, const TileBox& box, const Moti
       const float full = std::sqrt(m.x * m.x + m.y * m.y), length = std::min(full, kMaxMotionPx);
       const int samples = std::isfinite(full) ? std::max(1, static_cast<int>(std::ceil(length)) + 1) : 1;
       if (samples == 1) {
-        out.colour.push_back(layer.virtual_color(row, col));
-        out.coverage.push_back(layer.coverage(row, col));
+        if (box.covered) {
+          out.colour.push_back(layer.virtual_color(row, col));
+          out.coverage.push_back(layer.coverage(row, col));
+        }
         out.delta.push_back(layer.delta(row, col));
         continue;
       }
@@ -139,14 +159,15 @@ TileResult motion_tile(const VirtualLayer& layer, const TileBox& box, const Moti
       const float weight = 1.f / float(samples);
       Float3 colour, delta;
       float coverage = 0.f;
+      for (const Tap& t : taps) delta += sample(layer.delta.pixels(), t);
+      out.delta.push_back(weight * delta);
+      if (!box.covered) continue;
       for (const Tap& t : taps) {
         colour += sample(layer.virtual_color.pixels(), t);
         coverage += sample(layer.coverage.pixels(), t);
-        delta += sample(layer.delta.pixels(), t);
       }
       out.colour.push_back(weight * colour);
       out.coverage.push_back(weight * coverage);
-      out.delta.push_back(weight * delta);
     }
   return out;
 }
@@ -161,7 +182,8 @@ void filter_active_tiles(VirtualLayer& layer, const std::vector<std::uint8_t>& a
   for (std::size_t t = 0; t < active.size(); ++t) {
     if (!active[t]) continue;
     const int ty = static_cast<int>(t) / columns, tx = static_cast<int>(t) % columns;
-    boxes.push_back({ty * kTile, std::min(height, (ty + 1) * kTile), tx * kTile, std::min(width, (tx + 1) * kTile)});
+    boxes.push_back({ty * kTile, std::min(height, (ty + 1) * kTile), tx * kTile, std::min(width, (tx + 1) * kTile),
+                     active[t] == kCovered});
   }
   std::vector<TileResult> results(boxes.size());
   parallel_for_each_row(
@@ -172,8 +194,10 @@ void filter_active_tiles(VirtualLayer& layer, const std::vector<std::uint8_t>& a
     std::size_t i = 0;
     for (int row = box.row0; row < box.row1; ++row)
       for (int col = box.col0; col < box.col1; ++col, ++i) {
-        layer.virtual_color(row, col) = results[b].colour[i];
-        layer.coverage(row, col) = results[b].coverage[i];
+        if (box.covered) {
+          layer.virtual_color(row, col) = results[b].colour[i];
+          layer.coverage(row, col) = results[b].coverage[i];
+        }
         layer.delta(row, col) = results[b].delta[i];
       }
   }
@@ -289,10 +313,11 @@ void blur_layer(VirtualLayer& layer, float sigma_px, const MotionField* motion, 
                     (moving ? static_cast<int>(std::ceil(0.5f * longest)) : 0) + 1;
   const int columns = (layer.coverage.width() + kTile - 1) / kTile,
             rows = (layer.coverage.height() + kTile - 1) / kTile;
-  const std::vector<std::uint8_t> active = active_tiles(layer, reach, columns, rows);
+  const std::vector<std::uint8_t> active = active_tiles(layer, reach, columns, rows, threads);
   if (defocus) {
     const std::vector<float> weights = gaussian_kernel(sigma_px);
     filter_active_tiles(layer, active, columns, threads, [&](const VirtualLayer& source, const TileBox& box) {
+      if (!box.covered) return TileResult{{}, {}, gaussian_tile(source.delta, box, weights)};
       return TileResult{gaussian_tile(source.virtual_color, box, weights), gaussian_tile(source.coverage, box, weights),
                         gaussian_tile(source.delta, box, weights)};
     });

@@ -147,6 +147,29 @@ TEST(CameraLookCli, TheCompositeRuleReachesTheGraphAndTheReport) {
   EXPECT_GT(darker_both, shadow * 9 / 10);
 }
 
+// After the first frames the blur and the noise are measured on alternate frames (half their
+// cost), and the carried-over estimates still match the camera.
+TEST(CameraLookCli, BlurAndNoiseAreMeasuredOnAlternateFramesAfterTheFirstEight) {
+  const auto& sequence = cli_test::synthetic_sequence(
+      "--frames 12 --size 320x240 --trajectory static --no-gt --color-blur 1.5 --color-noise " +
+      std::to_string(kNoiseFloor) + "," + std::to_string(kNoiseGain));
+  test::TempDir dir;
+  const auto result = relight("replay --quiet " + sequence.string() + " --object " +
+                              (kData / "models" / "glossy_pebble.gltf").string() +
+                              " --no-video --no-frames --colormap none --out " + (dir.path() / "look").string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto look = nlohmann::json::parse(read_text_file(dir.path() / "look" / "report.json"))["camera_look"];
+  EXPECT_EQ(look["frames"], 12);
+  EXPECT_EQ(look["blur_estimates"], 10) << "8 frames with both, then every second one";
+  EXPECT_EQ(look["noise_estimates"], 10);
+  EXPECT_NEAR(look["blur_sigma_px"].get<double>(), kBlur, 0.2 * kBlur) << look.dump();
+  for (const auto& band : look["noise"]) {
+    if (band["samples"].get<int>() == 0) continue;
+    const double expected = true_noise(band["code"].get<double>());
+    for (const auto& sigma : band["sigma"]) EXPECT_NEAR(sigma.get<double>(), expected, 0.25 * expected) << band.dump();
+  }
+}
+
 TEST(CameraLookCli, AnUnknownArtefactIsOneLine) {
   test::TempDir dir;
   expect_one_line_error(replay(dir.path() / "bad", "--camera-artefacts blur,grain"), 2);

@@ -13,6 +13,9 @@ namespace relight::render {
 namespace {
 
 constexpr double kLongestFrameInterval = 0.25;  // seconds; beyond it frames were skipped
+/// Frames that measure both the blur and the noise before they alternate (the running estimates
+/// start from one frame's; averaging a few first keeps a short sequence's as good as before).
+constexpr int kFramesBeforeAlternating = 8;
 
 double blend(double previous, double current, double weight) { return previous + weight * (current - previous); }
 
@@ -89,7 +92,17 @@ void CameraLookStage::run(StageContext& context) {
   if (previous_frame)
     look.motion = image_motion(context.get(gbuffer_), frame, *previous_frame, options_.exposure_time_s);
 
-  if (options_.artefacts.blur) {
+  // Which estimates this frame makes: both while the running estimates settle, then alternating.
+  const bool both_known =
+      previous && previous->blur.valid() && previous->noise.valid() && summary_.frames >= kFramesBeforeAlternating;
+  const bool alternate =
+      options_.alternate_estimates && options_.artefacts.blur && options_.artefacts.noise && both_known;
+  const bool measure_blur = !alternate || summary_.frames % 2 == 0;
+  const bool measure_noise = !alternate || summary_.frames % 2 == 1;
+  if (options_.artefacts.blur && !measure_blur) {
+    look.blur = previous->blur;
+    look.blur_sigma_px = previous->blur_sigma_px;
+  } else if (options_.artefacts.blur) {
     // Edges along the motion only: the mean motion's direction (camera motion moves the image
     // nearly uniformly; rotation does exactly).
     std::optional<Eigen::Vector2f> direction;
@@ -100,6 +113,7 @@ void CameraLookStage::run(StageContext& context) {
       if (mean.norm() > 0.5f) direction = mean;
     }
     look.blur = colormap::estimate_camera_blur(color, options_.blur, direction);
+    ++summary_.blur_estimates;
     if (previous && previous->blur.valid()) {
       if (look.blur.valid())
         look.blur.sigma_px = blend(previous->blur.sigma_px, look.blur.sigma_px, options_.smoothing);
@@ -117,8 +131,12 @@ void CameraLookStage::run(StageContext& context) {
     ++summary_.frames_with_motion;
     summary_.max_motion_px = std::max(summary_.max_motion_px, double(look.motion.max_length()));
   }
-  if (options_.artefacts.noise) {
+  if (options_.artefacts.noise && !measure_noise) {
+    look.noise = previous->noise;
+    summary_.noise = look.noise;
+  } else if (options_.artefacts.noise) {
     look.noise = colormap::estimate_camera_noise(color, options_.noise);
+    ++summary_.noise_estimates;
     if (previous && previous->noise.valid()) {
       if (!look.noise.valid()) {
         look.noise = previous->noise;

@@ -13,6 +13,10 @@
 //     projected into both cameras. None on the first frame, without poses, or across a gap of frames;
 //   - noise: the camera's noise profile (camera_noise.h), smoothed over frames; the frame index
 //     seeds the virtual layer's noise.
+// With `alternate_estimates` (the default) the blur and the noise, after the first 8 frames, are
+// each measured every second frame (blur on one, noise on the next) and carried over in between: both
+// change slowly and are smoothed over frames anyway, and the two estimates were 40 % of the look's
+// cost per frame (camera/artefacts_640x480).
 #include <string>
 
 #include "relight/colormap/camera_look.h"
@@ -26,6 +30,7 @@ struct CameraLookOptions {
   colormap::CameraArtefacts artefacts;
   double exposure_time_s = 1.0 / 30.0;  ///< the camera's exposure: how much of the motion one frame integrates
   double smoothing = 0.25;              ///< weight of this frame's estimates in the running ones
+  bool alternate_estimates = true;      ///< blur and noise measured on alternate frames (see above)
   /// Variance (px^2) of the render's own point spread: DIR shades each pixel's centre (only the
   /// outlines' coverage is a 4x4 box, edge_coverage.h, whose 1/12 px^2 is left in the camera's).
   double render_variance_px2 = 0.0;
@@ -47,6 +52,8 @@ struct CameraLookSummary {
   double blur_sigma_px = 0.0;     ///< the camera's, last frame (smoothed)
   double applied_sigma_px = 0.0;  ///< the Gaussian the layer got, last frame
   int blur_edges = 0;             ///< edges of the last frame's estimate
+  int blur_estimates = 0;         ///< frames that measured the blur (alternate_estimates: not all)
+  int noise_estimates = 0;        ///< frames that measured the noise
   int frames_with_motion = 0;     ///< frames with a motion field
   double max_motion_px = 0.0;     ///< the longest image motion over an exposure
   colormap::NoiseProfile noise;   ///< last frame's (smoothed)
