@@ -80,6 +80,32 @@ TEST(ToneMapCli, ReinhardRollsOffTheHighlightThatTheExposureClampFlattens) {
   }
 }
 
+// The key follows the real light through the product: a sequence whose key light switches off
+// at frame 4 (relight synth --light-animation switch-off; the lights follow its probe stream).
+// With a short adaptation time the last frame's log-average luminance is that of the dark frames
+// on their own; with a long one it is still near the lit frames'.
+TEST(ToneMapCli, TheKeyFollowsALightSwitchedOffWithinTheAdaptationTime) {
+  const auto& switched = cli_test::synthetic_sequence(
+      "--frames 12 --size 320x240 --trajectory static --no-gt --light-animation switch-off --light-event-frame 4");
+  test::TempDir dir;
+  const auto log_average = [&](const std::string& name, const std::string& extra) {
+    const auto out = dir.path() / name;
+    const auto result = relight(
+        "replay --quiet " + switched.string() + " --object " + (kData / "models" / "glossy_pebble.gltf").string() +
+        " --no-video --no-frames --camera-artefacts none --tone-map reinhard --out " + out.string() + " " + extra);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    return nlohmann::json::parse(read_text_file(out / "report.json"))["tone_map"]["log_average_luminance"]
+        .get<double>();
+  };
+  const double lit = log_average("lit", "--frames 0:4");
+  const double dark = log_average("dark", "--frames 6:12 --tone-adaptation 0.02");
+  ASSERT_LT(dark, 0.9 * lit) << "the switch darkens the scene";
+  EXPECT_NEAR(log_average("fast", "--tone-adaptation 0.02"), dark, 0.01 * dark);
+  const double slow = log_average("slow", "--tone-adaptation 20");
+  EXPECT_NEAR(slow, lit, 0.05 * lit);
+  EXPECT_GT(slow, 1.1 * dark);
+}
+
 TEST(ToneMapCli, AnUnknownOperatorIsOneLine) {
   test::TempDir dir;
   const auto result = replay(dir.path() / "bad", "--tone-map filmic");
