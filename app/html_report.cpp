@@ -103,6 +103,20 @@ void contact_sheet_section(std::ostringstream& html, const ReportContent& conten
   if (!any) html << "<p class=note>No pictures were collected.</p>\n";
 }
 
+// The composite as rendered beside the composite with the camera's look, at full resolution.
+void camera_look_section(std::ostringstream& html, const CloseUp& close_up) {
+  html << "<h2>Camera look (frame " << close_up.frame
+       << ")</h2>\n<p class=note>The virtual objects as rendered, "
+          "and with the camera's blur, motion blur and noise measured in this frame (camera_look), 2x, "
+          "nearest pixel.</p>\n<div class=sheet>";
+  for (const Thumbnail* picture : {&close_up.before, &close_up.after}) {
+    html << "<figure><img alt=\"" << html_escape(picture->buffer) << "\" width=" << picture->width
+         << " height=" << picture->height << " style=\"image-rendering:pixelated\" src=\"data:image/png;base64,"
+         << base64(picture->jpeg) << "\"><figcaption>" << html_escape(picture->buffer) << "</figcaption></figure>";
+  }
+  html << "</div>\n";
+}
+
 void timing_table(std::ostringstream& html, const Json& stages) {
   double total = 0;
   for (const auto& stage : stages) total += stage.value("median_ms", 0.0);
@@ -285,6 +299,7 @@ std::string html_report(const std::string& title, const nlohmann::ordered_json& 
        << "</title><style>" << kStyle << "</style></head><body>\n<h1>" << html_escape(title) << "</h1>\n";
   summary_section(html, timing);
   contact_sheet_section(html, content);
+  if (content.camera_look) camera_look_section(html, *content.camera_look);
   const Json stages = timing.value("stages", Json::array());
   html << "<h2>Stage timings</h2>\n";
   timing_table(html, stages);

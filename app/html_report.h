@@ -17,7 +17,7 @@ namespace relight::app {
 
 struct Thumbnail {
   std::string buffer;
-  std::string jpeg;  ///< encoded bytes
+  std::string jpeg;  ///< encoded bytes (JPEG; a CloseUp's are PNG)
   int width = 0, height = 0;
 };
 
@@ -26,8 +26,15 @@ struct ContactSheetRow {
   std::vector<Thumbnail> pictures;
 };
 
+/// The same crop around the virtual objects in two pictures, at full resolution (scaled up).
+struct CloseUp {
+  std::int64_t frame = -1;
+  Thumbnail before, after;
+};
+
 struct ReportContent {
   std::vector<ContactSheetRow> contact_sheet;
+  std::optional<CloseUp> camera_look;                          ///< the composite as rendered and with the camera's look
   std::optional<std::vector<brdf::MaterialParams>> materials;  ///< of the last frame
   std::optional<lights::LightSet> lights;                      ///< of the last frame
 };

@@ -7,6 +7,7 @@
 #include <functional>
 #include <iostream>
 
+#include "as_rendered_composite_stage.h"
 #include "camera_trajectory_stage.h"
 #include "constant_stage.h"
 #include "frame_range.h"
@@ -272,6 +273,14 @@ void add_report_collector(ReplayPipeline& pipeline, std::int64_t total_frames, b
   collector->add_picture(method2 ? kDepthFiltered : kDepthSmoothed);
   collector->add_picture(kNormals);
   if (pipeline.renders) {
+    if (pipeline.camera_look) {
+      // Before and after the camera's look, side by side: the virtual layer as rendered (sharp,
+      // noiseless), then as this camera would have filmed it.
+      const ReportCollectorStage* shown = collector.get();
+      pipeline.graph->emplace<AsRenderedCompositeStage>(pipeline.composite_rule,
+                                                        [shown](std::int64_t frame) { return shown->shows(frame); });
+      collector->add_close_up(kCompositeAsRendered, kComposite, render::kVirtualCoverage);
+    }
     collector->add_picture(kComposite);
     if (pipeline.final_composite != kComposite) collector->add_picture(pipeline.final_composite);
     collector->add_picture(kBrdfPreview);  // a wide mosaic: last, so it wraps alone

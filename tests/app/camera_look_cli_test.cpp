@@ -109,6 +109,15 @@ TEST(CameraLookCli, ThePebbleCarriesTheCamerasNoiseAndBlurAndNoneKeepsItAsRender
   // Without artefacts the report has no camera_look and the graph no stage for it.
   const auto report = nlohmann::json::parse(read_text_file(dir.path() / "sharp" / "report.json"));
   EXPECT_FALSE(report.contains("camera_look"));
+  // report.html shows the pebble as rendered beside it with the camera's look (two close-ups).
+  const std::string html = read_text_file(dir.path() / "blur" / "report.html");
+  EXPECT_NE(html.find("<h2>Camera look (frame"), std::string::npos);
+  std::size_t close_ups = 0;
+  for (std::size_t at = html.find("data:image/png;base64,"); at != std::string::npos;
+       at = html.find("data:image/png;base64,", at + 1))
+    ++close_ups;
+  EXPECT_EQ(close_ups, 2u);
+  EXPECT_EQ(read_text_file(dir.path() / "sharp" / "report.html").find("<h2>Camera look"), std::string::npos);
 }
 
 // --composite multiplicative through replay: the report says which rule ran; the two rules agree
