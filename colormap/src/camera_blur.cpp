@@ -40,13 +40,15 @@ std::array<std::array<float, Cols>, Rows> blurred_patch(const Image<float>& y, i
   constexpr int kTall = Rows + 2 * 8;  // reach <= 8 (sigma <= 2.6)
   std::array<std::array<float, Cols>, kTall> horizontal{};
   const int top = r - Rows / 2 - reach, left = c - Cols / 2;
-  for (int i = 0; i < Rows + 2 * reach; ++i)
+  for (int i = 0; i < Rows + 2 * reach; ++i) {
+    // The patch's taps of this row (the callers keep the patch inside the image's margin).
+    const float* taps = y.row(top + i).data() + (left - reach);
     for (int j = 0; j < Cols; ++j) {
       float sum = 0.f;
-      for (std::size_t k = 0; k < weights.size(); ++k)
-        sum += weights[k] * y(top + i, left + j + static_cast<int>(k) - reach);
+      for (std::size_t k = 0; k < weights.size(); ++k) sum += weights[k] * taps[static_cast<std::size_t>(j) + k];
       horizontal[static_cast<std::size_t>(i)][static_cast<std::size_t>(j)] = sum;
     }
+  }
   std::array<std::array<float, Cols>, Rows> out{};
   for (std::size_t i = 0; i < Rows; ++i)
     for (std::size_t j = 0; j < Cols; ++j) {

@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "relight/core/error.h"
 #include "relight/core/image.h"
 
 namespace relight {
@@ -36,21 +37,31 @@ void gaussian_blur_region(const ImageType& image, int row0, int row1, int col0, 
   const int width = image.width(), height = image.height();
   const auto columns = static_cast<std::size_t>(col1 - col0);
   const int tall = row1 - row0 + 2 * radius;
+  if (out.size() < static_cast<std::size_t>(row1 - row0) * columns)
+    throw LogicError("gaussian_blur_region: the output is smaller than the region");
   std::vector<Pixel> horizontal(static_cast<std::size_t>(tall) * columns);
   for (int i = 0; i < tall; ++i) {
-    const int row = std::clamp(row0 - radius + i, 0, height - 1);
+    const Pixel* line = image.row(std::clamp(row0 - radius + i, 0, height - 1)).data();
     for (int j = 0; j < col1 - col0; ++j) {
+      const int first = col0 + j - radius;
       Pixel sum{};
-      for (std::size_t k = 0; k < weights.size(); ++k)
-        sum = sum + weights[k] * image(row, std::clamp(col0 + j + static_cast<int>(k) - radius, 0, width - 1));
+      if (first >= 0 && first + static_cast<int>(weights.size()) <= width) {  // inside: no clamping
+        const Pixel* taps = line + first;
+        for (std::size_t k = 0; k < weights.size(); ++k) sum = sum + weights[k] * taps[k];
+      } else {
+        for (std::size_t k = 0; k < weights.size(); ++k)
+          sum = sum + weights[k] * line[std::clamp(first + static_cast<int>(k), 0, width - 1)];
+      }
       horizontal[static_cast<std::size_t>(i) * columns + static_cast<std::size_t>(j)] = sum;
     }
   }
+  const Pixel* rows = horizontal.data();
+  Pixel* result = out.data();
   for (std::size_t i = 0; i < static_cast<std::size_t>(row1 - row0); ++i)
     for (std::size_t j = 0; j < columns; ++j) {
       Pixel sum{};
-      for (std::size_t k = 0; k < weights.size(); ++k) sum = sum + weights[k] * horizontal[(i + k) * columns + j];
-      out[i * columns + j] = sum;
+      for (std::size_t k = 0; k < weights.size(); ++k) sum = sum + weights[k] * rows[(i + k) * columns + j];
+      result[i * columns + j] = sum;
     }
 }
 
