@@ -43,10 +43,12 @@ NoiseProfile estimate_camera_noise(const ColorImage& image, const NoiseEstimatio
       // The 3x3 means of the luma around (r, c) give the local level and, by their Sobel
       // gradient, the flatness.
       std::array<std::array<float, 5>, 5> l{};
+      std::array<const Rgb8*, 5> rows{};  // the 5x5 neighbourhood's rows, from column c - 2
+      for (std::size_t i = 0; i < 5; ++i) rows[i] = image.row(r + static_cast<int>(i) - 2).data() + (c - 2);
       bool clipped = false;
       for (std::size_t i = 0; i < 5; ++i)
         for (std::size_t j = 0; j < 5; ++j) {
-          const Rgb8 p = image(r + static_cast<int>(i) - 2, c + static_cast<int>(j) - 2);
+          const Rgb8 p = rows[i][j];
           l[i][j] = luma(p);
           const bool inner = i >= 1 && i <= 3 && j >= 1 && j <= 3;
           clipped = clipped || (inner && (std::max({p.r, p.g, p.b}) == 255 || std::min({p.r, p.g, p.b}) == 0));
@@ -65,7 +67,9 @@ NoiseProfile estimate_camera_noise(const ColorImage& image, const NoiseEstimatio
       if (gx * gx + gy * gy > 64.f * flat * flat) continue;
       const int band = std::min(kNoiseBands - 1, static_cast<int>(m[1][1] / kBandWidth));
       for (int ch = 0; ch < 3; ++ch) {
-        const auto v = [&](int i, int j) { return channel(image(r + i, c + j), ch); };
+        const auto v = [&](int i, int j) {
+          return channel(rows[static_cast<std::size_t>(i + 2)][static_cast<std::size_t>(j + 2)], ch);
+        };
         const float response = v(-1, -1) - 2 * v(-1, 0) + v(-1, 1) - 2 * v(0, -1) + 4 * v(0, 0) - 2 * v(0, 1) +
                                v(1, -1) - 2 * v(1, 0) + v(1, 1);
         responses[static_cast<std::size_t>(band)][static_cast<std::size_t>(ch)].push_back(std::abs(response));
