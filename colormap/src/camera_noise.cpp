@@ -68,7 +68,7 @@ NoiseProfile estimate_camera_noise(const ColorImage& image, const NoiseEstimatio
       const int band = std::min(kNoiseBands - 1, static_cast<int>(m[1][1] / kBandWidth));
       for (int ch = 0; ch < 3; ++ch) {
         const auto v = [&](int i, int j) {
-          return channel(rows[static_cast<std::size_t>(i + 2)][static_cast<std::size_t>(j + 2)], ch);
+          return channel(rows[static_cast<std::size_t>(i) + 2][static_cast<std::size_t>(j) + 2], ch);
         };
         const float response = v(-1, -1) - 2 * v(-1, 0) + v(-1, 1) - 2 * v(0, -1) + 4 * v(0, 0) - 2 * v(0, 1) +
                                v(1, -1) - 2 * v(1, 0) + v(1, 1);
