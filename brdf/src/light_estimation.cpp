@@ -25,7 +25,7 @@ constexpr double kCauchyScale = 0.15;  // relative residual at which a sample's 
 /// clipped channel, not black.
 bool usable_pixel(const Rgb8& c, bool highlight, const Float3& p, const Float3& n) {
   if (highlight || p.z <= 0.f || !is_valid_normal(n)) return false;
-  if (c.r >= 250 || c.g >= 250 || c.b >= 250) return false;
+  if (has_clipped_channel(c)) return false;
   if (static_cast<int>(c.r) + c.g + c.b < 6) return false;
   const float facing = -(n.x * p.x + n.y * p.y + n.z * p.z) / std::sqrt(p.x * p.x + p.y * p.y + p.z * p.z);
   return facing > 0.2f;

@@ -77,16 +77,16 @@ Float3 real_difference(CompositeRule rule, const Rgb8& camera, const Float3& wit
           real_difference(rule, c.z, with.z, without.z)};
 }
 
-/// The camera's value at a real pixel where it clipped a channel, reconstructed from the
-/// rendered real radiance (composite.h); none where no channel is clipped.
-std::optional<Float3> unclipped_camera(const Rgb8& camera, const Float3& real, float scale) {
+/// The camera's value at a real pixel where it clipped a channel (`linear`: the camera pixel
+/// decoded), reconstructed from the rendered real radiance (composite.h); none where no channel is
+/// clipped.
+std::optional<Float3> unclipped_camera(const Rgb8& camera, const Float3& linear, const Float3& real, float scale) {
   const std::array<std::uint8_t, 3> code{camera.r, camera.g, camera.b};
-  const Float3 linear = colormap::decode_srgb8(camera);
   const std::array<float, 3> value{linear.x, linear.y, linear.z}, rendered{real.x, real.y, real.z};
   float camera_sum = 0.f, rendered_sum = 0.f;
   bool clipped = false;
   for (std::size_t k = 0; k < 3; ++k) {
-    if (code[k] >= kClippedCameraCode) {
+    if (code[k] >= kClippedCode) {
       clipped = true;
     } else {
       camera_sum += value[k];
@@ -98,7 +98,7 @@ std::optional<Float3> unclipped_camera(const Rgb8& camera, const Float3& real, f
   const float k = rendered_sum > 1e-6f ? camera_sum / rendered_sum : scale;
   std::array<float, 3> out = value;
   for (std::size_t c = 0; c < 3; ++c)
-    if (code[c] >= kClippedCameraCode) out[c] = std::max(value[c], k * rendered[c]);
+    if (code[c] >= kClippedCode) out[c] = std::max(value[c], k * rendered[c]);
   return Float3{out[0], out[1], out[2]};
 }
 
@@ -107,12 +107,13 @@ std::optional<Float3> unclipped_camera(const Rgb8& camera, const Float3& real, f
 /// objects change nothing there).
 std::optional<Float3> clipped_difference(const Rgb8& camera, const Float3& with, const Float3& without, float scale) {
   if (with == without) return std::nullopt;
-  const std::optional<Float3> unclipped = unclipped_camera(camera, without, scale);
+  const Float3 linear = colormap::decode_srgb8(camera);
+  const std::optional<Float3> unclipped = unclipped_camera(camera, linear, without, scale);
   if (!unclipped) return std::nullopt;
   const auto ratio = [](float w, float wo) { return wo > 1e-6f ? std::min(w / wo, kMaxCompositeRatio) : 1.f; };
   const Float3 changed{unclipped->x * ratio(with.x, without.x), unclipped->y * ratio(with.y, without.y),
                        unclipped->z * ratio(with.z, without.z)};
-  return changed - colormap::decode_srgb8(camera);
+  return changed - linear;
 }
 
 }  // namespace

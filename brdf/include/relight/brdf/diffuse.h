@@ -50,7 +50,7 @@ struct DiffuseOptions {
   float min_brightness = 0.004f;  ///< linear luminance of the pixel colour
   float max_kd = 2.f;            ///< k_d channels are clamped to [0, max_kd]
   float lobe_cos_min = 0.8f;     ///< <omega_o . r_l> above which a valid pixel is marked 2
-  int clip_code = 250;           ///< 8-bit inputs: a channel at or above this is clipped (mark 3)
+  int clip_code = kClippedCode;  ///< 8-bit inputs: a channel at or above this is clipped (mark 3)
   int threads = 0;
 };
 

@@ -13,6 +13,13 @@ struct Rgb8 {
   friend bool operator==(const Rgb8&, const Rgb8&) = default;
 };
 
+/// An 8-bit camera channel at or above this code is taken as clipped: the light it recorded was
+/// at least that bright, how much more is unknown (brdf/'s albedo and the composites leave it out).
+inline constexpr int kClippedCode = 250;
+inline bool has_clipped_channel(const Rgb8& c) {
+  return c.r >= kClippedCode || c.g >= kClippedCode || c.b >= kClippedCode;
+}
+
 /// Three floats: a linear RGB radiance, a normal or a position, depending on the image alias.
 struct Float3 {
   float x = 0.f, y = 0.f, z = 0.f;

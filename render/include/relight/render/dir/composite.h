@@ -25,7 +25,7 @@
 // tints the shadow; the ratio only needs the render's relative change. The ratio is capped at
 // kMaxCompositeRatio (light a virtual object adds to a dark real surface).
 //
-// Where the camera clipped (a channel at or above kClippedCameraCode, as brdf/ marks it) neither
+// Where the camera clipped (a channel at or above kClippedCode, core/pixel.h, as brdf/ marks it) neither
 // rule can work with the camera's value: it stands for "at least 1", the render's TM(L_r) clips
 // the same way, and a virtual shadow over a clipped table left the clipped channel at 1 while
 // the others darkened (a saturated, hue-shifted shadow). There both composites, and both rules,
@@ -53,8 +53,6 @@ enum class CompositeRule { Additive, Multiplicative };
 inline constexpr std::array<NamedValue<CompositeRule>, 2> kCompositeRuleNames{
     {{"additive", CompositeRule::Additive}, {"multiplicative", CompositeRule::Multiplicative}}};
 inline constexpr float kMaxCompositeRatio = 8.f;
-/// A camera channel at or above this 8-bit code is clipped (brdf::DiffuseOptions::clip_code).
-inline constexpr int kClippedCameraCode = 250;
 
 struct CompositeOptions {
   CompositeRule rule = CompositeRule::Additive;
