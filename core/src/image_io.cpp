@@ -10,10 +10,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -98,6 +100,45 @@ void check_format(const std::filesystem::path& path, std::initializer_list<Image
     expected += std::string(expected.empty() ? "" : " or ") + describe(format);
   }
   throw Error("cannot decode " + path.string() + ": not a " + expected + " file");
+}
+
+/// Width and height from a PNG's IHDR or a JPEG's frame header; nullopt when the header is
+/// missing or cut short.
+std::optional<std::pair<int, int>> encoded_size(std::span<const std::uint8_t> b, ImageFormat format) {
+  const auto be16 = [&](std::size_t i) { return (int(b[i]) << 8) | int(b[i + 1]); };
+  if (format == ImageFormat::Png) {
+    // signature (8), chunk length (4), "IHDR", width and height as big-endian 32-bit values.
+    if (b.size() < 24 || std::string_view(reinterpret_cast<const char*>(&b[12]), 4) != "IHDR") return std::nullopt;
+    const auto be32 = [&](std::size_t i) {
+      return (std::uint32_t(b[i]) << 24) | (std::uint32_t(b[i + 1]) << 16) | (std::uint32_t(b[i + 2]) << 8) | b[i + 3];
+    };
+    const std::uint32_t width = be32(16), height = be32(20);
+    constexpr std::uint32_t kLargest = 1u << 30;
+    return std::pair{int(std::min(width, kLargest)), int(std::min(height, kLargest))};
+  }
+  // JPEG: walk the marker segments to the first start-of-frame (SOF0-SOF15 but DHT, JPG, DAC).
+  std::size_t i = 2;
+  while (i + 4 <= b.size()) {
+    if (b[i] != 0xff) return std::nullopt;
+    const std::uint8_t marker = b[i + 1];
+    if (marker == 0xff) {  // fill byte
+      ++i;
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xd0 && marker <= 0xd8)) {  // segments without a length
+      i += 2;
+      continue;
+    }
+    const std::size_t length = static_cast<std::size_t>(be16(i + 2));
+    const bool frame = marker >= 0xc0 && marker <= 0xcf && marker != 0xc4 && marker != 0xc8 && marker != 0xcc;
+    if (frame) {
+      if (i + 9 > b.size()) return std::nullopt;
+      return std::pair{be16(i + 7), be16(i + 5)};
+    }
+    if (length < 2) return std::nullopt;
+    i += 2 + length;
+  }
+  return std::nullopt;
 }
 
 cv::Mat read_any(const std::filesystem::path& path, int flags, std::initializer_list<ImageFormat> accepted) {
@@ -206,6 +247,37 @@ ColorImage read_color(const std::filesystem::path& path) {
   if (raw.depth() != CV_8U) {
     throw Error("colour image " + path.string() + " is " + describe_depth(raw.depth()) + "; expected 8-bit");
   }
+  ColorImage image(raw.cols, raw.rows);
+  cv::Mat wrapped(raw.rows, raw.cols, CV_8UC3, image.data());
+  cv::cvtColor(raw, wrapped, cv::COLOR_BGR2RGB);
+  return image;
+}
+
+ColorImage decode_color(std::span<const std::uint8_t> bytes, const std::string& name, int max_side) {
+  const std::string_view head(reinterpret_cast<const char*>(bytes.data()), std::min<std::size_t>(bytes.size(), 16));
+  std::optional<ImageFormat> format;
+  for (const ImageFormat f : {ImageFormat::Png, ImageFormat::Jpeg})
+    if (has_signature(head, f)) format = f;
+  if (!format) throw Error("cannot decode " + name + ": not a PNG or JPEG image");
+  if (bytes.size() > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw Error("cannot decode " + name + ": larger than 2 GiB");
+  const auto size = encoded_size(bytes, *format);
+  if (!size) throw Error("cannot decode " + name + ": the " + describe(*format) + " header is missing or cut short");
+  if (size->first <= 0 || size->second <= 0 || size->first > max_side || size->second > max_side)
+    throw Error(name + ": a " + std::to_string(size->first) + "x" + std::to_string(size->second) +
+                " image, larger than " + std::to_string(max_side) + " pixels on a side (the limit)");
+  cv::Mat raw;
+  try {
+    const std::lock_guard lock(decoder_mutex());
+    const MutedStderr muted;
+    // imdecode only reads through this header.
+    const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
+    raw = cv::imdecode(encoded, cv::IMREAD_COLOR);
+  } catch (const cv::Exception& e) {
+    throw Error("cannot decode " + name + ": " + e.err);
+  }
+  if (raw.empty() || raw.depth() != CV_8U)
+    throw Error("cannot decode " + name + ": not a readable 8-bit image (corrupt or truncated?)");
   ColorImage image(raw.cols, raw.rows);
   cv::Mat wrapped(raw.rows, raw.cols, CV_8UC3, image.data());
   cv::cvtColor(raw, wrapped, cv::COLOR_BGR2RGB);

@@ -207,6 +207,33 @@ TEST_F(DirVkTest, ShadingMatchesTheCpuMirrorOnTheSameMaps) {
   expect_shading_matches_cpu(context, cube_scene());
 }
 
+// A textured virtual cube: the G-buffer's texture coordinates and footprint, the packed textures
+// and the VPLs' texture factors, and the merge's re-texturing of the indirect light, on the GPU
+// as in the CPU mirror.
+TEST_F(DirVkTest, TexturedShadingMatchesTheCpuMirror) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  MrScene scene = cube_scene();
+  test::texture_virtual_meshes(scene);
+  for (PhongMaterial& m : scene.materials)
+    if (m.base_color) m.kd = Eigen::Vector3f::Constant(0.8f);  // the colours come from the texture alone
+  expect_shading_matches_cpu(context, scene);
+  DirRendererVk renderer(context, 64, 48);
+  renderer.set_scene(scene, test_options());
+  const DifferentialImages images =
+      renderer.render(camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 64, 48), make_vpls(scene, 64), test_options());
+  const GBuffer& gbuffer = renderer.last_gbuffer();
+  int red = 0, white = 0;
+  for (std::size_t i = 0; i < images.real_virtual.size(); ++i) {
+    if (!gbuffer.virtual_surface.pixels()[i]) continue;
+    EXPECT_GT(gbuffer.texcoord.pixels()[i].z, 0.f) << "the cube has texture coordinates";
+    const Float3& c = images.real_virtual.pixels()[i];
+    if (c.x > 0.f && c.y < 0.3f * c.x) ++red;
+    if (c.x > 0.f && c.y > 0.6f * c.x) ++white;
+  }
+  EXPECT_GT(red, 20) << "the checkerboard's red cells";
+  EXPECT_GT(white, 20) << "and its white ones";
+}
+
 // An emitter VPL's tiles look at the scene from far away (ism.h) and it shades like a
 // directional light (vpl.h): both on the GPU as in the CPU mirror.
 TEST_F(DirVkTest, EmitterVplSplatsAndShadesLikeTheCpuMirror) {

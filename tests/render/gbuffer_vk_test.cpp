@@ -50,6 +50,40 @@ TEST_F(GBufferVkTest, MatchesTheRayCastGBuffer) {
   }
 }
 
+// Texture coordinates and footprints: the rasteriser's interpolation and screen derivatives
+// against the ray tracer's barycentrics and ray differentials.
+TEST_F(GBufferVkTest, TextureCoordinatesMatchTheRayDifferentials) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  MrScene scene = test::indoor_with_pebble();
+  test::texture_virtual_meshes(scene);
+  const MrCamera camera = test::camera_at({0.9, -0.7, 1.1}, {0.35, -0.2, 0.8}, 160, 120);
+  GBufferVk renderer(context, 160, 120);
+  renderer.set_scene(scene);
+  const GBuffer gpu = renderer.render(camera);
+  const GBuffer cpu = gbuffer_cpu(RayTracer(scene), camera);
+  ASSERT_FALSE(cpu.texcoord.empty());
+  int compared = 0, close_footprint = 0;
+  for (int row = 1; row < 119; ++row)
+    for (int col = 1; col < 159; ++col) {
+      if (!cpu.virtual_surface(row, col) || !gpu.virtual_surface(row, col)) continue;
+      if (cpu.material(row, col) != gpu.material(row, col) || gpu.texcoord(row, col).z == 0.f) continue;
+      ++compared;
+      const Float3 &g = gpu.texcoord(row, col), &c = cpu.texcoord(row, col);
+      EXPECT_NEAR(g.x, c.x, 5e-3f) << row << "," << col;
+      EXPECT_NEAR(g.y, c.y, 5e-3f) << row << "," << col;
+      // dFdx differences within a 2x2 quad against differentials to the next pixel: close, not
+      // equal, and on a curved surface the neighbour's ray meets another triangle.
+      if (std::abs(g.z - c.z) <= 0.25f * c.z) ++close_footprint;
+    }
+  ASSERT_GT(compared, 300) << "the pebble fills part of the view";
+  EXPECT_GT(close_footprint, compared * 9 / 10);
+  for (std::size_t i = 0; i < cpu.texcoord.size(); ++i) {
+    if (!cpu.virtual_surface.pixels()[i]) {
+      EXPECT_EQ(cpu.texcoord.pixels()[i].z, 0.f) << "real surfaces have no coordinates";
+    }
+  }
+}
+
 TEST_F(GBufferVkTest, RejectsAWrongCameraSizeAndRenderBeforeScene) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   GBufferVk renderer(context, 32, 24);

@@ -55,6 +55,29 @@ inline void add_virtual_box(MrScene& scene, const synth::Box& box, const PhongMa
   scene.meshes.push_back(mesh);
 }
 
+/// A side x side texel checkerboard of cell x cell squares, colours a and b (sRGB).
+inline ColorImage checkerboard(int side, int cell, Rgb8 a, Rgb8 b) {
+  ColorImage out(side, side);
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) out(y, x) = ((x / cell + y / cell) % 2 == 0) ? a : b;
+  return out;
+}
+
+/// Gives every virtual mesh of `scene` texture coordinates (a planar projection, 2.5 (x + z,
+/// y + z) in metres: 0.4 m per repeat) and the materials it uses a red and white checkerboard
+/// of 4 x 4 cells.
+inline void texture_virtual_meshes(MrScene& scene) {
+  const auto texture =
+      std::make_shared<const Texture>("checker", checkerboard(32, 8, Rgb8{230, 40, 30}, Rgb8{240, 240, 240}));
+  for (TriangleMesh& mesh : scene.meshes) {
+    if (mesh.real) continue;
+    mesh.texcoords.clear();
+    for (const Eigen::Vector3f& p : mesh.positions)
+      mesh.texcoords.emplace_back(2.5f * (p.x() + p.z()), 2.5f * (p.y() + p.z()));
+    for (const std::uint32_t m : mesh.triangle_material) scene.materials[m].base_color = texture;
+  }
+}
+
 /// A camera of `width` x `height` pixels (focal length scaled from the Kinect's) at `eye`
 /// looking at `target`.
 inline MrCamera camera_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, int width, int height) {

@@ -7,6 +7,7 @@ struct Vpl {  // vpl_buffer.h: GpuVpl
   vec4 normal_flags;       // w: bit 0 r(VPL), bit 1 in_real_virtual, bit 2 in_real, bit 3 emitter (bits)
   vec4 incident;
   vec4 flux;
+  vec4 kd_texture;  // Vpl::kd_texture
 };
 
 // orthonormal_basis() (phong_brdf.h), Duff et al. 2017.

@@ -5,7 +5,8 @@
 // every VPL subset) over the neighbours on the same kind of surface (real or virtual) within 5 %
 // of its distance and with normals within ~25 degrees; a subset whose pixel there fails is
 // looked for one period further out (its 8 pixels at ±n), averaged first, so that each subset
-// found counts once. Direct light passes through unblurred.
+// found counts once. Direct light passes through unblurred; the merged indirect light takes the
+// pixel's k_d texture factor (in the w of its shaded vec4s 1-3, dir_shade.comp).
 // The CPU mirror is merged_pixel() in dir_maps_cpu.cpp.
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -70,8 +71,10 @@ void main() {
       }
   }
   const vec4 direct_rv = shaded[4u * i];
-  radiance[4u * i] = vec4(direct_rv.xyz + sum_rv / weight, direct_rv.w);
-  radiance[4u * i + 1u] = vec4(shaded[4u * i + 1u].xyz + sum_r / weight, 0.0);
-  radiance[4u * i + 2u] = vec4(sum_rv / weight, 0.0);
-  radiance[4u * i + 3u] = vec4(sum_r / weight, 0.0);
+  const vec3 kd_texture = vec3(shaded[4u * i + 1u].w, shaded[4u * i + 2u].w, shaded[4u * i + 3u].w);
+  const vec3 indirect_rv = sum_rv / weight * kd_texture, indirect_r = sum_r / weight * kd_texture;
+  radiance[4u * i] = vec4(direct_rv.xyz + indirect_rv, direct_rv.w);
+  radiance[4u * i + 1u] = vec4(shaded[4u * i + 1u].xyz + indirect_r, 0.0);
+  radiance[4u * i + 2u] = vec4(indirect_rv, 0.0);
+  radiance[4u * i + 3u] = vec4(indirect_r, 0.0);
 }

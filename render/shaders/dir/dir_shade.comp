@@ -13,7 +13,9 @@
 // invocations read the same VPLs.
 //
 // Output per pixel (4 vec4): direct L_rv + emission (w: virtual coverage), direct L_r,
-// indirect L_rv, indirect L_r.
+// indirect L_rv, indirect L_r; the w of the last three hold the k_d texture factor, which
+// dir_merge.comp applies to the merged indirect light (the indirect light is shaded with the
+// material's own k_d, the direct light with the textured one; dir_cpu.cpp's MapShader::shade).
 #include "dir_common.glsl"
 #include "phong.glsl"
 
@@ -22,6 +24,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 struct Material {
   vec4 kd_ks;        // k_d, k_s
   vec4 emission_n;   // emission, Phong exponent n
+  vec4 texture;      // x: its base-colour texture's header in texture_words (bits); 0xffffffff: none
 };
 struct Light {
   vec4 position_kind;      // w: 0 point, 1 spot, 2 directional, 3 directional through its emitter VPL (bits)
@@ -35,7 +38,8 @@ struct ShadowView {
   vec4 texel_size;
 };
 
-layout(std430, set = 0, binding = 0) readonly buffer GBuffer { vec4 gbuffer[]; };  // positions, then normals
+// positions, then normals, then texture coordinates (GBufferVk::packed_bytes)
+layout(std430, set = 0, binding = 0) readonly buffer GBuffer { vec4 gbuffer[]; };
 layout(std430, set = 0, binding = 1) readonly buffer Materials { Material materials[]; };
 layout(std430, set = 0, binding = 2) readonly buffer Lights { Light lights[]; };
 layout(std430, set = 0, binding = 3) readonly buffer Views { ShadowView views[]; };
@@ -43,6 +47,8 @@ layout(std430, set = 0, binding = 4) readonly buffer ShadowAtlas { float shadow_
 layout(std430, set = 0, binding = 5) readonly buffer Vpls { Vpl vpls[]; };
 layout(std430, set = 0, binding = 6) readonly buffer IsmAtlas { float ism_atlas[]; };
 layout(std430, set = 0, binding = 7) writeonly buffer Radiance { vec4 radiance[]; };
+layout(std430, set = 0, binding = 8) readonly buffer Textures { uint texture_words[]; };
+#include "dir_texture.glsl"
 
 layout(push_constant) uniform Params {
   uint width;
@@ -129,16 +135,25 @@ void main() {
   const vec4 position = gbuffer[i];
   if (position.w == 0.0) {
     radiance[4u * i] = vec4(params.environment.xyz, 0.0);
-    radiance[4u * i + 1u] = vec4(params.environment.xyz, 0.0);
-    radiance[4u * i + 2u] = vec4(0.0);
-    radiance[4u * i + 3u] = vec4(0.0);
+    radiance[4u * i + 1u] = vec4(params.environment.xyz, 1.0);
+    radiance[4u * i + 2u] = vec4(0.0, 0.0, 0.0, 1.0);
+    radiance[4u * i + 3u] = vec4(0.0, 0.0, 0.0, 1.0);
     return;
   }
   const vec4 normal_material = gbuffer[pixels + i];
   const vec3 point = position.xyz, n = normal_material.xyz;
   const float real_pixel = position.w > 0.0 ? 1.0 : 0.0;  // r(p)
   const vec3 wo = normalize(params.camera_centre.xyz - point);
-  const Material m = materials[uint(normal_material.w)];
+  const Material own = materials[uint(normal_material.w)];
+  // base_color_factors() (gbuffer.h): the texture at the pixel's coordinates and footprint.
+  vec3 kd_texture = vec3(1.0);
+  const uint header = floatBitsToUint(own.texture.x);
+  if (header != 0xffffffffu) {
+    const vec4 t = gbuffer[2u * pixels + i];
+    kd_texture = t.z > 0.0 ? texture_sample(header, t.xy, texture_level(header, t.z)) : texture_mean(header);
+  }
+  Material m = own;  // textured: for the direct light
+  m.kd_ks.xyz *= kd_texture;
   vec3 rv = m.emission_n.xyz;
   vec3 r = real_pixel * m.emission_n.xyz;
   const bool want_rv = (params.flags & 4u) != 0u, want_r = (params.flags & 8u) != 0u;
@@ -207,9 +222,10 @@ void main() {
       const vec3 wi = to_vpl / sqrt(d2);
       const float cos_x = dot(wi, n), cos_y = -dot(wi, vpl.normal_flags.xyz);
       if (cos_x <= 0.0 || cos_y <= 0.0) continue;
-      const Material mv = materials[floatBitsToUint(vpl.position_material.w)];
+      Material mv = materials[floatBitsToUint(vpl.position_material.w)];
+      mv.kd_ks.xyz *= vpl.kd_texture.xyz;
       const vec3 contribution = vpl.flux.xyz * phong(mv, vpl.normal_flags.xyz, vpl.incident.xyz, -wi) *
-                                phong(m, n, wi, wo) * (cos_x * cos_y / max(d2, min_d2));
+                                phong(own, n, wi, wo) * (cos_x * cos_y / max(d2, min_d2));
       const vec2 seen = ism_visibility(j, vpl, point);
       if (seen.x == 0.0) continue;
       if (in_rv) indirect_rv += contribution * seen.y;
@@ -218,7 +234,7 @@ void main() {
   }
   const float scale = float(interleave * interleave);
   radiance[4u * i] = vec4(rv, 1.0 - real_pixel);
-  radiance[4u * i + 1u] = vec4(r, 0.0);
-  radiance[4u * i + 2u] = vec4(indirect_rv * scale, 0.0);
-  radiance[4u * i + 3u] = vec4(indirect_r * scale, 0.0);
+  radiance[4u * i + 1u] = vec4(r, kd_texture.x);
+  radiance[4u * i + 2u] = vec4(indirect_rv * scale, kd_texture.y);
+  radiance[4u * i + 3u] = vec4(indirect_r * scale, kd_texture.z);
 }

@@ -1,11 +1,15 @@
 #version 450
 // G-buffer pass: target 0 = (world position, signed distance), the sign holding r(p) as in
 // Knecht et al. (positive: real surface, negative: virtual); target 1 = (normal facing the
-// camera, material index). Every corner carries its triangle's material and flag (a flat
-// attribute: gl_PrimitiveID would need the geometry-shader feature).
+// camera, material index); target 2 = (texture coordinates, footprint, 0) on meshes with texture
+// coordinates, else zero (GBuffer::texcoord: the footprint is the longer of the coordinates'
+// screen derivatives, the GPU's form of gbuffer_cpu's ray differentials). Every corner carries
+// its triangle's material and flags (a flat attribute: gl_PrimitiveID would need the
+// geometry-shader feature).
 layout(location = 0) in vec3 world_position;
 layout(location = 1) in vec3 world_normal;
-layout(location = 2) flat in uint triangle_info;  // bits 0-30: material index; bit 31: virtual
+layout(location = 2) flat in uint triangle_info;  // bits 0-29: material index; bit 30: has texcoord; bit 31: virtual
+layout(location = 3) in vec2 surface_texcoord;
 
 layout(push_constant) uniform Camera {
   mat4 world_to_clip;
@@ -14,14 +18,19 @@ layout(push_constant) uniform Camera {
 
 layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
+layout(location = 2) out vec4 out_texcoord;
 
 void main() {
   const uint info = triangle_info;
   const bool is_virtual = (info >> 31) != 0u;
+  const bool has_texcoord = ((info >> 30) & 1u) != 0u;
   const vec3 to_camera = camera.centre.xyz - world_position;
   const float distance = length(to_camera);
   vec3 n = normalize(world_normal);
   if (dot(n, to_camera) < 0.0) n = -n;
   out_position = vec4(world_position, is_virtual ? -distance : distance);
-  out_normal = vec4(n, float(info & 0x7fffffffu));
+  out_normal = vec4(n, float(info & 0x3fffffffu));
+  // Derivatives before the branch: they need every invocation of the quad.
+  const float footprint = max(length(dFdx(surface_texcoord)), length(dFdy(surface_texcoord)));
+  out_texcoord = has_texcoord ? vec4(surface_texcoord, max(footprint, 1e-12), 0.0) : vec4(0.0);
 }

@@ -17,6 +17,7 @@ struct Radiance {
   Vec3 real = Vec3::Zero();
   Vec3 indirect_real_virtual = Vec3::Zero();  ///< this pixel's VPL subset, scaled by n^2
   Vec3 indirect_real = Vec3::Zero();
+  Vec3 kd_texture = Vec3::Ones();  ///< the texture factor of k_d, applied to the indirect light after the merge
 };
 
 class MapShader {
@@ -32,12 +33,18 @@ class MapShader {
         first_emitter_(vpls.size() - emitter_count(vpls)),
         options_(options) {}
 
+  /// Direct light with k_d textured by `kd_texture`; the indirect light with the material's own
+  /// k_d, textured after the interleaved merge (merged_pixel), so that the merge's average over
+  /// neighbouring pixels does not blur the texture into it.
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
-                               float real_pixel, std::uint32_t subset) const {
+                               const Vec3& kd_texture, float real_pixel, std::uint32_t subset) const {
     Radiance out;
     out.real_virtual = m.emission;
     out.real = real_pixel * m.emission;
-    if (options_.shading.direct) add_direct(point, normal, wo, m, real_pixel, out);
+    out.kd_texture = kd_texture;
+    Phong textured = m;
+    textured.kd = m.kd.cwiseProduct(kd_texture);
+    if (options_.shading.direct) add_direct(point, normal, wo, textured, real_pixel, out);
     if (options_.shading.indirect) add_indirect(point, normal, wo, m, real_pixel, subset, out);
     return out;
   }
@@ -46,7 +53,7 @@ class MapShader {
   [[nodiscard]] bool want_rv() const { return options_.output != DirOutput::RealOnly; }
   [[nodiscard]] bool want_r() const { return options_.output != DirOutput::RealVirtualOnly; }
 
-  void add_direct(const Vec3& point, const Vec3& n, const Vec3& wo, const PhongMaterial& m, float real_pixel,
+  void add_direct(const Vec3& point, const Vec3& n, const Vec3& wo, const Phong& m, float real_pixel,
                   Radiance& out) const {
     for (std::size_t l = 0; l < scene_.lights.size(); ++l) {
       const MrLight& light = scene_.lights[l];
@@ -76,7 +83,7 @@ class MapShader {
     }
   }
 
-  void add_indirect(const Vec3& point, const Vec3& n, const Vec3& wo, const PhongMaterial& m, float real_pixel,
+  void add_indirect(const Vec3& point, const Vec3& n, const Vec3& wo, const Phong& m, float real_pixel,
                     std::uint32_t subset, Radiance& out) const {
     const float min_distance2 = options_.shading.min_distance * options_.shading.min_distance;
     const auto count = static_cast<std::uint32_t>(first_emitter_);
@@ -93,10 +100,9 @@ class MapShader {
       const Vec3 wi = to_vpl / std::sqrt(distance2);
       const float cos_x = wi.dot(n), cos_y = -wi.dot(vpl.normal);
       if (cos_x <= 0.f || cos_y <= 0.f) continue;
-      const Vec3 contribution =
-          vpl.flux.cwiseProduct(phong_brdf(scene_.materials[vpl.material], vpl.normal, vpl.incident, -wi))
-              .cwiseProduct(phong_brdf(m, n, wi, wo)) *
-          (cos_x * cos_y / std::max(distance2, min_distance2));
+      const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(vpl_phong(scene_, vpl), vpl.normal, vpl.incident, -wi))
+                                    .cwiseProduct(phong_brdf(m, n, wi, wo)) *
+                                (cos_x * cos_y / std::max(distance2, min_distance2));
       const IsmLookup::Visibility seen = ism_(j, point);
       if (seen.real == 0.f) continue;
       if (in_rv) rv += contribution * seen.virtual_;
@@ -163,8 +169,8 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
       }
   }
   Radiance out;
-  out.indirect_real_virtual = sum_rv / weight;
-  out.indirect_real = sum_r / weight;
+  out.indirect_real_virtual = (sum_rv / weight).cwiseProduct(own.kd_texture);
+  out.indirect_real = (sum_r / weight).cwiseProduct(own.kd_texture);
   out.real_virtual = own.real_virtual + out.indirect_real_virtual;
   out.real = own.real + out.indirect_real;
   return out;
@@ -183,6 +189,7 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
   if (ism_atlas.size() < ism_texels) throw Error("shade_dir_from_maps: the ISM atlas is smaller than its VPLs need");
   if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
   const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
+  const RadianceImage kd_texture = base_color_factors(gbuffer, scene);
   const Vec3 environment = scene.environment.radiance;
   const int n = options.interleave;
   Image<Radiance> shaded(width, height);
@@ -198,8 +205,10 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
         const Vec3 point(p.x, p.y, p.z), normal(nn.x, nn.y, nn.z);
         const float real_pixel = gbuffer.virtual_surface(y, x) ? 0.f : 1.f;
         const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));
-        shaded(y, x) = shader.shade(point, normal, (camera_centre - point).normalized(),
-                                    scene.materials[gbuffer.material(y, x) - 1u], real_pixel, subset);
+        const Float3 t = kd_texture.empty() ? Float3{1.f, 1.f, 1.f} : kd_texture(y, x);
+        shaded(y, x) =
+            shader.shade(point, normal, (camera_centre - point).normalized(),
+                         scene.materials[gbuffer.material(y, x) - 1u], Vec3(t.x, t.y, t.z), real_pixel, subset);
       }
   }, 4);
   DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,

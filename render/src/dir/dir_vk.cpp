@@ -4,6 +4,7 @@
 #include <bit>
 #include <chrono>
 #include <cstring>
+#include <map>
 #include <optional>
 
 #include "dir/ism_vk.h"
@@ -47,10 +48,61 @@ using detail::ShadeParams;
 
 float bits(std::uint32_t value) { return std::bit_cast<float>(value); }
 
-std::vector<float> pack_materials(const MrScene& scene) {
+constexpr std::uint32_t kNoTexture = 0xffffffffu;
+
+/// The scenes' base-colour textures as dir_texture.glsl reads them, and the header word of each
+/// material's texture (kNoTexture: none). A texture shared by several materials is packed once.
+struct PackedTextures {
+  std::vector<std::uint32_t> words;
+  std::vector<std::uint32_t> material_header;
+};
+
+PackedTextures pack_textures(const MrScene& scene) {
+  PackedTextures out;
+  std::map<const Texture*, std::uint32_t> headers;
+  for (const PhongMaterial& m : scene.materials) {
+    const Texture* texture = m.base_color.get();
+    if (!texture) {
+      out.material_header.push_back(kNoTexture);
+      continue;
+    }
+    if (const auto found = headers.find(texture); found != headers.end()) {
+      out.material_header.push_back(found->second);
+      continue;
+    }
+    const auto header = static_cast<std::uint32_t>(out.words.size());
+    const auto levels = static_cast<std::uint32_t>(texture->levels());
+    out.words.insert(out.words.end(), {levels, static_cast<std::uint32_t>(texture->wrap_u()),
+                                       static_cast<std::uint32_t>(texture->wrap_v()),
+                                       static_cast<std::uint32_t>(std::max(texture->width(), texture->height()))});
+    const std::uint32_t first_texel = header + 4 + 4 * levels;
+    for (int l = 0; l < texture->levels(); ++l)
+      out.words.insert(out.words.end(), {first_texel + static_cast<std::uint32_t>(texture->level_offset(l)),
+                                         static_cast<std::uint32_t>(texture->level_width(l)),
+                                         static_cast<std::uint32_t>(texture->level_height(l)), 0u});
+    out.words.insert(out.words.end(), texture->texels().begin(), texture->texels().end());
+    headers.emplace(texture, header);
+    out.material_header.push_back(header);
+  }
+  return out;
+}
+
+/// Per material, its texture (null: none): when a new scene's list equals the last one's, the
+/// packed textures on the device still hold (scenes are rebuilt every frame, textures are shared).
+/// (Held, not just compared: a texture freed and another made at its address would look unchanged.)
+std::vector<std::shared_ptr<const Texture>> material_textures(const MrScene& scene) {
+  std::vector<std::shared_ptr<const Texture>> out;
+  for (const PhongMaterial& m : scene.materials) out.push_back(m.base_color);
+  return out;
+}
+
+std::vector<float> pack_materials(const MrScene& scene, const std::vector<std::uint32_t>& texture_headers) {
   std::vector<float> out;
-  for (const PhongMaterial& m : scene.materials)
-    out.insert(out.end(), {m.kd.x(), m.kd.y(), m.kd.z(), m.ks, m.emission.x(), m.emission.y(), m.emission.z(), m.n});
+  for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+    const PhongMaterial& m = scene.materials[i];
+    out.insert(out.end(), {m.kd.x(), m.kd.y(), m.kd.z(), m.ks, m.emission.x(), m.emission.y(), m.emission.z(), m.n,
+                           bits(texture_headers[i]), 0.f, 0.f, 0.f});
+  }
   return out;
 }
 
@@ -87,13 +139,15 @@ std::vector<float> pack_views(const ShadowLayout& layout) {
 
 std::vector<float> pack_vpls(std::span<const Vpl> vpls) {
   std::vector<float> out;
-  out.reserve(vpls.size() * 16);
+  out.reserve(vpls.size() * 20);
   for (const Vpl& v : vpls) {
     const std::uint32_t flags =
         (v.on_real_surface ? 1u : 0u) | (v.in_real_virtual ? 2u : 0u) | (v.in_real ? 4u : 0u) | (v.emitter() ? 8u : 0u);
-    out.insert(out.end(), {v.position.x(), v.position.y(), v.position.z(), bits(v.material), v.normal.x(), v.normal.y(),
-                           v.normal.z(), bits(flags), v.incident.x(), v.incident.y(), v.incident.z(), 0.f, v.flux.x(),
-                           v.flux.y(), v.flux.z(), 0.f});
+    out.insert(out.end(), {v.position.x(),   v.position.y(),   v.position.z(),   bits(v.material),
+                           v.normal.x(),     v.normal.y(),     v.normal.z(),     bits(flags),
+                           v.incident.x(),   v.incident.y(),   v.incident.z(),   0.f,
+                           v.flux.x(),       v.flux.y(),       v.flux.z(),       0.f,
+                           v.kd_texture.x(), v.kd_texture.y(), v.kd_texture.z(), 0.f});
   }
   return out;
 }
@@ -113,19 +167,25 @@ struct DirRendererVk::Impl {
         gbuffer(context, width, height),
         shadow_maps(context),
         ism(context),
-        shade(context, {.spirv = shaders::dir_shade_comp, .storage_buffers = 8,
-                        .push_constant_bytes = sizeof(ShadeParams), .max_descriptor_sets = 2}),
-        merge(context, {.spirv = shaders::dir_merge_comp, .storage_buffers = 3,
-                        .push_constant_bytes = sizeof(MergeParams), .max_descriptor_sets = 2}),
+        shade(context, {.spirv = shaders::dir_shade_comp,
+                        .storage_buffers = 9,
+                        .push_constant_bytes = sizeof(ShadeParams),
+                        .max_descriptor_sets = 2}),
+        merge(context, {.spirv = shaders::dir_merge_comp,
+                        .storage_buffers = 3,
+                        .push_constant_bytes = sizeof(MergeParams),
+                        .max_descriptor_sets = 2}),
         gbuffer_buffer(context, GBufferVk::packed_bytes(width, height)),
         shaded(context, 16 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
         output(context, 16 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height)),
         merge_set(merge.bind({&gbuffer_buffer, &shaded, &output})),
-        timers{vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context),
-               vk::GpuTimer(context), vk::GpuTimer(context)} {}
+        timers{vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context),
+               vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context)} {}
 
   /// `slot` holds at least `data` (grown, never shrunk) with `data` uploaded.
-  void upload(std::unique_ptr<vk::VulkanBuffer>& slot, const std::vector<float>& data) {
+  template <class T>
+  void upload(std::unique_ptr<vk::VulkanBuffer>& slot, const std::vector<T>& data) {
+    static_assert(sizeof(T) == sizeof(float));
     const std::size_t bytes = std::max<std::size_t>(data.size(), 4) * sizeof(float);
     if (!slot || slot->size_bytes() < bytes) slot = std::make_unique<vk::VulkanBuffer>(context, bytes);
     if (!data.empty()) context.transfer().upload(std::as_bytes(std::span(data)), *slot);
@@ -139,7 +199,9 @@ struct DirRendererVk::Impl {
   vk::ComputePipeline shade, merge;
   vk::VulkanBuffer gbuffer_buffer, shaded, output;
   vk::UniqueDescriptorSet merge_set;
-  std::unique_ptr<vk::VulkanBuffer> materials, lights, views, vpls;
+  std::unique_ptr<vk::VulkanBuffer> materials, lights, views, vpls, textures;
+  std::vector<std::shared_ptr<const Texture>> uploaded_textures;  // per material, of the packed `textures`
+  std::vector<std::uint32_t> texture_headers;                     // per material
   vk::UniqueDescriptorSet shade_set;
   std::array<vk::GpuTimer, 6> timers;
   std::optional<MrScene> scene;
@@ -159,7 +221,7 @@ struct DirRendererVk::Impl {
     vk::compute_barrier(cmd);
     d.shade_set = {};
     d.shade_set = d.shade.bind({&d.gbuffer_buffer, d.materials.get(), d.lights.get(), d.views.get(),
-                                &d.shadow_maps.atlas(), d.vpls.get(), &d.ism.atlas(), &d.shaded});
+                                &d.shadow_maps.atlas(), d.vpls.get(), &d.ism.atlas(), &d.shaded, d.textures.get()});
     const auto n = static_cast<std::uint32_t>(options.interleave);
     d.timers[3].start(cmd);
     d.shade.dispatch(cmd, d.shade_set, params, vk::ComputePipeline::group_count((params.width + n - 1) / n * n, 8),
@@ -188,7 +250,14 @@ void DirRendererVk::set_scene(const MrScene& scene, const DirRenderOptions& opti
   d.layout = plan_shadow_views(scene, options.shadow_tile);
   d.points = sample_ism_points(scene, options.ism);
   d.ism.set_points(d.points);
-  d.upload(d.materials, pack_materials(scene));
+  if (std::vector<std::shared_ptr<const Texture>> textures = material_textures(scene);
+      textures != d.uploaded_textures || !d.textures) {
+    PackedTextures packed = pack_textures(scene);
+    d.upload(d.textures, packed.words);
+    d.texture_headers = std::move(packed.material_header);
+    d.uploaded_textures = std::move(textures);
+  }
+  d.upload(d.materials, pack_materials(scene, d.texture_headers));
   d.upload(d.lights, pack_lights(scene, d.layout));
   d.upload(d.views, pack_views(d.layout));
   d.scene = scene;

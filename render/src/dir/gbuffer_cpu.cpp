@@ -1,17 +1,60 @@
+#include <algorithm>
+#include <cmath>
+
 #include "relight/core/parallel.h"
 #include "relight/render/dir/gbuffer.h"
 
 namespace relight::render {
+namespace {
+
+/// How far the hit's texture coordinates move to where the ray `next` meets the hit's plane (a
+/// ray differential: the neighbouring pixel's ray against the same triangle's plane).
+float texcoord_step(const SurfaceHit& hit, const Eigen::Vector3f& origin, const Eigen::Vector3f& next) {
+  const float facing = next.dot(hit.geometric_normal);
+  if (!(std::abs(facing) > 1e-6f)) return 0.f;
+  const float t = (hit.point - origin).dot(hit.geometric_normal) / facing;
+  if (!(t > 0.f)) return 0.f;
+  return (hit.texcoord_gradient * (origin + t * next - hit.point)).norm();
+}
+
+}  // namespace
+
+bool has_textures(const MrScene& scene) {
+  return std::any_of(scene.materials.begin(), scene.materials.end(),
+                     [](const PhongMaterial& m) { return m.base_color != nullptr; });
+}
+
+RadianceImage base_color_factors(const GBuffer& gbuffer, const MrScene& scene) {
+  if (gbuffer.texcoord.empty() || !has_textures(scene)) return {};
+  RadianceImage out(gbuffer.texcoord.width(), gbuffer.texcoord.height());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out.pixels()[i] = {1.f, 1.f, 1.f};
+    const std::uint16_t label = gbuffer.material.pixels()[i];
+    if (label == 0) continue;
+    const Texture* texture = scene.materials.at(label - 1u).base_color.get();
+    if (!texture) continue;
+    const Float3& t = gbuffer.texcoord.pixels()[i];
+    // A footprint of zero marks a pixel without coordinates (the coordinates themselves may be 0).
+    const Eigen::Vector3f c = t.z > 0.f ? texture->sample(t.x, t.y, texture->level_of_detail(t.z)) : texture->mean();
+    out.pixels()[i] = {c.x(), c.y(), c.z()};
+  }
+  return out;
+}
 
 GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads) {
   const PinholeIntrinsics& k = camera.intrinsics;
   GBuffer out{PositionMap(k.width, k.height), NormalMap(k.width, k.height), LabelImage(k.width, k.height),
               Mask(k.width, k.height), DepthMap(k.width, k.height)};
+  const bool textured = has_textures(tracer.scene());
+  if (textured) out.texcoord = Image<Float3>(k.width, k.height);
   const Eigen::Vector3f origin = camera.camera_to_world.translation().cast<float>();
+  const auto ray = [&](int col, int row) {
+    return (camera.camera_to_world.linear() * k.ray(col, row).normalized()).cast<float>().eval();
+  };
   parallel_rows(k.height, threads, [&](int begin, int end) {
     for (int row = begin; row < end; ++row)
       for (int col = 0; col < k.width; ++col) {
-        const Eigen::Vector3f d = (camera.camera_to_world.linear() * k.ray(col, row).normalized()).cast<float>();
+        const Eigen::Vector3f d = ray(col, row);
         const auto real = tracer.intersect(Layer::Real, origin, d);
         const auto virtual_hit =
             tracer.intersect(Layer::Virtual, origin, d, real ? real->t : std::numeric_limits<float>::infinity());
@@ -24,6 +67,12 @@ GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads
         out.material(row, col) = static_cast<std::uint16_t>(hit->material + 1);
         out.virtual_surface(row, col) = hit->real ? 0 : 1;
         out.distance(row, col) = hit->t;
+        if (textured && hit->has_texcoord) {
+          const float footprint =
+              std::max(texcoord_step(*hit, origin, ray(col + 1, row)), texcoord_step(*hit, origin, ray(col, row + 1)));
+          // At least a little above zero: zero marks "no coordinates" (base_color_factors).
+          out.texcoord(row, col) = {hit->texcoord.x(), hit->texcoord.y(), std::max(footprint, 1e-12f)};
+        }
       }
   }, 4);
   return out;

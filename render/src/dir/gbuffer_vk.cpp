@@ -50,7 +50,7 @@ struct GBufferVk::Impl {
   vk::VulkanContext& context;
   std::uint32_t width, height;
   vk::UniqueRenderPass render_pass;
-  vk::VulkanImage position_target, normal_target, depth_target;
+  vk::VulkanImage position_target, normal_target, texcoord_target, depth_target;
   vk::UniqueFramebuffer framebuffer;
   detail::MeshPipeline pipeline;
   vk::VulkanBuffer readback;
@@ -63,20 +63,24 @@ GBufferVk::Impl::Impl(vk::VulkanContext& context, int width, int height)
     : context(context),
       width(static_cast<std::uint32_t>(width)),
       height(static_cast<std::uint32_t>(height)),
-      render_pass(detail::create_raster_pass(context.device(), std::array{kTargetFormat, kTargetFormat}, kDepthFormat)),
+      render_pass(detail::create_raster_pass(context.device(), std::array{kTargetFormat, kTargetFormat, kTargetFormat},
+                                             kDepthFormat)),
       position_target(context, this->width, this->height, kTargetFormat,
                       VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT),
       normal_target(context, this->width, this->height, kTargetFormat,
                     VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT),
+      texcoord_target(context, this->width, this->height, kTargetFormat,
+                      VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT),
       depth_target(context, this->width, this->height, kDepthFormat, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
                    VK_IMAGE_ASPECT_DEPTH_BIT),
       framebuffer(detail::create_framebuffer(
           context.device(), render_pass.get(),
-          std::array{position_target.view(), normal_target.view(), depth_target.view()}, this->width, this->height)),
+          std::array{position_target.view(), normal_target.view(), texcoord_target.view(), depth_target.view()},
+          this->width, this->height)),
       pipeline(detail::create_mesh_pipeline(context.device(), {.render_pass = render_pass.get(),
                                                                .vertex_spirv = shaders::gbuffer_vert,
                                                                .fragment_spirv = shaders::gbuffer_frag,
-                                                               .colour_targets = 2,
+                                                               .colour_targets = 3,
                                                                .push_constant_bytes = sizeof(CameraConstants)})),
       readback(context, GBufferVk::packed_bytes(width, height), vk::BufferDomain::Readback),
       timer(context) {}
@@ -100,7 +104,7 @@ void GBufferVk::set_scene(const MrScene& scene, std::optional<Layer> only) {
 }
 
 std::size_t GBufferVk::packed_bytes(int width, int height) {
-  return 8 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  return 12 * sizeof(float) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
 }
 
 void GBufferVk::record(VkCommandBuffer cmd, const MrCamera& camera, const vk::VulkanBuffer& destination) {
@@ -118,8 +122,8 @@ void GBufferVk::record(VkCommandBuffer cmd, const MrCamera& camera, const vk::Vu
   constants.centre[1] = centre.y();
   constants.centre[2] = centre.z();
 
-  std::array<VkClearValue, 3> clear{};
-  clear[2].depthStencil = {1.f, 0};
+  std::array<VkClearValue, 4> clear{};
+  clear[3].depthStencil = {1.f, 0};
   VkRenderPassBeginInfo begin{};
   begin.sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO;
   begin.renderPass = g.render_pass.get();
@@ -138,6 +142,9 @@ void GBufferVk::record(VkCommandBuffer cmd, const MrCamera& camera, const vk::Vu
   vkCmdCopyImageToBuffer(cmd, g.position_target.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, destination.handle(), 1, &region);
   region.bufferOffset = static_cast<VkDeviceSize>(g.width) * g.height * 4 * sizeof(float);
   vkCmdCopyImageToBuffer(cmd, g.normal_target.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, destination.handle(), 1, &region);
+  region.bufferOffset *= 2;
+  vkCmdCopyImageToBuffer(cmd, g.texcoord_target.handle(), VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, destination.handle(), 1,
+                         &region);
 }
 
 GBuffer GBufferVk::render(const MrCamera& camera) {
@@ -152,18 +159,20 @@ GBuffer GBufferVk::render(const MrCamera& camera) {
 
 GBuffer GBufferVk::unpack(std::span<const float> data, int width, int height) {
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  if (data.size() < 8 * pixels) throw LogicError("GBufferVk::unpack: too few values");
-  GBuffer out{PositionMap(width, height), NormalMap(width, height), LabelImage(width, height), Mask(width, height),
-              DepthMap(width, height)};
+  if (data.size() < 12 * pixels) throw LogicError("GBufferVk::unpack: too few values");
+  GBuffer out{PositionMap(width, height), NormalMap(width, height), LabelImage(width, height),
+              Mask(width, height),        DepthMap(width, height),  Image<Float3>(width, height)};
   for (std::size_t i = 0; i < pixels; ++i) {
     const float* p = &data[4 * i];
     const float* n = &data[4 * (pixels + i)];
+    const float* t = &data[4 * (2 * pixels + i)];
     if (p[3] == 0.f) continue;  // cleared: nothing drawn
     out.position.pixels()[i] = {p[0], p[1], p[2]};
     out.distance.pixels()[i] = std::abs(p[3]);
     out.virtual_surface.pixels()[i] = p[3] < 0.f ? 1 : 0;
     out.normal.pixels()[i] = {n[0], n[1], n[2]};
     out.material.pixels()[i] = static_cast<std::uint16_t>(n[3] + 1.f);
+    out.texcoord.pixels()[i] = {t[0], t[1], t[2]};
   }
   return out;
 }

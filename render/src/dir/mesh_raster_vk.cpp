@@ -16,7 +16,9 @@ void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, Mes
   for (const TriangleMesh& mesh : scene.meshes) {
     if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      const std::uint32_t info = mesh.triangle_material[t] | (mesh.real ? 0u : 0x80000000u);
+      const bool textured = !mesh.texcoords.empty();
+      const std::uint32_t info =
+          mesh.triangle_material[t] | (mesh.real ? 0u : kVirtualBit) | (textured ? kTexcoordBit : 0u);
       const auto& tri = mesh.triangles[t];
       Eigen::Vector3f flat = Eigen::Vector3f::Zero();
       if (mesh.normals.empty())
@@ -24,7 +26,8 @@ void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, Mes
       for (std::uint32_t v : tri) {
         const Eigen::Vector3f& p = mesh.positions[v];
         const Eigen::Vector3f n = mesh.normals.empty() ? flat : mesh.normals[v];
-        vertices.push_back({{p.x(), p.y(), p.z()}, {n.x(), n.y(), n.z()}, info});
+        const Eigen::Vector2f uv = textured ? mesh.texcoords[v] : Eigen::Vector2f::Zero();
+        vertices.push_back({{p.x(), p.y(), p.z()}, {n.x(), n.y(), n.z()}, info, {uv.x(), uv.y()}});
       }
     }
   }
@@ -120,10 +123,11 @@ MeshPipeline create_mesh_pipeline(VkDevice device, const MeshPipelineInfo& info)
        out.fragment_shader.get(), "main", nullptr},
   }};
   const VkVertexInputBindingDescription binding{0, sizeof(RasterVertex), VK_VERTEX_INPUT_RATE_VERTEX};
-  const std::array<VkVertexInputAttributeDescription, 3> attributes{{
+  const std::array<VkVertexInputAttributeDescription, 4> attributes{{
       {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(RasterVertex, position)},
       {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(RasterVertex, normal)},
       {2, 0, VK_FORMAT_R32_UINT, offsetof(RasterVertex, info)},
+      {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(RasterVertex, texcoord)},
   }};
   VkPipelineVertexInputStateCreateInfo vertex_input{};
   vertex_input.sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO;

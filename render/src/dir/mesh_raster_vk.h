@@ -23,10 +23,15 @@ namespace relight::render::detail {
 /// One triangle corner. Expanded per corner (no index buffer): the passes' cost is the
 /// rasterisation, not the vertex count, and the flat `info` attribute stands in for
 /// gl_PrimitiveID (which would need the geometry-shader feature).
+inline constexpr std::uint32_t kVirtualBit = 0x80000000u;
+inline constexpr std::uint32_t kTexcoordBit = 0x40000000u;  ///< the mesh has texture coordinates
+inline constexpr std::uint32_t kMaterialBits = 0x3fffffffu;
+
 struct RasterVertex {
   float position[3];
   float normal[3];
-  std::uint32_t info;  ///< bits 0-30: material index; bit 31: virtual
+  std::uint32_t info;  ///< bits 0-29: material index; bit 30: has texcoord; bit 31: virtual
+  float texcoord[2];   ///< (0, 0) without texture coordinates
 };
 
 struct SceneVertices {

@@ -88,8 +88,8 @@ class DirShader {
       const float cos_x = wi.dot(v.shading_normal);
       const float cos_y = -wi.dot(vpl.normal);
       if (cos_x <= 0.f || cos_y <= 0.f || wi.dot(v.geometric_normal) <= 0.f) continue;
-      const Vec3 f_y = phong_brdf(scene_.materials[vpl.material], vpl.normal, vpl.incident, -wi);
-      const Vec3 f_x = phong_brdf(*v.material, v.shading_normal, wi, v.wo);
+      const Vec3 f_y = phong_brdf(vpl_phong(scene_, vpl), vpl.normal, vpl.incident, -wi);
+      const Vec3 f_x = phong_brdf(v.brdf, v.shading_normal, wi, v.wo);
       const Vec3 contribution =
           vpl.flux.cwiseProduct(f_y).cwiseProduct(f_x) * (cos_x * cos_y / std::max(distance2, min_distance2));
       if (contribution.isZero()) continue;

@@ -61,7 +61,7 @@ bool PathIntegrator::continue_path(const Vertex& v, int bounce, Vec3& throughput
   if (bounce >= options_.max_bounces) return false;
   const float u1 = rng.uniform();
   const float u2 = rng.uniform();
-  const std::optional<BrdfSample> sample = sample_phong(*v.material, v.shading_normal, v.wo, u1, u2);
+  const std::optional<BrdfSample> sample = sample_phong(v.brdf, v.shading_normal, v.wo, u1, u2);
   if (!sample || sample->wi.dot(v.geometric_normal) <= 0.f) return false;
   throughput = throughput.cwiseProduct(sample->weight);
   if (bounce + 1 >= options_.roulette_from) {

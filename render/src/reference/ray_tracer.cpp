@@ -2,6 +2,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -78,7 +80,45 @@ RTCRay make_ray(const Eigen::Vector3f& origin, const Eigen::Vector3f& direction,
   return ray;
 }
 
+/// The hit's texture coordinates (barycentric u, v) and their gradient along the triangle: with
+/// edges e1, e2 and coordinate differences t1, t2, a point p0 + a e1 + b e2 has coordinates
+/// uv0 + a t1 + b t2, and (a, b) follows from the edges' Gram matrix.
+void add_texcoords(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>& triangle, float u, float v,
+                   SurfaceHit& hit) {
+  const Eigen::Vector2f& uv0 = mesh.texcoords[triangle[0]];
+  const Eigen::Vector2f& uv1 = mesh.texcoords[triangle[1]];
+  const Eigen::Vector2f& uv2 = mesh.texcoords[triangle[2]];
+  hit.has_texcoord = true;
+  hit.texcoord = (1.f - u - v) * uv0 + u * uv1 + v * uv2;
+  const Eigen::Vector3f e1 = mesh.positions[triangle[1]] - mesh.positions[triangle[0]];
+  const Eigen::Vector3f e2 = mesh.positions[triangle[2]] - mesh.positions[triangle[0]];
+  Eigen::Matrix2f gram;
+  gram << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+  const float determinant = gram.determinant();
+  if (!(std::abs(determinant) > 0.f)) return;
+  Eigen::Matrix<float, 2, 3> edges;
+  edges.row(0) = e1.transpose();
+  edges.row(1) = e2.transpose();
+  Eigen::Matrix2f differences;
+  differences.col(0) = uv1 - uv0;
+  differences.col(1) = uv2 - uv0;
+  hit.texcoord_gradient = differences * gram.inverse() * edges;
+}
+
 }  // namespace
+
+Eigen::Vector3f base_color_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
+  const PhongMaterial& material = scene.materials[hit.material];
+  if (!material.base_color) return Eigen::Vector3f::Ones();
+  return hit.has_texcoord ? material.base_color->sample(hit.texcoord.x(), hit.texcoord.y(), lod)
+                          : material.base_color->mean();
+}
+
+Phong phong_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
+  Phong out = scene.materials[hit.material];
+  out.kd = out.kd.cwiseProduct(base_color_at(scene, hit, lod));
+  return out;
+}
 
 struct RayTracer::Impl {
   MrScene scene;  // owns the meshes the layers point into
@@ -143,6 +183,7 @@ std::optional<SurfaceHit> RayTracer::intersect(Layer which, const Eigen::Vector3
   }
   hit.material = mesh.triangle_material[query.hit.primID];
   hit.real = mesh.real;
+  if (!mesh.texcoords.empty()) add_texcoords(mesh, triangle, query.hit.u, query.hit.v, hit);
   return hit;
 }
 

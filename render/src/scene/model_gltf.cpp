@@ -6,10 +6,13 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <map>
+#include <span>
 #include <sstream>
 
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
+#include "relight/core/image_io.h"
 #include "relight/render/scene/model_io.h"
 
 namespace relight::render {
@@ -89,6 +92,31 @@ class AccessorReader {
     float v[3];
     std::memcpy(v, bytes_ + i * stride_, sizeof v);
     return {v[0], v[1], v[2]};
+  }
+
+  /// A texture coordinate: float VEC2, or normalised unsigned byte or short VEC2 (glTF 3.7.2.1).
+  [[nodiscard]] Eigen::Vector2f vec2(std::size_t i) const {
+    if (accessor_->type != TINYGLTF_TYPE_VEC2) fail("texture coordinates must be VEC2");
+    const unsigned char* p = bytes_ + i * stride_;
+    switch (accessor_->componentType) {
+      case TINYGLTF_COMPONENT_TYPE_FLOAT: {
+        float v[2];
+        std::memcpy(v, p, sizeof v);
+        return {v[0], v[1]};
+      }
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+        if (accessor_->normalized) return {float(p[0]) / 255.f, float(p[1]) / 255.f};
+        break;
+      case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+        if (accessor_->normalized) {
+          std::uint16_t v[2];
+          std::memcpy(v, p, sizeof v);
+          return {float(v[0]) / 65535.f, float(v[1]) / 65535.f};
+        }
+        break;
+      default: break;
+    }
+    fail("texture coordinates must be float or normalised unsigned byte/short");
   }
 
   [[nodiscard]] std::uint32_t index(std::size_t i) const {
@@ -178,6 +206,20 @@ class GltfMeshCollector {
       const Eigen::Matrix3f normal_matrix = transform.linear().inverse().transpose();
       for (std::size_t i = 0; i < normals.count(); ++i) mesh.normals.push_back((normal_matrix * normals.vec3(i)).normalized());
     }
+    if (primitive.material >= 0 && static_cast<std::size_t>(primitive.material) < gltf_.materials.size() &&
+        out_.materials[static_cast<std::size_t>(primitive.material)].base_color) {
+      const int set =
+          gltf_.materials[static_cast<std::size_t>(primitive.material)].pbrMetallicRoughness.baseColorTexture.texCoord;
+      const std::string attribute = "TEXCOORD_" + std::to_string(set);
+      const auto found = primitive.attributes.find(attribute);
+      if (found == primitive.attributes.end())
+        throw Error(file_ + ": mesh '" + name + "' has a textured material but no " + attribute);
+      const AccessorReader texcoords(gltf_, found->second, file_);
+      if (texcoords.count() != mesh.positions.size())
+        throw Error(file_ + ": mesh '" + name + "' has " + std::to_string(texcoords.count()) + " " + attribute +
+                    " for " + std::to_string(mesh.positions.size()) + " vertices");
+      for (std::size_t i = 0; i < texcoords.count(); ++i) mesh.texcoords.push_back(texcoords.vec2(i));
+    }
     std::vector<std::uint32_t> indices;
     if (primitive.indices >= 0) {
       const AccessorReader reader(gltf_, primitive.indices, file_);
@@ -217,15 +259,100 @@ std::string first_line(std::string text) {
   return text;
 }
 
-// Textures are not used (materials are Phong constants), so images are neither decoded nor
-// checked: a broken or hostile image cannot fail or slow down loading the geometry.
-bool skip_image(tinygltf::Image*, int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+/// The encoded bytes of every image that tinygltf read from a data URI or an external file,
+/// by image index; images in a buffer view are read from the buffer after loading. Nothing is
+/// decoded while loading: only the images that a material's base colour uses are (textures()),
+/// so an unused broken or hostile image cannot fail or slow down reading the model.
+struct EncodedImages {
+  std::vector<std::vector<std::uint8_t>> bytes;
+};
+
+bool keep_encoded_image(tinygltf::Image* image, int index, std::string*, std::string*, int, int,
+                        const unsigned char* bytes, int size, void* user) {
+  if (index < 0 || image->bufferView >= 0 || size <= 0) return true;
+  auto& images = *static_cast<EncodedImages*>(user);
+  if (images.bytes.size() <= static_cast<std::size_t>(index)) images.bytes.resize(static_cast<std::size_t>(index) + 1);
+  images.bytes[static_cast<std::size_t>(index)].assign(bytes, bytes + size);
   return true;
 }
 
-tinygltf::Model read_gltf(const std::filesystem::path& path, bool binary) {
+/// Larger textures are refused (8192^2 texels with their mip chain take 360 MB).
+constexpr int kMaxTextureSide = 8192;
+
+TextureWrap wrap_of(int gl_wrap) {
+  switch (gl_wrap) {
+    case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return TextureWrap::ClampToEdge;
+    case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return TextureWrap::MirroredRepeat;
+    default: return TextureWrap::Repeat;
+  }
+}
+
+/// The base-colour textures of a model's materials, each (image, sampler) decoded once.
+class GltfTextures {
+ public:
+  GltfTextures(const tinygltf::Model& gltf, const EncodedImages& images, std::string file)
+      : gltf_(gltf), images_(images), file_(std::move(file)) {}
+
+  /// The material's base-colour texture, or null when it has none.
+  std::shared_ptr<const Texture> base_color(const tinygltf::Material& material) {
+    const int index = material.pbrMetallicRoughness.baseColorTexture.index;
+    if (index < 0) return nullptr;
+    if (static_cast<std::size_t>(index) >= gltf_.textures.size())
+      fail("material '" + material.name + "' uses texture " + std::to_string(index) + ", but the file has " +
+           std::to_string(gltf_.textures.size()));
+    const tinygltf::Texture& texture = gltf_.textures[static_cast<std::size_t>(index)];
+    if (texture.source < 0 || static_cast<std::size_t>(texture.source) >= gltf_.images.size())
+      fail("texture " + std::to_string(index) + " has no image");
+    if (texture.sampler >= 0 && static_cast<std::size_t>(texture.sampler) >= gltf_.samplers.size())
+      fail("texture " + std::to_string(index) + " uses a missing sampler");
+    const std::pair key{texture.source, texture.sampler};
+    if (const auto found = decoded_.find(key); found != decoded_.end()) return found->second;
+    const tinygltf::Image& image = gltf_.images[static_cast<std::size_t>(texture.source)];
+    const std::string what = file_ + ": image " + std::to_string(texture.source) +
+                             (image.uri.empty() || image.uri.starts_with("data:") ? "" : " (" + image.uri + ")");
+    const ColorImage decoded = decode_color(encoded(image, texture.source, what), what, kMaxTextureSide);
+    TextureWrap wrap_u = TextureWrap::Repeat, wrap_v = TextureWrap::Repeat;
+    if (texture.sampler >= 0) {
+      const tinygltf::Sampler& sampler = gltf_.samplers[static_cast<std::size_t>(texture.sampler)];
+      wrap_u = wrap_of(sampler.wrapS);
+      wrap_v = wrap_of(sampler.wrapT);
+    }
+    auto out = std::make_shared<const Texture>(
+        image.name.empty() ? "image " + std::to_string(texture.source) : image.name, decoded, wrap_u, wrap_v);
+    decoded_.emplace(key, out);
+    return out;
+  }
+
+ private:
+  [[noreturn]] void fail(const std::string& why) const { throw Error(file_ + ": " + why); }
+
+  std::span<const std::uint8_t> encoded(const tinygltf::Image& image, int index, const std::string& what) const {
+    if (image.bufferView >= 0) {
+      if (static_cast<std::size_t>(image.bufferView) >= gltf_.bufferViews.size())
+        fail("an image's buffer view is missing");
+      const tinygltf::BufferView& view = gltf_.bufferViews[static_cast<std::size_t>(image.bufferView)];
+      if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= gltf_.buffers.size())
+        fail("a buffer view has no buffer");
+      const std::vector<unsigned char>& data = gltf_.buffers[static_cast<std::size_t>(view.buffer)].data;
+      if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
+        throw Error(what + ": its buffer view reaches past the end of its buffer");
+      return {data.data() + view.byteOffset, view.byteLength};
+    }
+    if (static_cast<std::size_t>(index) >= images_.bytes.size() ||
+        images_.bytes[static_cast<std::size_t>(index)].empty())
+      throw Error(what + ": cannot read the image (missing file or empty data)");
+    return images_.bytes[static_cast<std::size_t>(index)];
+  }
+
+  const tinygltf::Model& gltf_;
+  const EncodedImages& images_;
+  std::string file_;
+  std::map<std::pair<int, int>, std::shared_ptr<const Texture>> decoded_;
+};
+
+tinygltf::Model read_gltf(const std::filesystem::path& path, bool binary, EncodedImages& images) {
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(skip_image, nullptr);
+  loader.SetImageLoader(keep_encoded_image, &images);
   tinygltf::Model gltf;
   std::string error, warning;
   bool ok = false;
@@ -246,10 +373,15 @@ tinygltf::Model read_gltf(const std::filesystem::path& path, bool binary) {
 VirtualModel load_gltf(const std::filesystem::path& path) {
   std::string extension = path.extension().string();
   std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char c) { return std::tolower(c); });
-  const tinygltf::Model gltf = read_gltf(path, extension == ".glb");
+  EncodedImages images;
+  const tinygltf::Model gltf = read_gltf(path, extension == ".glb", images);
   VirtualModel model;
   model.name = path.stem().string();
-  for (const tinygltf::Material& m : gltf.materials) model.materials.push_back(from_gltf(m));
+  GltfTextures textures(gltf, images, path.string());
+  for (const tinygltf::Material& m : gltf.materials) {
+    model.materials.push_back(from_gltf(m));
+    model.materials.back().base_color = textures.base_color(m);
+  }
   const auto default_material = static_cast<std::uint32_t>(model.materials.size());
   model.materials.push_back(PhongMaterial{{{0.8f, 0.8f, 0.8f}, 0.f, 1.f}, "default", {0.f, 0.f, 0.f}});
   GltfMeshCollector collector(gltf, model, path.string(), default_material);

@@ -22,6 +22,12 @@ MrLight spot_light(const Eigen::Vector3f& position, const Eigen::Vector3f& direc
   return light;
 }
 
+Phong phong_at(const PhongMaterial& material, const Eigen::Vector2f& uv, float lod) {
+  Phong out = material;
+  if (material.base_color) out.kd = out.kd.cwiseProduct(material.base_color->sample(uv.x(), uv.y(), lod));
+  return out;
+}
+
 std::uint32_t MrScene::add_material(PhongMaterial material) {
   materials.push_back(std::move(material));
   return static_cast<std::uint32_t>(materials.size() - 1);
@@ -42,6 +48,10 @@ void validate_mesh(const TriangleMesh& mesh, std::size_t material_count) {
     throw Error(where + "needs one material per triangle");
   if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size())
     throw Error(where + "needs one normal per vertex or none");
+  if (!mesh.texcoords.empty() && mesh.texcoords.size() != mesh.positions.size())
+    throw Error(where + "needs one texture coordinate per vertex or none");
+  for (const Eigen::Vector2f& uv : mesh.texcoords)
+    if (!uv.allFinite()) throw Error(where + "has a non-finite texture coordinate");
   for (const Eigen::Vector3f& p : mesh.positions)
     if (!p.allFinite()) throw Error(where + "has a non-finite vertex position");
   for (const auto& triangle : mesh.triangles)

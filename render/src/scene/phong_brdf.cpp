@@ -11,7 +11,7 @@ constexpr float kPi = std::numbers::pi_v<float>;
 
 float luminance(const Eigen::Vector3f& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
 
-float diffuse_probability(const PhongMaterial& m) {
+float diffuse_probability(const Phong& m) {
   const float d = std::max(0.f, luminance(m.kd));
   const float s = std::max(0.f, m.ks);
   return d + s > 0.f ? d / (d + s) : 0.f;
@@ -35,7 +35,7 @@ void orthonormal_basis(const Eigen::Vector3f& n, Eigen::Vector3f& t, Eigen::Vect
   b = Eigen::Vector3f(c, sign + n.y() * n.y() * a, -n.y());
 }
 
-float phong_pdf(const PhongMaterial& material, const Eigen::Vector3f& normal, const Eigen::Vector3f& wi,
+float phong_pdf(const Phong& material, const Eigen::Vector3f& normal, const Eigen::Vector3f& wi,
                 const Eigen::Vector3f& wo) {
   const float cos_i = normal.dot(wi);
   if (cos_i <= 0.f) return 0.f;
@@ -48,8 +48,8 @@ float phong_pdf(const PhongMaterial& material, const Eigen::Vector3f& normal, co
   return pdf;
 }
 
-std::optional<BrdfSample> sample_phong(const PhongMaterial& material, const Eigen::Vector3f& normal,
-                                       const Eigen::Vector3f& wo, float u1, float u2) {
+std::optional<BrdfSample> sample_phong(const Phong& material, const Eigen::Vector3f& normal, const Eigen::Vector3f& wo,
+                                       float u1, float u2) {
   if (normal.dot(wo) <= 0.f) return std::nullopt;
   const float pd = diffuse_probability(material);
   if (pd <= 0.f && material.ks <= 0.f) return std::nullopt;

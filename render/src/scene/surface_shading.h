@@ -20,7 +20,8 @@ struct Vertex {
   Vec3 geometric_normal;
   Vec3 shading_normal;
   Vec3 wo;
-  const PhongMaterial* material = nullptr;
+  const PhongMaterial* material = nullptr;  ///< for its emission
+  Phong brdf;                               ///< the material's, textured at the point
 };
 
 inline Vertex make_vertex(const SurfaceHit& hit, const Vec3& direction, const MrScene& scene) {
@@ -32,6 +33,7 @@ inline Vertex make_vertex(const SurfaceHit& hit, const Vec3& direction, const Mr
   // An interpolated normal can face away from a grazing viewer; shade with the true one there.
   if (v.shading_normal.dot(v.wo) <= 0.f) v.shading_normal = v.geometric_normal;
   v.material = &scene.materials[hit.material];
+  v.brdf = phong_at(scene, hit);
   return v;
 }
 
@@ -74,7 +76,7 @@ inline Vec3 direct_light(const Vertex& v, const LightSample& sample) {
   if (sample.wi.dot(v.geometric_normal) <= 0.f) return Vec3::Zero();
   const float cos_i = sample.wi.dot(v.shading_normal);
   if (cos_i <= 0.f) return Vec3::Zero();
-  return phong_brdf(*v.material, v.shading_normal, sample.wi, v.wo).cwiseProduct(sample.irradiance) * cos_i;
+  return phong_brdf(v.brdf, v.shading_normal, sample.wi, v.wo).cwiseProduct(sample.irradiance) * cos_i;
 }
 
 }  // namespace relight::render::detail

@@ -54,6 +54,11 @@ void check_model(const VirtualModel& model, const std::filesystem::path& file) {
       if (!mesh.positions[v].allFinite()) fail(mesh, "vertex " + std::to_string(v + 1) + " is not finite");
     for (std::size_t v = 0; v < mesh.normals.size(); ++v)
       if (!mesh.normals[v].allFinite()) fail(mesh, "normal " + std::to_string(v + 1) + " is not finite");
+    for (std::size_t v = 0; v < mesh.texcoords.size(); ++v)
+      if (!mesh.texcoords[v].allFinite()) fail(mesh, "texture coordinate " + std::to_string(v + 1) + " is not finite");
+    if (!mesh.texcoords.empty() && mesh.texcoords.size() != mesh.positions.size())
+      fail(mesh, std::to_string(mesh.texcoords.size()) + " texture coordinates for " +
+                     std::to_string(mesh.positions.size()) + " vertices");
     if (mesh.triangle_material.size() != mesh.triangles.size()) fail(mesh, "triangles without a material");
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       for (const std::uint32_t index : mesh.triangles[t])

@@ -38,7 +38,7 @@ void fill_texel(RsmTexel& texel, const MrScene& scene, const std::optional<Surfa
   texel.hit = hit;
   if (!hit) return;
   texel.flux = emitted;
-  const float albedo = std::max(luminance(scene.materials[hit->material].kd), kMinAlbedo);
+  const float albedo = std::max(luminance(phong_at(scene, *hit).kd), kMinAlbedo);
   texel.importance = std::max(0.f, luminance(emitted)) * albedo;
 }
 

@@ -69,8 +69,13 @@ class ConeSearch {
                                                const ConeHit& hit, bool real) {
     if (hit.point == ConeHit::kNone) return std::nullopt;
     const IsmPoint& point = points[hit.point];
-    return SurfaceHit{hit.t, segment.origin + hit.t * segment.direction, point.normal, point.normal, point.material,
-                      real};
+    SurfaceHit out;
+    out.t = hit.t;
+    out.point = segment.origin + hit.t * segment.direction;
+    out.geometric_normal = out.shading_normal = point.normal;
+    out.material = point.material;
+    out.real = real;
+    return out;
   }
 
   IsmPointPools points_;
@@ -139,6 +144,7 @@ class VplTracer {
     if (vpl.normal.dot(vpl.incident) <= 0.f) vpl.normal = geometric;
     vpl.flux = flux;
     vpl.material = hit.material;
+    vpl.kd_texture = base_color_at(scene_, hit);
     vpl.on_real_surface = hit.real;
     vpl.in_real_virtual = in_real_virtual;
     vpl.in_real = in_real;
@@ -150,7 +156,7 @@ class VplTracer {
     if (bounce >= options_.bounces) return;
     // Continue the light path by sampling the VPL's BRDF (reciprocity: wo = where light came from).
     const float u1 = rng.uniform(), u2 = rng.uniform();
-    const auto sample = sample_phong(scene_.materials[vpl.material], vpl.normal, vpl.incident, u1, u2);
+    const auto sample = sample_phong(vpl_phong(scene_, vpl), vpl.normal, vpl.incident, u1, u2);
     if (!sample || sample->wi.dot(geometric) <= 0.f) return;
     const Vec3 next_flux = flux.cwiseProduct(sample->weight);
     if (cone_) {

@@ -3,7 +3,10 @@
 // relight::Error with the file name and the reason, and decodes only the formats it names below,
 // told by their signature (OpenCV would hand any file to whichever of its many decoders claims
 // it); every writer is atomic (see atomic_file.h) and picks the format from the extension.
+#include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string>
 
 #include "relight/core/image.h"
 
@@ -25,6 +28,10 @@ void write_label_png(const std::filesystem::path& path, const LabelImage& labels
 /// 8-bit colour, PNG or JPEG. Grey images are expanded to RGB; 16-bit images are rejected.
 ColorImage read_color(const std::filesystem::path& path);
 void write_color(const std::filesystem::path& path, const ColorImage& image);
+/// 8-bit colour from the bytes of a PNG or JPEG file held in memory (a glTF model's embedded
+/// texture); `name` says in errors what the bytes are. The image's size is read from its header
+/// first, and one wider or higher than `max_side` is refused before anything is allocated for it.
+ColorImage decode_color(std::span<const std::uint8_t> bytes, const std::string& name, int max_side);
 void write_mask(const std::filesystem::path& path, const Mask& mask);
 
 /// Linear HDR radiance: Radiance .hdr or OpenEXR .exr. A NaN or infinite pixel is an error.

@@ -16,9 +16,22 @@ struct GBuffer {
   LabelImage material;   ///< MrScene material index + 1; 0 where nothing is seen
   Mask virtual_surface;  ///< 1 where the surface belongs to a virtual object (r(p) = 0)
   DepthMap distance;     ///< from the camera centre, metres; 0 where nothing is seen
+  /// (u, v, footprint) where the surface has texture coordinates, zero elsewhere: its texture
+  /// coordinates and the pixel's footprint in them, the longer of how far (u, v) moves to the
+  /// next pixel right and below (Texture::level_of_detail); empty when no material of the scene
+  /// has a texture.
+  Image<Float3> texcoord{};
 
   static constexpr const char* type_name = "GBuffer";
 };
+
+/// Whether any material of `scene` has a base-colour texture (then G-buffers carry texcoord).
+[[nodiscard]] bool has_textures(const MrScene& scene);
+
+/// The texture factor of k_d at each pixel of `gbuffer` (Texture::sample at the pixel's
+/// coordinates and footprint; the texture's mean on a textured material without coordinates
+/// there); 1 elsewhere. Empty when `gbuffer` carries no texture coordinates.
+[[nodiscard]] RadianceImage base_color_factors(const GBuffer& gbuffer, const MrScene& scene);
 
 [[nodiscard]] GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads = 0);
 

@@ -1,7 +1,8 @@
 #pragma once
 // The rasterised G-buffer on Vulkan (Knecht's dissertation §5.2.2): one draw of every
-// real and virtual triangle of an MrScene from the camera, into two RGBA32F targets
-// (position + signed distance, normal + material) and a depth buffer; the CPU reference is
+// real and virtual triangle of an MrScene from the camera, into three RGBA32F targets
+// (position + signed distance, normal + material, texture coordinates + footprint) and a depth
+// buffer; the CPU reference is
 // gbuffer_cpu() (gbuffer.h), and the two agree pixel for pixel up to triangle edges.
 //
 // Reads: the MrScene (set_scene, uploaded once), an MrCamera per render. Writes: GBuffer.
@@ -37,8 +38,9 @@ class GBufferVk {
   /// Renders the camera's view and reads the G-buffer back. The camera's intrinsics must have
   /// this renderer's size.
   [[nodiscard]] GBuffer render(const MrCamera& camera);
-  /// Records the draw and a copy of both targets into `destination` (packed_bytes(): first every
-  /// pixel's position.xyz + signed distance, then every pixel's normal.xyz + material index), for
+  /// Records the draw and a copy of the targets into `destination` (packed_bytes(): first every
+  /// pixel's position.xyz + signed distance, then every pixel's normal.xyz + material index, then
+  /// every pixel's texture coordinates + footprint), for
   /// a renderer that goes on shading on the GPU.
   void record(VkCommandBuffer cmd, const MrCamera& camera, const vk::VulkanBuffer& destination);
   [[nodiscard]] static std::size_t packed_bytes(int width, int height);

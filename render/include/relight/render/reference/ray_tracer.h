@@ -22,7 +22,18 @@ struct SurfaceHit {
   Eigen::Vector3f shading_normal;    ///< unit, interpolated vertex normal (or the geometric one)
   std::uint32_t material = 0;
   bool real = true;
+  /// Interpolated texture coordinates, and how they change with the point on the triangle's plane
+  /// (d uv / d point, for a pixel's footprint); zero on meshes without texture coordinates.
+  bool has_texcoord = false;  ///< false: the material's texture is taken at its mean colour
+  Eigen::Vector2f texcoord = Eigen::Vector2f::Zero();
+  Eigen::Matrix<float, 2, 3> texcoord_gradient = Eigen::Matrix<float, 2, 3>::Zero();
 };
+
+/// The factor k_d takes at a hit from its material's base-colour texture (at the hit's
+/// coordinates, mip level `lod`; the texture's mean where the hit has none); 1 untextured.
+[[nodiscard]] Eigen::Vector3f base_color_at(const MrScene& scene, const SurfaceHit& hit, float lod = 0.f);
+/// The Phong parameters at a hit: the material's with k_d times base_color_at().
+[[nodiscard]] Phong phong_at(const MrScene& scene, const SurfaceHit& hit, float lod = 0.f);
 
 class RayTracer {
  public:

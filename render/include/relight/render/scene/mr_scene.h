@@ -10,28 +10,40 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "relight/core/camera.h"
 #include "relight/core/phong.h"
 #include "relight/core/pose.h"
+#include "relight/render/scene/texture.h"
 
 namespace relight::render {
 
 /// A material of the scene: relight's Phong model (core/phong.h; sampled in phong_brdf.h), a name,
-/// and an emitted radiance (a virtual light source shaped like its mesh).
+/// an emitted radiance (a virtual light source shaped like its mesh) and, optionally, a base-colour
+/// texture that multiplies k_d per channel at each surface point (texture.h; the triangles need
+/// texture coordinates). The texture is shared: scenes are copied every frame, texels are not.
 struct PhongMaterial : Phong {
   std::string name;
   Eigen::Vector3f emission{0.f, 0.f, 0.f};
+  std::shared_ptr<const Texture> base_color{};
 };
 
+/// The Phong parameters at a surface point with texture coordinates `uv` and mip level `lod`:
+/// the material's, with k_d multiplied by its texture where it has one.
+[[nodiscard]] Phong phong_at(const PhongMaterial& material, const Eigen::Vector2f& uv, float lod = 0.f);
+
 /// An indexed triangle mesh with one material per triangle. `normals` is either empty (flat
-/// shading with the geometric normal) or one unit normal per vertex (interpolated).
+/// shading with the geometric normal) or one unit normal per vertex (interpolated); `texcoords`
+/// is either empty or one texture coordinate per vertex (interpolated; glTF's TEXCOORD of the
+/// material's base-colour texture).
 struct TriangleMesh {
   std::string name;
   std::vector<Eigen::Vector3f> positions;
   std::vector<Eigen::Vector3f> normals;
+  std::vector<Eigen::Vector2f> texcoords;
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<std::uint32_t> triangle_material;  ///< index into MrScene::materials
   bool real = true;                              ///< r(x): measured surface or virtual object

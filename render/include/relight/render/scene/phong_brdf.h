@@ -25,11 +25,11 @@ struct BrdfSample {
 
 /// Samples wi given wo from two uniform numbers u1 (lobe choice and first coordinate) and u2.
 /// nullopt when the material reflects nothing or the sample falls below the surface.
-[[nodiscard]] std::optional<BrdfSample> sample_phong(const PhongMaterial& material, const Eigen::Vector3f& normal,
+[[nodiscard]] std::optional<BrdfSample> sample_phong(const Phong& material, const Eigen::Vector3f& normal,
                                                      const Eigen::Vector3f& wo, float u1, float u2);
 
 /// The mixture pdf of sample_phong for a given wi (solid-angle measure).
-[[nodiscard]] float phong_pdf(const PhongMaterial& material, const Eigen::Vector3f& normal, const Eigen::Vector3f& wi,
+[[nodiscard]] float phong_pdf(const Phong& material, const Eigen::Vector3f& normal, const Eigen::Vector3f& wi,
                               const Eigen::Vector3f& wo);
 
 /// An orthonormal basis (t, b, n) around unit n (Duff et al. 2017, no branch on a threshold).

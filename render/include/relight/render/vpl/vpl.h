@@ -71,6 +71,8 @@ struct Vpl {
   Eigen::Vector3f incident;  ///< unit, from the VPL towards where its light came from
   Eigen::Vector3f flux;
   std::uint32_t material = 0;
+  /// The factor of the material's k_d from its base-colour texture at the VPL (1: untextured).
+  Eigen::Vector3f kd_texture = Eigen::Vector3f::Ones();
   bool on_real_surface = true;  ///< r(VPL)
   bool in_real_virtual = true;
   bool in_real = true;
@@ -81,6 +83,13 @@ struct Vpl {
 
   [[nodiscard]] bool emitter() const { return bounce == 0; }
 };
+
+/// The Phong parameters of the surface a VPL lies on (its material, k_d textured at the VPL).
+[[nodiscard]] inline Phong vpl_phong(const MrScene& scene, const Vpl& vpl) {
+  Phong out = scene.materials[vpl.material];
+  out.kd = out.kd.cwiseProduct(vpl.kd_texture);
+  return out;
+}
 
 /// How far out along its light an emitter VPL sits, in radii of the scene's bounding sphere.
 inline constexpr float kEmitterDistance = 100.f;

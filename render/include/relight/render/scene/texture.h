@@ -1,0 +1,73 @@
+#pragma once
+// A base-colour texture of a virtual object's material (glTF 2.0 `baseColorTexture`): the
+// factor its material's k_d is multiplied by at a surface point, per channel, from the point's
+// texture coordinates.
+//
+// Texels are kept as the file has them, 8-bit sRGB (glTF's base colour is sRGB-encoded), with a
+// mip chain made in linear RGB (each level a 2x2 box filter of the one above, re-encoded), so
+// that the CPU renderers and the Vulkan shading sample the same packed words (dir_texture.glsl
+// is this file's GLSL twin). A sample is trilinear: bilinear within the two levels around `lod`,
+// linear between them, each texel decoded to linear RGB before filtering (filtering the encoded
+// values would darken edges between colours). lod = log2 of the pixel footprint in level-0 texels
+// (0: magnified or one texel per pixel); the path tracer samples level 0 and lets its pixel
+// samples average the texture, DIR's one sample per pixel takes the footprint from the G-buffer.
+//
+// Departures from glTF's sampler: the filters are always linear (a NEAREST magnification filter
+// is read as LINEAR), and KHR_texture_transform is not applied.
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "relight/core/image.h"
+
+namespace relight::render {
+
+enum class TextureWrap : std::uint32_t { Repeat = 0, ClampToEdge = 1, MirroredRepeat = 2 };
+
+/// sRGB-encoded 8-bit value -> linear, the exact IEC 61966-2-1 curve.
+[[nodiscard]] float srgb_to_linear(std::uint8_t value);
+[[nodiscard]] std::uint8_t linear_to_srgb(float linear);
+
+class Texture {
+ public:
+  /// Builds the mip chain from sRGB-encoded RGB texels; throws relight::Error when the image is
+  /// empty.
+  Texture(std::string name, const ColorImage& srgb, TextureWrap wrap_u = TextureWrap::Repeat,
+          TextureWrap wrap_v = TextureWrap::Repeat);
+
+  /// Linear RGB at texture coordinates (u, v) (glTF's: (0, 0) is the image's top-left corner)
+  /// and mip level `lod` (clamped to the chain).
+  [[nodiscard]] Eigen::Vector3f sample(float u, float v, float lod = 0.f) const;
+  /// The texture's average colour (linear RGB): what a pixel covering all of it shows.
+  [[nodiscard]] Eigen::Vector3f mean() const;
+  /// The mip level for a pixel whose footprint spans `footprint` in texture coordinates (the
+  /// longer of its two sides): log2 of that in texels of the texture's longer side, in [0, top].
+  /// Exact for square textures; on others the shorter axis is filtered a little more.
+  [[nodiscard]] float level_of_detail(float footprint) const;
+
+  [[nodiscard]] const std::string& name() const { return name_; }
+  [[nodiscard]] int width() const { return widths_.front(); }
+  [[nodiscard]] int height() const { return heights_.front(); }
+  [[nodiscard]] int levels() const { return static_cast<int>(widths_.size()); }
+  [[nodiscard]] int level_width(int level) const { return widths_[static_cast<std::size_t>(level)]; }
+  [[nodiscard]] int level_height(int level) const { return heights_[static_cast<std::size_t>(level)]; }
+  /// Index of level `level`'s first texel in texels().
+  [[nodiscard]] std::size_t level_offset(int level) const { return offsets_[static_cast<std::size_t>(level)]; }
+  /// Every level's texels, row by row, as r | g << 8 | b << 16 (sRGB-encoded).
+  [[nodiscard]] std::span<const std::uint32_t> texels() const { return texels_; }
+  [[nodiscard]] TextureWrap wrap_u() const { return wrap_u_; }
+  [[nodiscard]] TextureWrap wrap_v() const { return wrap_v_; }
+
+ private:
+  [[nodiscard]] Eigen::Vector3f bilinear(int level, float u, float v) const;
+
+  std::string name_;
+  std::vector<std::uint32_t> texels_;
+  std::vector<int> widths_, heights_;
+  std::vector<std::size_t> offsets_;
+  TextureWrap wrap_u_, wrap_v_;
+};
+
+}  // namespace relight::render

@@ -1,0 +1,89 @@
+// `relight replay` with a textured glTF object (data/models/box_textured.gltf, the Cesium logo on
+// a cube): the composite shows the texture on the object, an untextured copy of the same model
+// shows flat faces, and a model whose texture cannot be decoded is one error line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cli.h"
+#include "relight/core/atomic_file.h"
+#include "relight/core/image_io.h"
+#include "temp_dir.h"
+
+namespace relight::app {
+namespace {
+
+using cli_test::expect_one_line_error;
+using cli_test::relight;
+
+const std::filesystem::path kBox = std::filesystem::path(RELIGHT_TEST_DATA) / "models" / "box_textured.gltf";
+
+const std::filesystem::path& sequence() {
+  return cli_test::synthetic_sequence("--frames 2 --size 320x240 --trajectory static");
+}
+
+test::CommandResult replay(const std::filesystem::path& model, const std::filesystem::path& out) {
+  // The 1 m box, centred on its origin, scaled to 12 cm and lifted to stand on the table.
+  return relight("replay --quiet " + sequence().string() + " --object " + model.string() +
+                 " --place 0.35,-0.2,0.81,30,0.12 --camera-artefacts none --colormap none --no-video --buffers --out " +
+                 out.string());
+}
+
+/// Mean absolute green difference between horizontal neighbours that are both fully covered by
+/// the object: the texture's detail (shading alone changes little from pixel to pixel).
+double covered_detail(const std::filesystem::path& run, int& pixels) {
+  const ColorImage composite = read_color(run / "frames" / "000001_composite.png");
+  const ColorImage coverage = read_color(run / "frames" / "000001_virtual_coverage.png");
+  double sum = 0;
+  pixels = 0;
+  for (int r = 1; r < composite.height() - 1; ++r)
+    for (int c = 1; c < composite.width() - 1; ++c) {
+      bool inside = true;
+      for (int i = -1; i <= 1; ++i)
+        for (int j = -1; j <= 2; ++j)
+          inside = inside && coverage.in_bounds(r + i, c + j) && coverage(r + i, c + j).r == 255;
+      if (!inside) continue;
+      sum += std::abs(double(composite(r, c + 1).g) - double(composite(r, c).g));
+      ++pixels;
+    }
+  return pixels > 0 ? sum / pixels : 0.0;
+}
+
+TEST(TexturedObjectCli, TheCompositeShowsTheModelsTexture) {
+  test::TempDir dir;
+  std::string untextured = read_text_file(kBox);
+  const std::size_t reference = untextured.find("\"baseColorTexture\"");
+  ASSERT_NE(reference, std::string::npos);
+  // The same model with the texture reference renamed to a key glTF does not know.
+  untextured.replace(reference, std::string("\"baseColorTexture\"").size(), "\"unusedTexture\"");
+  write_file_atomically(dir.path() / "flat.gltf", untextured);
+
+  const auto textured_run = replay(kBox, dir.path() / "textured");
+  ASSERT_EQ(textured_run.exit_code, 0) << textured_run.err;
+  const auto flat_run = replay(dir.path() / "flat.gltf", dir.path() / "flat");
+  ASSERT_EQ(flat_run.exit_code, 0) << flat_run.err;
+  int textured_pixels = 0, flat_pixels = 0;
+  const double textured = covered_detail(dir.path() / "textured", textured_pixels);
+  const double flat = covered_detail(dir.path() / "flat", flat_pixels);
+  std::printf("detail inside the box: textured %.2f (%d px), untextured %.2f (%d px)\n", textured, textured_pixels,
+              flat, flat_pixels);
+  ASSERT_GT(textured_pixels, 200) << "the box covers part of the frame";
+  EXPECT_GT(textured, 2.5 * flat + 0.5);  // measured 10.3 against 2.9
+}
+
+TEST(TexturedObjectCli, AnUndecodableTextureIsOneErrorLine) {
+  test::TempDir dir;
+  std::string broken = read_text_file(kBox);
+  const std::size_t data = broken.find("data:image/png;base64,");
+  ASSERT_NE(data, std::string::npos);
+  const std::size_t payload = data + std::string("data:image/png;base64,").size();
+  broken.replace(payload, broken.find('"', payload) - payload, "AAAAAAAAAAAA");  // 9 zero bytes
+  write_file_atomically(dir.path() / "broken.gltf", broken);
+  const auto result = replay(dir.path() / "broken.gltf", dir.path() / "out");
+  expect_one_line_error(result, 1);
+  EXPECT_NE(result.err.find("image 0"), std::string::npos) << result.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "report.json"));
+}
+
+}  // namespace
+}  // namespace relight::app
