@@ -349,7 +349,10 @@ const IsmPointPools& DirRendererVk::ism_points() const { return impl_->points; }
 const GBuffer& DirRendererVk::last_gbuffer() const {
   // Read back once per render: the CPU backend shades from it and the DIR stage smooths with it.
   if (!impl_->last_gbuffer) {
-    std::vector<float> data(impl_->gbuffer_buffer.size_bytes() / sizeof(float));
+    // The texture coordinates (the last third) only when a material has a texture to sample.
+    std::size_t floats = impl_->gbuffer_buffer.size_bytes() / sizeof(float);
+    if (!impl_->scene || !has_textures(*impl_->scene)) floats = floats / 12 * 8;
+    std::vector<float> data(floats);
     impl_->context.transfer().download(impl_->gbuffer_buffer, std::as_writable_bytes(std::span(data)));
     impl_->last_gbuffer = GBufferVk::unpack(data, impl_->width, impl_->height);
   }

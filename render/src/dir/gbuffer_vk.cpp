@@ -159,20 +159,24 @@ GBuffer GBufferVk::render(const MrCamera& camera) {
 
 GBuffer GBufferVk::unpack(std::span<const float> data, int width, int height) {
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
-  if (data.size() < 12 * pixels) throw LogicError("GBufferVk::unpack: too few values");
-  GBuffer out{PositionMap(width, height), NormalMap(width, height), LabelImage(width, height),
-              Mask(width, height),        DepthMap(width, height),  Image<Float3>(width, height)};
+  if (data.size() < 8 * pixels) throw LogicError("GBufferVk::unpack: too few values");
+  const bool texcoords = data.size() >= 12 * pixels;
+  GBuffer out{PositionMap(width, height), NormalMap(width, height), LabelImage(width, height), Mask(width, height),
+              DepthMap(width, height)};
+  if (texcoords) out.texcoord = Image<Float3>(width, height);
   for (std::size_t i = 0; i < pixels; ++i) {
     const float* p = &data[4 * i];
     const float* n = &data[4 * (pixels + i)];
-    const float* t = &data[4 * (2 * pixels + i)];
     if (p[3] == 0.f) continue;  // cleared: nothing drawn
     out.position.pixels()[i] = {p[0], p[1], p[2]};
     out.distance.pixels()[i] = std::abs(p[3]);
     out.virtual_surface.pixels()[i] = p[3] < 0.f ? 1 : 0;
     out.normal.pixels()[i] = {n[0], n[1], n[2]};
     out.material.pixels()[i] = static_cast<std::uint16_t>(n[3] + 1.f);
-    out.texcoord.pixels()[i] = {t[0], t[1], t[2]};
+    if (texcoords) {
+      const float* t = &data[4 * (2 * pixels + i)];
+      out.texcoord.pixels()[i] = {t[0], t[1], t[2]};
+    }
   }
   return out;
 }

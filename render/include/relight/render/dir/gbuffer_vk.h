@@ -44,7 +44,8 @@ class GBufferVk {
   /// a renderer that goes on shading on the GPU.
   void record(VkCommandBuffer cmd, const MrCamera& camera, const vk::VulkanBuffer& destination);
   [[nodiscard]] static std::size_t packed_bytes(int width, int height);
-  /// The GBuffer of a packed copy (distance 0 = nothing drawn).
+  /// The GBuffer of a packed copy (distance 0 = nothing drawn); a copy of the first two blocks
+  /// only (8 floats per pixel) gives a GBuffer without texcoord.
   [[nodiscard]] static GBuffer unpack(std::span<const float> packed, int width, int height);
   /// GPU time of the last render's draw, milliseconds (0 without timestamp support).
   [[nodiscard]] double last_gpu_ms() const;
