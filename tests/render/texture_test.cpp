@@ -230,6 +230,16 @@ TEST(TexturedGltf, BrokenTexturesFailWithOneLineNamingTheImage) {
 
 constexpr float kSun = 2.f;  // irradiance at normal incidence
 
+/// A virtual sun straight above, irradiance kSun.
+void add_sun_overhead(MrScene& scene) {
+  MrLight sun;
+  sun.kind = LightKind::Directional;
+  sun.direction = Eigen::Vector3f::UnitZ();
+  sun.intensity = Eigen::Vector3f::Constant(kSun);
+  sun.real = false;
+  scene.lights.push_back(sun);
+}
+
 /// A virtual 1 m square at z = 0.2 facing up, textured with a 4x4-cell checkerboard of red and
 /// blue (coordinates 0..1 across it), k_d 0.8, under a sun straight above; nothing else.
 MrScene textured_square() {
@@ -246,12 +256,7 @@ MrScene textured_square() {
   square.triangle_material = {scene.add_material(material), 0};
   square.triangle_material[1] = square.triangle_material[0];
   scene.meshes.push_back(square);
-  MrLight sun;
-  sun.kind = LightKind::Directional;
-  sun.direction = Eigen::Vector3f::UnitZ();
-  sun.intensity = Eigen::Vector3f::Constant(kSun);
-  sun.real = false;
-  scene.lights.push_back(sun);
+  add_sun_overhead(scene);
   return scene;
 }
 
@@ -302,6 +307,65 @@ TEST(TexturedRendering, DirDirectLightFollowsTheTexture) {
   }
   EXPECT_GT(red, 100);
   EXPECT_GT(blue, 100);
+}
+
+// Khronos' BoxTextured, as shipped, in DIR: at every pixel of its upward face where the decoded
+// image is uniform around the pixel's texel (so that filtering cannot change it), the rendered
+// radiance is the Phong model with k_d = that texel, under a sun straight above.
+TEST(TexturedRendering, BoxTexturedShowsItsDecodedImage) {
+  const VirtualModel box = load_model(std::filesystem::path(RELIGHT_TEST_DATA) / "models" / "box_textured.gltf");
+  MrScene scene;
+  add_virtual_model(scene, box, Placement{});
+  add_sun_overhead(scene);
+  // About one texel per pixel on the top face (211 texels across 1 m, seen from 1.35 m).
+  const MrCamera camera = test::camera_at({0.01, -0.02, 1.85}, {0, 0, 0.5}, 320, 240);
+  GBuffer gbuffer;
+  const DifferentialImages images = direct_light(scene, camera, gbuffer);
+  const PhongMaterial& material = scene.materials.at(gbuffer.material(120, 160) - 1u);
+  ASSERT_NE(material.base_color, nullptr);
+  const Texture& texture = *material.base_color;
+  const int w = texture.width(), h = texture.height();
+  const auto texel = [&](int x, int y) {
+    const std::uint32_t t = texture.texels()[static_cast<std::size_t>(((y % h) + h) % h) * static_cast<std::size_t>(w) +
+                                             static_cast<std::size_t>(((x % w) + w) % w)];
+    return Eigen::Vector3i(int(t & 0xffu), int((t >> 8) & 0xffu), int((t >> 16) & 0xffu));
+  };
+  const Eigen::Vector3f eye = camera.camera_to_world.translation().cast<float>();
+  int checked = 0, distinct_colours = 0;
+  Eigen::Vector3i first_colour(-1, -1, -1);
+  for (int y = 0; y < 240; ++y)
+    for (int x = 0; x < 320; ++x) {
+      if (gbuffer.distance(y, x) == 0.f || gbuffer.normal(y, x).z < 0.999f) continue;
+      const Float3& t = gbuffer.texcoord(y, x);
+      ASSERT_GT(t.z, 0.f);
+      // Levels 0 and 1 only, whose bilinear taps lie within 3 texels of the pixel's own.
+      if (texture.level_of_detail(t.z) >= 1.f) continue;
+      const int tx = static_cast<int>(std::floor(t.x * float(w))), ty = static_cast<int>(std::floor(t.y * float(h)));
+      const Eigen::Vector3i centre = texel(tx, ty);
+      bool uniform = true;
+      for (int j = -3; j <= 3; ++j)
+        for (int i = -3; i <= 3; ++i) uniform = uniform && (texel(tx + i, ty + j) - centre).cwiseAbs().maxCoeff() <= 1;
+      if (!uniform) continue;
+      ++checked;
+      if (first_colour.x() < 0) first_colour = centre;
+      if ((centre - first_colour).cwiseAbs().maxCoeff() > 40) ++distinct_colours;
+      Phong at_texel = material;
+      at_texel.kd = material.kd.cwiseProduct(Eigen::Vector3f(srgb_to_linear(std::uint8_t(centre.x())),
+                                                             srgb_to_linear(std::uint8_t(centre.y())),
+                                                             srgb_to_linear(std::uint8_t(centre.z()))));
+      const Float3& p = gbuffer.position(y, x);
+      const Eigen::Vector3f point(p.x, p.y, p.z);
+      const Eigen::Vector3f expected = phong_brdf(at_texel, Eigen::Vector3f::UnitZ().eval(), scene.lights[0].direction,
+                                                  (eye - point).normalized().eval()) *
+                                       kSun;
+      const Float3& c = images.real_virtual(y, x);
+      EXPECT_LT((Eigen::Vector3f(c.x, c.y, c.z) - expected).norm(), 0.01f * expected.norm() + 2e-3f)
+          << "pixel " << x << "," << y << " texel " << centre.transpose();
+    }
+  std::printf("BoxTextured top face: %d pixels checked against their texel, %d of another colour than the first\n",
+              checked, distinct_colours);
+  EXPECT_GT(checked, 5000) << "the top face fills much of the view";
+  EXPECT_GT(distinct_colours, 500) << "the logo's colours, not one flat colour";
 }
 
 TEST(TexturedRendering, PathTracerFollowsTheTexture) {
