@@ -276,8 +276,10 @@ bool keep_encoded_image(tinygltf::Image* image, int index, std::string*, std::st
   return true;
 }
 
-/// Larger textures are refused (8192^2 texels with their mip chain take 360 MB).
+/// Larger textures are refused (8192^2 texels with their mip chain take 360 MB), and so are
+/// models whose decoded textures would hold more texels than that together.
 constexpr int kMaxTextureSide = 8192;
+constexpr std::size_t kMaxTextureTexels = std::size_t{kMaxTextureSide} * kMaxTextureSide;
 
 TextureWrap wrap_of(int gl_wrap) {
   switch (gl_wrap) {
@@ -311,6 +313,10 @@ class GltfTextures {
     const std::string what = file_ + ": image " + std::to_string(texture.source) +
                              (image.uri.empty() || image.uri.starts_with("data:") ? "" : " (" + image.uri + ")");
     const ColorImage decoded = decode_color(encoded(image, texture.source, what), what, kMaxTextureSide);
+    texels_ += decoded.size();
+    if (texels_ > kMaxTextureTexels)
+      fail("its textures hold more than " + std::to_string(kMaxTextureTexels) +
+           " texels together (the limit), at image " + std::to_string(texture.source));
     TextureWrap wrap_u = TextureWrap::Repeat, wrap_v = TextureWrap::Repeat;
     if (texture.sampler >= 0) {
       const tinygltf::Sampler& sampler = gltf_.samplers[static_cast<std::size_t>(texture.sampler)];
@@ -348,6 +354,7 @@ class GltfTextures {
   const EncodedImages& images_;
   std::string file_;
   std::map<std::pair<int, int>, std::shared_ptr<const Texture>> decoded_;
+  std::size_t texels_ = 0;  // decoded so far
 };
 
 tinygltf::Model read_gltf(const std::filesystem::path& path, bool binary, EncodedImages& images) {
