@@ -24,8 +24,8 @@ inline void check_loaded_model(const render::VirtualModel& model) {
       if (m >= model.materials.size()) std::abort();
   }
   for (const render::PhongMaterial& m : model.materials)
-    if (m.base_color && (!m.base_color->sample(0.3f, 0.7f, 1.5f).allFinite() || !m.base_color->mean().allFinite()))
-      std::abort();
+    for (const render::Texture* t : {m.base_color.get(), m.emission_texture.get()})
+      if (t && (!t->sample(0.3f, 0.7f, 1.5f).allFinite() || !t->mean().allFinite())) std::abort();
   render::MrScene scene;
   render::add_virtual_model(scene, model, render::Placement{});
   try {

@@ -215,7 +215,11 @@ TEST_F(DirVkTest, TexturedShadingMatchesTheCpuMirror) {
   MrScene scene = cube_scene();
   test::texture_virtual_meshes(scene);
   for (PhongMaterial& m : scene.materials)
-    if (m.base_color) m.kd = Eigen::Vector3f::Constant(0.8f);  // the colours come from the texture alone
+    if (m.base_color) {
+      m.kd = Eigen::Vector3f::Constant(0.8f);         // the colours come from the texture alone
+      m.emission = Eigen::Vector3f::Constant(0.02f);  // and a faint glow through the same texture
+      m.emission_texture = m.base_color;
+    }
   expect_shading_matches_cpu(context, scene);
   DirRendererVk renderer(context, 64, 48);
   renderer.set_scene(scene, test_options());

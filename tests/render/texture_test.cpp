@@ -8,6 +8,7 @@
 #include <cmath>
 #include <fstream>
 #include <numbers>
+#include <utility>
 
 #include "glb_file.h"
 #include "relight/core/error.h"
@@ -106,7 +107,9 @@ TEST(TexturedGltf, BoxTexturedLoadsItsBaseColourTextureAndCoordinates) {
 
 /// A one-triangle glTF with a textured material in `dir`: buffer.bin holds positions and, unless
 /// `with_texcoords` is false, TEXCOORD_0; the image is the file `image` (written by the caller).
-std::filesystem::path write_textured_triangle(const std::filesystem::path& dir, bool with_texcoords) {
+std::filesystem::path write_textured_triangle(
+    const std::filesystem::path& dir, bool with_texcoords,
+    const std::string& material = R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}})") {
   const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const float texcoords[6] = {0, 0, 1, 0, 0, 1};
   {
@@ -118,7 +121,8 @@ std::filesystem::path write_textured_triangle(const std::filesystem::path& dir, 
   const std::string json = R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
     "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {)" +
                            attributes + R"(}, "material": 0}]}],
-    "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+    "materials": [)" + material +
+                           R"(],
     "textures": [{"source": 0}], "images": [{"uri": "texture.png"}],
     "buffers": [{"uri": "buffer.bin", "byteLength": 60}],
     "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
@@ -147,6 +151,23 @@ TEST(TexturedGltf, AnExternalPngTextureIsDecoded) {
   EXPECT_LT((texture->sample(0.25f, 0.25f) - linear(kRed)).norm(), 1e-6f);
   EXPECT_LT((texture->sample(0.75f, 0.25f) - linear(kBlue)).norm(), 1e-6f);
   EXPECT_EQ(model.meshes.at(0).texcoords.size(), 3u);
+}
+
+TEST(TexturedGltf, AnEmissiveTextureMultipliesTheEmission) {
+  const relight::test::TempDir dir;
+  write_color(dir.path() / "texture.png", checkerboard(4, 2, kRed, kBlue));
+  const VirtualModel model = load_model(
+      write_textured_triangle(dir.path(), true, R"({"emissiveTexture": {"index": 0}, "emissiveFactor": [1, 0.5, 1]})"));
+  const PhongMaterial& material = model.materials.at(0);
+  EXPECT_EQ(material.base_color, nullptr);
+  ASSERT_NE(material.emission_texture, nullptr);
+  EXPECT_EQ(model.meshes.at(0).texcoords.size(), 3u) << "read for the emissive texture alone";
+  EXPECT_LT((material.emission - Eigen::Vector3f(1.f, 0.5f, 1.f)).norm(), 1e-6f);
+  // One TEXCOORD set per material: two different ones are refused.
+  const std::string two_sets =
+      R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "emissiveTexture": {"index": 0, "texCoord": 1}})";
+  const std::string error = load_error(write_textured_triangle(dir.path(), true, two_sets));
+  EXPECT_NE(error.find("different TEXCOORD sets (0, 1)"), std::string::npos) << error;
 }
 
 TEST(TexturedGltf, AJpegTextureIsDecodedByItsSignature) {
@@ -290,6 +311,14 @@ DifferentialImages direct_light(const MrScene& scene, const MrCamera& camera, GB
   return render_dir_cpu(scene, camera, {}, options, &gbuffer);
 }
 
+/// The path tracer's direct light (and emission) alone, `spp` samples per pixel.
+DifferentialImages path_traced_direct(const MrScene& scene, const MrCamera& camera, int spp) {
+  DifferentialPathTracer tracer(scene, {.max_bounces = 0});
+  tracer.reset(camera);
+  tracer.render(spp);
+  return tracer.images();
+}
+
 TEST(TexturedRendering, DirDirectLightFollowsTheTexture) {
   const MrScene scene = textured_square();
   const MrCamera camera = test::camera_at({0.05, -0.6, 1.4}, {0, 0, 0.2}, 80, 60);
@@ -368,14 +397,37 @@ TEST(TexturedRendering, BoxTexturedShowsItsDecodedImage) {
   EXPECT_GT(distinct_colours, 500) << "the logo's colours, not one flat colour";
 }
 
+// The same square glowing through its emission texture, unlit: L = emission t in DIR and in
+// the path tracer.
+TEST(TexturedRendering, EmissionFollowsTheEmissionTexture) {
+  MrScene scene = textured_square();
+  scene.lights.clear();
+  PhongMaterial& material = scene.materials[0];
+  material.emission = {0.5f, 1.f, 2.f};
+  material.emission_texture = std::exchange(material.base_color, nullptr);
+  const MrCamera camera = test::camera_at({0.05, -0.6, 1.4}, {0, 0, 0.2}, 40, 30);
+  GBuffer gbuffer;
+  const DifferentialImages dir = direct_light(scene, camera, gbuffer);
+  const DifferentialImages traced = path_traced_direct(scene, camera, 4);
+  const std::vector<Expected> cells = cell_centres(gbuffer);
+  ASSERT_GT(cells.size(), 60u);
+  for (const Expected& e : cells) {
+    // cell_centres' radiance is 0.8 t E / pi; the emission is (0.5, 1, 2) t.
+    const Eigen::Vector3f expected =
+        (e.radiance * (std::numbers::pi_v<float> / (0.8f * kSun))).cwiseProduct(material.emission);
+    for (const DifferentialImages* images : {&dir, &traced}) {
+      const Float3& c = images->real_virtual(e.y, e.x);
+      EXPECT_LT((Eigen::Vector3f(c.x, c.y, c.z) - expected).norm(), 0.01f * expected.norm() + 1e-4f)
+          << "pixel " << e.x << "," << e.y << (images == &dir ? " (DIR)" : " (path tracer)");
+    }
+  }
+}
+
 TEST(TexturedRendering, PathTracerFollowsTheTexture) {
   const MrScene scene = textured_square();
   const MrCamera camera = test::camera_at({0.05, -0.6, 1.4}, {0, 0, 0.2}, 40, 30);
   const GBuffer gbuffer = gbuffer_cpu(RayTracer(scene), camera);
-  DifferentialPathTracer tracer(scene, {.max_bounces = 0});
-  tracer.reset(camera);
-  tracer.render(16);
-  const DifferentialImages images = tracer.images();
+  const DifferentialImages images = path_traced_direct(scene, camera, 16);
   const std::vector<Expected> cells = cell_centres(gbuffer);
   ASSERT_GT(cells.size(), 60u);
   for (const Expected& e : cells) {

@@ -24,7 +24,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 struct Material {
   vec4 kd_ks;        // k_d, k_s
   vec4 emission_n;   // emission, Phong exponent n
-  vec4 texture;      // x: its base-colour texture's header in texture_words (bits); 0xffffffff: none
+  vec4 texture;      // x, y: its base-colour and emission textures' headers in texture_words (bits); 0xffffffff: none
 };
 struct Light {
   vec4 position_kind;      // w: 0 point, 1 spot, 2 directional, 3 directional through its emitter VPL (bits)
@@ -145,15 +145,12 @@ void main() {
   const float real_pixel = position.w > 0.0 ? 1.0 : 0.0;  // r(p)
   const vec3 wo = normalize(params.camera_centre.xyz - point);
   const Material own = materials[uint(normal_material.w)];
-  // base_color_factors() (gbuffer.h): the texture at the pixel's coordinates and footprint.
-  vec3 kd_texture = vec3(1.0);
-  const uint header = floatBitsToUint(own.texture.x);
-  if (header != 0xffffffffu) {
-    const vec4 t = gbuffer[2u * pixels + i];
-    kd_texture = t.z > 0.0 ? texture_sample(header, t.xy, texture_level(header, t.z)) : texture_mean(header);
-  }
+  // texture_factors() (gbuffer.h): the textures at the pixel's coordinates and footprint.
+  const vec4 t = gbuffer[2u * pixels + i];
+  const vec3 kd_texture = material_texture(floatBitsToUint(own.texture.x), t);
   Material m = own;  // textured: for the direct light
   m.kd_ks.xyz *= kd_texture;
+  m.emission_n.xyz *= material_texture(floatBitsToUint(own.texture.y), t);
   vec3 rv = m.emission_n.xyz;
   vec3 r = real_pixel * m.emission_n.xyz;
   const bool want_rv = (params.flags & 4u) != 0u, want_r = (params.flags & 8u) != 0u;

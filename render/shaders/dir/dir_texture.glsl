@@ -65,3 +65,10 @@ vec3 texture_sample(uint header, vec2 uv, float lod) {
   if (f == 0.0 || l0 + 1u >= levels) return near;
   return (1.0 - f) * near + f * texture_bilinear(header, l0 + 1u, uv);
 }
+
+// texture_factors() (gbuffer.h) at one pixel: 1 without a texture (header 0xffffffff), the
+// texture's mean where the G-buffer's footprint (texcoord.z) marks no coordinates.
+vec3 material_texture(uint header, vec4 texcoord) {
+  if (header == 0xffffffffu) return vec3(1.0);
+  return texcoord.z > 0.0 ? texture_sample(header, texcoord.xy, texture_level(header, texcoord.z)) : texture_mean(header);
+}

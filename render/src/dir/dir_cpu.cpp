@@ -37,10 +37,11 @@ class MapShader {
   /// k_d, textured after the interleaved merge (merged_pixel), so that the merge's average over
   /// neighbouring pixels does not blur the texture into it.
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
-                               const Vec3& kd_texture, float real_pixel, std::uint32_t subset) const {
+                               const Vec3& kd_texture, const Vec3& emission, float real_pixel,
+                               std::uint32_t subset) const {
     Radiance out;
-    out.real_virtual = m.emission;
-    out.real = real_pixel * m.emission;
+    out.real_virtual = emission;
+    out.real = real_pixel * emission;
     out.kd_texture = kd_texture;
     Phong textured = m;
     textured.kd = m.kd.cwiseProduct(kd_texture);
@@ -189,7 +190,8 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
   if (ism_atlas.size() < ism_texels) throw Error("shade_dir_from_maps: the ISM atlas is smaller than its VPLs need");
   if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
   const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
-  const RadianceImage kd_texture = base_color_factors(gbuffer, scene);
+  const RadianceImage kd_texture = texture_factors(gbuffer, scene, MaterialTexture::BaseColor);
+  const RadianceImage emission_texture = texture_factors(gbuffer, scene, MaterialTexture::Emission);
   const Vec3 environment = scene.environment.radiance;
   const int n = options.interleave;
   Image<Radiance> shaded(width, height);
@@ -206,9 +208,10 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
         const float real_pixel = gbuffer.virtual_surface(y, x) ? 0.f : 1.f;
         const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));
         const Float3 t = kd_texture.empty() ? Float3{1.f, 1.f, 1.f} : kd_texture(y, x);
-        shaded(y, x) =
-            shader.shade(point, normal, (camera_centre - point).normalized(),
-                         scene.materials[gbuffer.material(y, x) - 1u], Vec3(t.x, t.y, t.z), real_pixel, subset);
+        const Float3 e = emission_texture.empty() ? Float3{1.f, 1.f, 1.f} : emission_texture(y, x);
+        const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
+        shaded(y, x) = shader.shade(point, normal, (camera_centre - point).normalized(), material, Vec3(t.x, t.y, t.z),
+                                    material.emission.cwiseProduct(Vec3(e.x, e.y, e.z)), real_pixel, subset);
       }
   }, 4);
   DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,

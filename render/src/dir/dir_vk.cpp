@@ -50,24 +50,38 @@ float bits(std::uint32_t value) { return std::bit_cast<float>(value); }
 
 constexpr std::uint32_t kNoTexture = 0xffffffffu;
 
-/// The scenes' base-colour textures as dir_texture.glsl reads them, and the header word of each
-/// material's texture (kNoTexture: none). A texture shared by several materials is packed once.
+/// The scenes' textures as dir_texture.glsl reads them, and the header words of each material's
+/// base-colour and emission textures (two per material; kNoTexture: none). A texture shared by
+/// several materials (or slots) is packed once.
 struct PackedTextures {
   std::vector<std::uint32_t> words;
-  std::vector<std::uint32_t> material_header;
+  std::vector<std::uint32_t> material_headers;
 };
 
-PackedTextures pack_textures(const MrScene& scene) {
+/// Per material its base-colour and its emission texture (null: none): when a new scene's list
+/// equals the last one's, the packed textures on the device still hold (scenes are rebuilt every
+/// frame, textures are shared). Held, not just compared: a texture freed and another made at its
+/// address would look unchanged.
+std::vector<std::shared_ptr<const Texture>> material_textures(const MrScene& scene) {
+  std::vector<std::shared_ptr<const Texture>> out;
+  for (const PhongMaterial& m : scene.materials) {
+    out.push_back(m.base_color);
+    out.push_back(m.emission_texture);
+  }
+  return out;
+}
+
+PackedTextures pack_textures(const std::vector<std::shared_ptr<const Texture>>& textures) {
   PackedTextures out;
   std::map<const Texture*, std::uint32_t> headers;
-  for (const PhongMaterial& m : scene.materials) {
-    const Texture* texture = m.base_color.get();
+  for (const std::shared_ptr<const Texture>& slot : textures) {
+    const Texture* texture = slot.get();
     if (!texture) {
-      out.material_header.push_back(kNoTexture);
+      out.material_headers.push_back(kNoTexture);
       continue;
     }
     if (const auto found = headers.find(texture); found != headers.end()) {
-      out.material_header.push_back(found->second);
+      out.material_headers.push_back(found->second);
       continue;
     }
     const auto header = static_cast<std::uint32_t>(out.words.size());
@@ -82,17 +96,8 @@ PackedTextures pack_textures(const MrScene& scene) {
                                          static_cast<std::uint32_t>(texture->level_height(l)), 0u});
     out.words.insert(out.words.end(), texture->texels().begin(), texture->texels().end());
     headers.emplace(texture, header);
-    out.material_header.push_back(header);
+    out.material_headers.push_back(header);
   }
-  return out;
-}
-
-/// Per material, its texture (null: none): when a new scene's list equals the last one's, the
-/// packed textures on the device still hold (scenes are rebuilt every frame, textures are shared).
-/// (Held, not just compared: a texture freed and another made at its address would look unchanged.)
-std::vector<std::shared_ptr<const Texture>> material_textures(const MrScene& scene) {
-  std::vector<std::shared_ptr<const Texture>> out;
-  for (const PhongMaterial& m : scene.materials) out.push_back(m.base_color);
   return out;
 }
 
@@ -101,7 +106,7 @@ std::vector<float> pack_materials(const MrScene& scene, const std::vector<std::u
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     const PhongMaterial& m = scene.materials[i];
     out.insert(out.end(), {m.kd.x(), m.kd.y(), m.kd.z(), m.ks, m.emission.x(), m.emission.y(), m.emission.z(), m.n,
-                           bits(texture_headers[i]), 0.f, 0.f, 0.f});
+                           bits(texture_headers[2 * i]), bits(texture_headers[2 * i + 1]), 0.f, 0.f});
   }
   return out;
 }
@@ -201,7 +206,7 @@ struct DirRendererVk::Impl {
   vk::UniqueDescriptorSet merge_set;
   std::unique_ptr<vk::VulkanBuffer> materials, lights, views, vpls, textures;
   std::vector<std::shared_ptr<const Texture>> uploaded_textures;  // per material, of the packed `textures`
-  std::vector<std::uint32_t> texture_headers;                     // per material
+  std::vector<std::uint32_t> texture_headers;                     // two per material
   vk::UniqueDescriptorSet shade_set;
   std::array<vk::GpuTimer, 6> timers;
   std::optional<MrScene> scene;
@@ -252,9 +257,9 @@ void DirRendererVk::set_scene(const MrScene& scene, const DirRenderOptions& opti
   d.ism.set_points(d.points);
   if (std::vector<std::shared_ptr<const Texture>> textures = material_textures(scene);
       textures != d.uploaded_textures || !d.textures) {
-    PackedTextures packed = pack_textures(scene);
+    PackedTextures packed = pack_textures(textures);
     d.upload(d.textures, packed.words);
-    d.texture_headers = std::move(packed.material_header);
+    d.texture_headers = std::move(packed.material_headers);
     d.uploaded_textures = std::move(textures);
   }
   d.upload(d.materials, pack_materials(scene, d.texture_headers));

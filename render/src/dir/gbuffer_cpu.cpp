@@ -21,17 +21,22 @@ float texcoord_step(const SurfaceHit& hit, const Eigen::Vector3f& origin, const 
 
 bool has_textures(const MrScene& scene) {
   return std::any_of(scene.materials.begin(), scene.materials.end(),
-                     [](const PhongMaterial& m) { return m.base_color != nullptr; });
+                     [](const PhongMaterial& m) { return m.base_color != nullptr || m.emission_texture != nullptr; });
 }
 
-RadianceImage base_color_factors(const GBuffer& gbuffer, const MrScene& scene) {
-  if (gbuffer.texcoord.empty() || !has_textures(scene)) return {};
+RadianceImage texture_factors(const GBuffer& gbuffer, const MrScene& scene, MaterialTexture which) {
+  const auto texture_of = [which](const PhongMaterial& m) {
+    return which == MaterialTexture::BaseColor ? m.base_color.get() : m.emission_texture.get();
+  };
+  if (gbuffer.texcoord.empty() || std::none_of(scene.materials.begin(), scene.materials.end(),
+                                               [&](const PhongMaterial& m) { return texture_of(m); }))
+    return {};
   RadianceImage out(gbuffer.texcoord.width(), gbuffer.texcoord.height());
   for (std::size_t i = 0; i < out.size(); ++i) {
     out.pixels()[i] = {1.f, 1.f, 1.f};
     const std::uint16_t label = gbuffer.material.pixels()[i];
     if (label == 0) continue;
-    const Texture* texture = scene.materials.at(label - 1u).base_color.get();
+    const Texture* texture = texture_of(scene.materials.at(label - 1u));
     if (!texture) continue;
     const Float3& t = gbuffer.texcoord.pixels()[i];
     // A footprint of zero marks a pixel without coordinates (the coordinates themselves may be 0).
@@ -70,7 +75,7 @@ GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads
         if (textured && hit->has_texcoord) {
           const float footprint =
               std::max(texcoord_step(*hit, origin, ray(col + 1, row)), texcoord_step(*hit, origin, ray(col, row + 1)));
-          // At least a little above zero: zero marks "no coordinates" (base_color_factors).
+          // At least a little above zero: zero marks "no coordinates" (texture_factors).
           out.texcoord(row, col) = {hit->texcoord.x(), hit->texcoord.y(), std::max(footprint, 1e-12f)};
         }
       }

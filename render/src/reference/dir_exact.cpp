@@ -41,8 +41,8 @@ class DirShader {
     out.virtual_pixel = !hit->real;
     const Vertex v = make_vertex(*hit, direction, scene_);
     const float real_pixel = hit->real ? 1.f : 0.f;  // r(p)
-    out.real_virtual += v.material->emission;
-    out.real += real_pixel * v.material->emission;
+    out.real_virtual += v.emission;
+    out.real += real_pixel * v.emission;
     if (options_.direct) add_direct(v, real_pixel, out);
     if (options_.indirect) add_indirect(v, real_pixel, out);
     return out;

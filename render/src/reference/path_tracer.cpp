@@ -105,7 +105,7 @@ void PathIntegrator::trace_layer(Vec3 origin, Vec3 direction, int bounce, bool w
       break;
     }
     const Vertex v = make_vertex(*hit, direction, scene_);
-    radiance += throughput.cwiseProduct(v.material->emission);
+    radiance += throughput.cwiseProduct(v.emission);
     direct_lights(v, with_virtual, with_virtual && tracer_.has_virtual_geometry(), rays,
                   [&](const MrLight&, const Vec3& contribution, bool virtual_visible) {
                     if (virtual_visible) radiance += throughput.cwiseProduct(contribution);
@@ -143,7 +143,7 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
       break;
     }
     const Vertex v = make_vertex(*hit, direction, scene_);
-    const Vec3 emitted = throughput.cwiseProduct(v.material->emission);
+    const Vec3 emitted = throughput.cwiseProduct(v.emission);
     out.real_virtual += emitted;
     out.real += emitted;
     direct_lights(v, true, has_virtual, out.rays,

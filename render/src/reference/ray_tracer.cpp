@@ -108,10 +108,13 @@ void add_texcoords(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>&
 }  // namespace
 
 Eigen::Vector3f base_color_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
+  return texture_at(scene.materials[hit.material].base_color.get(), hit.has_texcoord ? &hit.texcoord : nullptr, lod);
+}
+
+Eigen::Vector3f emission_at(const MrScene& scene, const SurfaceHit& hit) {
   const PhongMaterial& material = scene.materials[hit.material];
-  if (!material.base_color) return Eigen::Vector3f::Ones();
-  return hit.has_texcoord ? material.base_color->sample(hit.texcoord.x(), hit.texcoord.y(), lod)
-                          : material.base_color->mean();
+  return material.emission.cwiseProduct(
+      texture_at(material.emission_texture.get(), hit.has_texcoord ? &hit.texcoord : nullptr));
 }
 
 Phong phong_at(const MrScene& scene, const SurfaceHit& hit, float lod) {

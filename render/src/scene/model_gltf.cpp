@@ -7,6 +7,7 @@
 #include <cstring>
 #include <exception>
 #include <map>
+#include <optional>
 #include <span>
 #include <sstream>
 
@@ -206,11 +207,8 @@ class GltfMeshCollector {
       const Eigen::Matrix3f normal_matrix = transform.linear().inverse().transpose();
       for (std::size_t i = 0; i < normals.count(); ++i) mesh.normals.push_back((normal_matrix * normals.vec3(i)).normalized());
     }
-    if (primitive.material >= 0 && static_cast<std::size_t>(primitive.material) < gltf_.materials.size() &&
-        out_.materials[static_cast<std::size_t>(primitive.material)].base_color) {
-      const int set =
-          gltf_.materials[static_cast<std::size_t>(primitive.material)].pbrMetallicRoughness.baseColorTexture.texCoord;
-      const std::string attribute = "TEXCOORD_" + std::to_string(set);
+    if (const std::optional<int> set = texcoord_set(primitive.material, name)) {
+      const std::string attribute = "TEXCOORD_" + std::to_string(*set);
       const auto found = primitive.attributes.find(attribute);
       if (found == primitive.attributes.end())
         throw Error(file_ + ": mesh '" + name + "' has a textured material but no " + attribute);
@@ -242,6 +240,22 @@ class GltfMeshCollector {
     }
     if (mesh.normals.size() != mesh.positions.size()) compute_vertex_normals(mesh);
     return mesh;
+  }
+
+  /// The TEXCOORD set a primitive's textured material reads (nullopt: no texture); one set per
+  /// material, since relight's meshes carry one.
+  std::optional<int> texcoord_set(int material, const std::string& mesh) const {
+    if (material < 0 || static_cast<std::size_t>(material) >= gltf_.materials.size()) return std::nullopt;
+    const PhongMaterial& ours = out_.materials[static_cast<std::size_t>(material)];
+    const tinygltf::Material& theirs = gltf_.materials[static_cast<std::size_t>(material)];
+    const int base = theirs.pbrMetallicRoughness.baseColorTexture.texCoord, emissive = theirs.emissiveTexture.texCoord;
+    if (ours.base_color && ours.emission_texture && base != emissive)
+      throw Error(file_ + ": mesh '" + mesh +
+                  "': the material's base-colour and emissive textures use different TEXCOORD sets (" +
+                  std::to_string(base) + ", " + std::to_string(emissive) + "); relight reads one");
+    if (ours.base_color) return base;
+    if (ours.emission_texture) return emissive;
+    return std::nullopt;
   }
 
   const tinygltf::Model& gltf_;
@@ -295,9 +309,9 @@ class GltfTextures {
   GltfTextures(const tinygltf::Model& gltf, const EncodedImages& images, std::string file)
       : gltf_(gltf), images_(images), file_(std::move(file)) {}
 
-  /// The material's base-colour texture, or null when it has none.
-  std::shared_ptr<const Texture> base_color(const tinygltf::Material& material) {
-    const int index = material.pbrMetallicRoughness.baseColorTexture.index;
+  /// The texture a material refers to with `index` (its base colour's or its emission's), or
+  /// null for -1.
+  std::shared_ptr<const Texture> texture(const tinygltf::Material& material, int index) {
     if (index < 0) return nullptr;
     if (static_cast<std::size_t>(index) >= gltf_.textures.size())
       fail("material '" + material.name + "' uses texture " + std::to_string(index) + ", but the file has " +
@@ -387,7 +401,8 @@ VirtualModel load_gltf(const std::filesystem::path& path) {
   GltfTextures textures(gltf, images, path.string());
   for (const tinygltf::Material& m : gltf.materials) {
     model.materials.push_back(from_gltf(m));
-    model.materials.back().base_color = textures.base_color(m);
+    model.materials.back().base_color = textures.texture(m, m.pbrMetallicRoughness.baseColorTexture.index);
+    model.materials.back().emission_texture = textures.texture(m, m.emissiveTexture.index);
   }
   const auto default_material = static_cast<std::uint32_t>(model.materials.size());
   model.materials.push_back(PhongMaterial{{{0.8f, 0.8f, 0.8f}, 0.f, 1.f}, "default", {0.f, 0.f, 0.f}});

@@ -22,6 +22,11 @@ MrLight spot_light(const Eigen::Vector3f& position, const Eigen::Vector3f& direc
   return light;
 }
 
+Eigen::Vector3f texture_at(const Texture* texture, const Eigen::Vector2f* uv, float lod) {
+  if (!texture) return Eigen::Vector3f::Ones();
+  return uv ? texture->sample(uv->x(), uv->y(), lod) : texture->mean();
+}
+
 Phong phong_at(const PhongMaterial& material, const Eigen::Vector2f& uv, float lod) {
   Phong out = material;
   if (material.base_color) out.kd = out.kd.cwiseProduct(material.base_color->sample(uv.x(), uv.y(), lod));

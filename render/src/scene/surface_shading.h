@@ -20,8 +20,9 @@ struct Vertex {
   Vec3 geometric_normal;
   Vec3 shading_normal;
   Vec3 wo;
-  const PhongMaterial* material = nullptr;  ///< for its emission
-  Phong brdf;                               ///< the material's, textured at the point
+  const PhongMaterial* material = nullptr;
+  Phong brdf;     ///< the material's, textured at the point
+  Vec3 emission;  ///< the material's, textured at the point
 };
 
 inline Vertex make_vertex(const SurfaceHit& hit, const Vec3& direction, const MrScene& scene) {
@@ -34,6 +35,7 @@ inline Vertex make_vertex(const SurfaceHit& hit, const Vec3& direction, const Mr
   if (v.shading_normal.dot(v.wo) <= 0.f) v.shading_normal = v.geometric_normal;
   v.material = &scene.materials[hit.material];
   v.brdf = phong_at(scene, hit);
+  v.emission = emission_at(scene, hit);
   return v;
 }
 

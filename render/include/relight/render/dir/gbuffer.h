@@ -25,13 +25,15 @@ struct GBuffer {
   static constexpr const char* type_name = "GBuffer";
 };
 
-/// Whether any material of `scene` has a base-colour texture (then G-buffers carry texcoord).
+/// Whether any material of `scene` has a texture (then G-buffers carry texcoord).
 [[nodiscard]] bool has_textures(const MrScene& scene);
 
-/// The texture factor of k_d at each pixel of `gbuffer` (Texture::sample at the pixel's
-/// coordinates and footprint; the texture's mean on a textured material without coordinates
-/// there); 1 elsewhere. Empty when `gbuffer` carries no texture coordinates.
-[[nodiscard]] RadianceImage base_color_factors(const GBuffer& gbuffer, const MrScene& scene);
+enum class MaterialTexture { BaseColor, Emission };
+/// The factor a material texture gives k_d (BaseColor) or the emission at each pixel of
+/// `gbuffer` (Texture::sample at the pixel's coordinates and footprint; the texture's mean on a
+/// textured material without coordinates there); 1 elsewhere. Empty when `gbuffer` carries no
+/// texture coordinates or no material has such a texture.
+[[nodiscard]] RadianceImage texture_factors(const GBuffer& gbuffer, const MrScene& scene, MaterialTexture which);
 
 [[nodiscard]] GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads = 0);
 

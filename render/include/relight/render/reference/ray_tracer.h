@@ -32,6 +32,8 @@ struct SurfaceHit {
 /// The factor k_d takes at a hit from its material's base-colour texture (at the hit's
 /// coordinates, mip level `lod`; the texture's mean where the hit has none); 1 untextured.
 [[nodiscard]] Eigen::Vector3f base_color_at(const MrScene& scene, const SurfaceHit& hit, float lod = 0.f);
+/// The radiance a hit's material emits there (its emission times its emission texture).
+[[nodiscard]] Eigen::Vector3f emission_at(const MrScene& scene, const SurfaceHit& hit);
 /// The Phong parameters at a hit: the material's with k_d times base_color_at().
 [[nodiscard]] Phong phong_at(const MrScene& scene, const SurfaceHit& hit, float lod = 0.f);
 

@@ -10,14 +10,16 @@
 //   k_s = 0.04 (1 - metallic) + luminance(baseColor) metallic, and the Phong exponent that
 //   matches a Beckmann lobe of slope alpha = roughness^2, n = 2 / alpha^2 - 2 (Walter et al.
 //   2007), clamped to [1, 10000]; emission = emissiveFactor times KHR_materials_emissive_strength.
-// glTF base-colour textures (PNG or JPEG; a data URI, a GLB buffer view or a file beside the
-// model) become the material's Texture (texture.h) with its sampler's wrap modes, and the
-// primitive's TEXCOORD_n (float, or normalised unsigned byte/short) its mesh's texcoords; only
+// glTF base-colour and emissive textures (PNG or JPEG; a data URI, a GLB buffer view or a file
+// beside the model) become the material's Textures (texture.h) with their samplers' wrap modes,
+// and the primitive's TEXCOORD_n (float, or normalised unsigned byte/short; one set per
+// material, so the two textures must share it) its mesh's texcoords; only
 // the images a material uses are decoded, each checked against 8192 px a side from its header
-// before decoding. The texture multiplies k_d only, so a fully metallic material (k_d = 0)
-// shows no texture and k_s keeps the factor's luminance. Other textures (normal,
-// metallic-roughness, emissive, occlusion), MTL texture maps, KHR_texture_transform and the base
-// colour's alpha are ignored. Meshes keep the file's axes (y-up, see virtual_model.h); glTF node
+// before decoding (and all of a model's together against 8192^2 texels). The base colour
+// multiplies k_d only, so a fully metallic material (k_d = 0) shows no texture and k_s keeps the
+// factor's luminance; the emissive texture multiplies the emission. Other textures (normal,
+// metallic-roughness, occlusion), MTL texture maps, KHR_texture_transform and the base colour's
+// alpha are ignored. Meshes keep the file's axes (y-up, see virtual_model.h); glTF node
 // transforms are applied. save_gltf writes no textures.
 #include <filesystem>
 

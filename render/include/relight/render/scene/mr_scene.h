@@ -23,13 +23,19 @@ namespace relight::render {
 
 /// A material of the scene: relight's Phong model (core/phong.h; sampled in phong_brdf.h), a name,
 /// an emitted radiance (a virtual light source shaped like its mesh) and, optionally, a base-colour
-/// texture that multiplies k_d per channel at each surface point (texture.h; the triangles need
-/// texture coordinates). The texture is shared: scenes are copied every frame, texels are not.
+/// texture that multiplies k_d and an emission texture that multiplies the emission, per channel
+/// at each surface point (texture.h; the triangles need texture coordinates). Textures are
+/// shared: scenes are copied every frame, texels are not.
 struct PhongMaterial : Phong {
   std::string name;
   Eigen::Vector3f emission{0.f, 0.f, 0.f};
   std::shared_ptr<const Texture> base_color{};
+  std::shared_ptr<const Texture> emission_texture{};
 };
+
+/// A texture's colour at a point with coordinates `uv` (mip level `lod`), or its mean where the
+/// point has none; 1 without a texture.
+[[nodiscard]] Eigen::Vector3f texture_at(const Texture* texture, const Eigen::Vector2f* uv, float lod = 0.f);
 
 /// The Phong parameters at a surface point with texture coordinates `uv` and mip level `lod`:
 /// the material's, with k_d multiplied by its texture where it has one.

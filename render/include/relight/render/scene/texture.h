@@ -1,7 +1,7 @@
 #pragma once
-// A base-colour texture of a virtual object's material (glTF 2.0 `baseColorTexture`): the
-// factor its material's k_d is multiplied by at a surface point, per channel, from the point's
-// texture coordinates.
+// A texture of a virtual object's material (glTF 2.0 `baseColorTexture`, `emissiveTexture`): the
+// factor its material's k_d (or emission) is multiplied by at a surface point, per channel, from
+// the point's texture coordinates.
 //
 // Texels are kept as the file has them, 8-bit sRGB (glTF's base colour is sRGB-encoded), with a
 // mip chain made in linear RGB (each level a 2x2 box filter of the one above, re-encoded), so
