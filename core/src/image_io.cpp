@@ -141,20 +141,34 @@ std::optional<std::pair<int, int>> encoded_size(std::span<const std::uint8_t> b,
   return std::nullopt;
 }
 
+/// Runs an OpenCV decoder, one at a time and with its stderr muted; an OpenCV exception becomes
+/// relight::Error naming `what`.
+template <class Decode>
+cv::Mat run_decoder(const std::string& what, const Decode& decode) {
+  try {
+    const std::lock_guard lock(decoder_mutex());
+    const MutedStderr muted;
+    return decode();
+  } catch (const cv::Exception& e) {
+    throw Error("cannot decode " + what + ": " + e.err);
+  }
+}
+
+/// An 8-bit BGR image (OpenCV's decoders' order) as relight's RGB ColorImage.
+ColorImage rgb_image(const cv::Mat& bgr) {
+  ColorImage image(bgr.cols, bgr.rows);
+  cv::Mat wrapped(bgr.rows, bgr.cols, CV_8UC3, image.data());
+  cv::cvtColor(bgr, wrapped, cv::COLOR_BGR2RGB);
+  return image;
+}
+
 cv::Mat read_any(const std::filesystem::path& path, int flags, std::initializer_list<ImageFormat> accepted) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw Error("cannot read " + path.string() + ": no such file");
   check_format(path, accepted);
   // OpenCV keeps EXR behind an opt-in switch since 4.5; relight reads only files it is asked to.
   ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
-  cv::Mat image;
-  try {
-    const std::lock_guard lock(decoder_mutex());
-    const MutedStderr muted;
-    image = cv::imread(path.string(), flags);
-  } catch (const cv::Exception& e) {
-    throw Error("cannot decode " + path.string() + ": " + e.err);
-  }
+  const cv::Mat image = run_decoder(path.string(), [&] { return cv::imread(path.string(), flags); });
   if (image.empty()) throw Error("cannot decode " + path.string() + ": not a readable image (corrupt or truncated?)");
   return image;
 }
@@ -247,10 +261,7 @@ ColorImage read_color(const std::filesystem::path& path) {
   if (raw.depth() != CV_8U) {
     throw Error("colour image " + path.string() + " is " + describe_depth(raw.depth()) + "; expected 8-bit");
   }
-  ColorImage image(raw.cols, raw.rows);
-  cv::Mat wrapped(raw.rows, raw.cols, CV_8UC3, image.data());
-  cv::cvtColor(raw, wrapped, cv::COLOR_BGR2RGB);
-  return image;
+  return rgb_image(raw);
 }
 
 ColorImage decode_color(std::span<const std::uint8_t> bytes, const std::string& name, int max_side) {
@@ -266,22 +277,12 @@ ColorImage decode_color(std::span<const std::uint8_t> bytes, const std::string& 
   if (size->first <= 0 || size->second <= 0 || size->first > max_side || size->second > max_side)
     throw Error(name + ": a " + std::to_string(size->first) + "x" + std::to_string(size->second) +
                 " image, larger than " + std::to_string(max_side) + " pixels on a side (the limit)");
-  cv::Mat raw;
-  try {
-    const std::lock_guard lock(decoder_mutex());
-    const MutedStderr muted;
-    // imdecode only reads through this header.
-    const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
-    raw = cv::imdecode(encoded, cv::IMREAD_COLOR);
-  } catch (const cv::Exception& e) {
-    throw Error("cannot decode " + name + ": " + e.err);
-  }
+  // imdecode only reads through this header.
+  const cv::Mat encoded(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<std::uint8_t*>(bytes.data()));
+  const cv::Mat raw = run_decoder(name, [&] { return cv::imdecode(encoded, cv::IMREAD_COLOR); });
   if (raw.empty() || raw.depth() != CV_8U)
     throw Error("cannot decode " + name + ": not a readable 8-bit image (corrupt or truncated?)");
-  ColorImage image(raw.cols, raw.rows);
-  cv::Mat wrapped(raw.rows, raw.cols, CV_8UC3, image.data());
-  cv::cvtColor(raw, wrapped, cv::COLOR_BGR2RGB);
-  return image;
+  return rgb_image(raw);
 }
 
 void write_color(const std::filesystem::path& path, const ColorImage& image) {

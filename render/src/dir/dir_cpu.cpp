@@ -43,9 +43,7 @@ class MapShader {
     out.real_virtual = emission;
     out.real = real_pixel * emission;
     out.kd_texture = kd_texture;
-    Phong textured = m;
-    textured.kd = m.kd.cwiseProduct(kd_texture);
-    if (options_.shading.direct) add_direct(point, normal, wo, textured, real_pixel, out);
+    if (options_.shading.direct) add_direct(point, normal, wo, with_kd_factor(m, kd_texture), real_pixel, out);
     if (options_.shading.indirect) add_indirect(point, normal, wo, m, real_pixel, subset, out);
     return out;
   }

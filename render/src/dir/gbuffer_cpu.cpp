@@ -40,7 +40,8 @@ RadianceImage texture_factors(const GBuffer& gbuffer, const MrScene& scene, Mate
     if (!texture) continue;
     const Float3& t = gbuffer.texcoord.pixels()[i];
     // A footprint of zero marks a pixel without coordinates (the coordinates themselves may be 0).
-    const Eigen::Vector3f c = t.z > 0.f ? texture->sample(t.x, t.y, texture->level_of_detail(t.z)) : texture->mean();
+    const Eigen::Vector2f uv(t.x, t.y);
+    const Eigen::Vector3f c = texture_at(texture, t.z > 0.f ? &uv : nullptr, texture->level_of_detail(t.z));
     out.pixels()[i] = {c.x(), c.y(), c.z()};
   }
   return out;

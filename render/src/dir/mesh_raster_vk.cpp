@@ -15,8 +15,8 @@ void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, Mes
   std::vector<RasterVertex> vertices;
   for (const TriangleMesh& mesh : scene.meshes) {
     if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
+    const bool textured = !mesh.texcoords.empty();
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      const bool textured = !mesh.texcoords.empty();
       const std::uint32_t info =
           mesh.triangle_material[t] | (mesh.real ? 0u : kVirtualBit) | (textured ? kTexcoordBit : 0u);
       const auto& tri = mesh.triangles[t];

@@ -25,7 +25,6 @@ namespace relight::render::detail {
 /// gl_PrimitiveID (which would need the geometry-shader feature).
 inline constexpr std::uint32_t kVirtualBit = 0x80000000u;
 inline constexpr std::uint32_t kTexcoordBit = 0x40000000u;  ///< the mesh has texture coordinates
-inline constexpr std::uint32_t kMaterialBits = 0x3fffffffu;
 
 struct RasterVertex {
   float position[3];

@@ -118,9 +118,7 @@ Eigen::Vector3f emission_at(const MrScene& scene, const SurfaceHit& hit) {
 }
 
 Phong phong_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
-  Phong out = scene.materials[hit.material];
-  out.kd = out.kd.cwiseProduct(base_color_at(scene, hit, lod));
-  return out;
+  return with_kd_factor(scene.materials[hit.material], base_color_at(scene, hit, lod));
 }
 
 struct RayTracer::Impl {

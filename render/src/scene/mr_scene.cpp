@@ -27,9 +27,9 @@ Eigen::Vector3f texture_at(const Texture* texture, const Eigen::Vector2f* uv, fl
   return uv ? texture->sample(uv->x(), uv->y(), lod) : texture->mean();
 }
 
-Phong phong_at(const PhongMaterial& material, const Eigen::Vector2f& uv, float lod) {
+Phong with_kd_factor(const Phong& material, const Eigen::Vector3f& factor) {
   Phong out = material;
-  if (material.base_color) out.kd = out.kd.cwiseProduct(material.base_color->sample(uv.x(), uv.y(), lod));
+  out.kd = out.kd.cwiseProduct(factor);
   return out;
 }
 

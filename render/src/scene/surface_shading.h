@@ -20,7 +20,6 @@ struct Vertex {
   Vec3 geometric_normal;
   Vec3 shading_normal;
   Vec3 wo;
-  const PhongMaterial* material = nullptr;
   Phong brdf;     ///< the material's, textured at the point
   Vec3 emission;  ///< the material's, textured at the point
 };
@@ -33,7 +32,6 @@ inline Vertex make_vertex(const SurfaceHit& hit, const Vec3& direction, const Mr
   v.shading_normal = hit.shading_normal.dot(v.geometric_normal) < 0.f ? Vec3(-hit.shading_normal) : hit.shading_normal;
   // An interpolated normal can face away from a grazing viewer; shade with the true one there.
   if (v.shading_normal.dot(v.wo) <= 0.f) v.shading_normal = v.geometric_normal;
-  v.material = &scene.materials[hit.material];
   v.brdf = phong_at(scene, hit);
   v.emission = emission_at(scene, hit);
   return v;

@@ -37,9 +37,9 @@ struct PhongMaterial : Phong {
 /// point has none; 1 without a texture.
 [[nodiscard]] Eigen::Vector3f texture_at(const Texture* texture, const Eigen::Vector2f* uv, float lod = 0.f);
 
-/// The Phong parameters at a surface point with texture coordinates `uv` and mip level `lod`:
-/// the material's, with k_d multiplied by its texture where it has one.
-[[nodiscard]] Phong phong_at(const PhongMaterial& material, const Eigen::Vector2f& uv, float lod = 0.f);
+/// `material`'s Phong parameters with k_d multiplied per channel by `factor` (its texture's
+/// colour at a surface point).
+[[nodiscard]] Phong with_kd_factor(const Phong& material, const Eigen::Vector3f& factor);
 
 /// An indexed triangle mesh with one material per triangle. `normals` is either empty (flat
 /// shading with the geometric normal) or one unit normal per vertex (interpolated); `texcoords`

@@ -86,9 +86,7 @@ struct Vpl {
 
 /// The Phong parameters of the surface a VPL lies on (its material, k_d textured at the VPL).
 [[nodiscard]] inline Phong vpl_phong(const MrScene& scene, const Vpl& vpl) {
-  Phong out = scene.materials[vpl.material];
-  out.kd = out.kd.cwiseProduct(vpl.kd_texture);
-  return out;
+  return with_kd_factor(scene.materials[vpl.material], vpl.kd_texture);
 }
 
 /// How far out along its light an emitter VPL sits, in radii of the scene's bounding sphere.
