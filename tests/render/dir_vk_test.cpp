@@ -238,6 +238,24 @@ TEST_F(DirVkTest, TexturedShadingMatchesTheCpuMirror) {
   EXPECT_GT(white, 20) << "and its white ones";
 }
 
+// A metallic-roughness texture (a checkerboard of rough dielectric and smoother metal) on the
+// textured cube, on a material mapped from glTF's factors: the GPU's per-pixel Phong parameters
+// and its VPLs' match the CPU mirror.
+TEST_F(DirVkTest, MetallicRoughnessShadingMatchesTheCpuMirror) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  MrScene scene = cube_scene();
+  test::texture_virtual_meshes(scene);
+  const auto mr = std::make_shared<const Texture>("mr", test::checkerboard(16, 2, Rgb8{0, 240, 0}, Rgb8{0, 120, 255}),
+                                                  TextureWrap::Repeat, TextureWrap::Repeat, TextureEncoding::Linear);
+  for (PhongMaterial& m : scene.materials)
+    if (m.base_color) {
+      m.metallic_roughness = {{0.9f, 0.6f, 0.3f}, 0.8f, 0.9f};
+      static_cast<Phong&>(m) = phong_from_metallic_roughness(m.metallic_roughness);
+      m.metallic_roughness_texture = mr;
+    }
+  expect_shading_matches_cpu(context, scene);
+}
+
 // An emitter VPL's tiles look at the scene from far away (ism.h) and it shades like a
 // directional light (vpl.h): both on the GPU as in the CPU mirror.
 TEST_F(DirVkTest, EmitterVplSplatsAndShadesLikeTheCpuMirror) {

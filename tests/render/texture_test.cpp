@@ -48,6 +48,21 @@ TEST(Texture, SamplesTexelCentresAndFiltersInLinearLight) {
   EXPECT_LT((between - 0.5f * (linear(kRed) + linear(kGreen))).norm(), 1e-6f);
 }
 
+TEST(Texture, LinearTexturesHoldDataNotColours) {
+  // Metallic-roughness texels are values / 255, filtered and mip-mapped as they are.
+  const Rgb8 a{0, 51, 255}, b{0, 153, 0};
+  const Texture texture("data", image_of(2, 1, {a, b}), TextureWrap::ClampToEdge, TextureWrap::ClampToEdge,
+                        TextureEncoding::Linear);
+  EXPECT_EQ(texture.encoding(), TextureEncoding::Linear);
+  EXPECT_LT((texture.sample(0.25f, 0.5f) - Eigen::Vector3f(0.f, 0.2f, 1.f)).norm(), 1e-6f);
+  EXPECT_LT((texture.sample(0.5f, 0.5f) - Eigen::Vector3f(0.f, 0.4f, 0.5f)).norm(), 1e-6f);
+  ASSERT_EQ(texture.levels(), 2);
+  EXPECT_EQ(texture.texels()[texture.level_offset(1)], 0u | (102u << 8) | (128u << 16)) << "the mean of the values";
+  // The same bytes as colours decode through the sRGB curve.
+  const Texture colour("colour", image_of(2, 1, {a, b}));
+  EXPECT_NEAR(colour.sample(0.25f, 0.5f).y(), srgb_to_linear(51), 1e-6f);
+}
+
 TEST(Texture, WrapModesFollowTheGltfSampler) {
   const ColorImage image = image_of(2, 2, {kRed, kGreen, kBlue, kWhite});
   const Texture repeat("repeat", image, TextureWrap::Repeat, TextureWrap::Repeat);
@@ -168,6 +183,42 @@ TEST(TexturedGltf, AnEmissiveTextureMultipliesTheEmission) {
       R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}, "emissiveTexture": {"index": 0, "texCoord": 1}})";
   const std::string error = load_error(write_textured_triangle(dir.path(), true, two_sets));
   EXPECT_NE(error.find("different TEXCOORD sets (0, 1)"), std::string::npos) << error;
+}
+
+TEST(TexturedGltf, AMetallicRoughnessTextureIsReadAsLinearDataWithItsFactors) {
+  const relight::test::TempDir dir;
+  write_color(dir.path() / "texture.png", checkerboard(4, 2, kRed, kBlue));
+  const std::string material = R"({"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0},
+      "baseColorFactor": [0.2, 0.4, 0.6, 1], "metallicFactor": 0.5, "roughnessFactor": 0.8}})";
+  const VirtualModel model = load_model(write_textured_triangle(dir.path(), true, material));
+  const PhongMaterial& m = model.materials.at(0);
+  ASSERT_NE(m.metallic_roughness_texture, nullptr);
+  EXPECT_EQ(m.metallic_roughness_texture->encoding(), TextureEncoding::Linear);
+  EXPECT_LT((m.metallic_roughness_texture->sample(0.75f, 0.25f) - Eigen::Vector3f(20.f, 40.f, 220.f) / 255.f).norm(),
+            1e-6f);
+  EXPECT_EQ(model.meshes.at(0).texcoords.size(), 3u) << "read for the metallic-roughness texture alone";
+  EXPECT_LT((m.metallic_roughness.base_color - Eigen::Vector3f(0.2f, 0.4f, 0.6f)).norm(), 1e-6f);
+  EXPECT_FLOAT_EQ(m.metallic_roughness.metallic, 0.5f);
+  EXPECT_FLOAT_EQ(m.metallic_roughness.roughness, 0.8f);
+  // The material's own Phong is the factors' (what a point without coordinates falls back to).
+  EXPECT_LT((m.kd - Eigen::Vector3f(0.1f, 0.2f, 0.3f)).norm(), 1e-6f);
+  // At a texel: roughness G x 0.8, metallic B x 0.5.
+  const Phong at = surface_phong(m, Eigen::Vector3f(0.f, 0.5f, 1.f));
+  const Phong expected = phong_from_metallic_roughness({{0.2f, 0.4f, 0.6f}, 0.5f, 0.4f});
+  EXPECT_LT((at.kd - expected.kd).norm(), 1e-6f);
+  EXPECT_FLOAT_EQ(at.ks, expected.ks);
+  EXPECT_FLOAT_EQ(at.n, expected.n);
+  EXPECT_GT(at.n, 5.f * m.n) << "smoother than the factor alone";
+
+  // relight's own Phong parameters (extras) are kept as they are: the texture has nothing to map.
+  const std::string extras = R"({"pbrMetallicRoughness": {"metallicRoughnessTexture": {"index": 0}},
+      "extras": {"relight_phong": {"kd": [0.5, 0.5, 0.5], "ks": 0.1, "n": 20}}})";
+  EXPECT_EQ(load_model(write_textured_triangle(dir.path(), true, extras)).materials.at(0).metallic_roughness_texture,
+            nullptr);
+  const std::string two_sets = R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+      "metallicRoughnessTexture": {"index": 0, "texCoord": 2}}})";
+  const std::string error = load_error(write_textured_triangle(dir.path(), true, two_sets));
+  EXPECT_NE(error.find("different TEXCOORD sets (0, 2)"), std::string::npos) << error;
 }
 
 TEST(TexturedGltf, AJpegTextureIsDecodedByItsSignature) {
@@ -421,6 +472,53 @@ TEST(TexturedRendering, EmissionFollowsTheEmissionTexture) {
           << "pixel " << e.x << "," << e.y << (images == &dir ? " (DIR)" : " (path tracer)");
     }
   }
+}
+
+// The square's checker cells alternate between a rough red dielectric and a blue-based metal of
+// medium roughness through a metallic-roughness texture (the base colour texture stays): each
+// cell's light is the Phong model of its own texel's mapping, in DIR and in the path tracer; the
+// metal cells lose the texture's blue (k_d = 0) and show k_s's broad highlight instead.
+TEST(TexturedRendering, MetallicRoughnessTextureSetsThePhongParametersPerPoint) {
+  MrScene scene = textured_square();
+  PhongMaterial& material = scene.materials[0];
+  const Rgb8 dielectric{0, 230, 0}, metal{0, 200, 255};  // glTF: G roughness, B metallic
+  material.metallic_roughness_texture = std::make_shared<const Texture>(
+      "mr", checkerboard(64, 16, dielectric, metal), TextureWrap::Repeat, TextureWrap::Repeat, TextureEncoding::Linear);
+  material.metallic_roughness = {Eigen::Vector3f::Constant(0.8f), 1.f, 1.f};
+  static_cast<Phong&>(material) = phong_from_metallic_roughness(material.metallic_roughness);
+  const MrCamera camera = test::camera_at({0.05, -0.6, 1.4}, {0, 0, 0.2}, 80, 60);
+  GBuffer gbuffer;
+  const DifferentialImages dir = direct_light(scene, camera, gbuffer);
+  const DifferentialImages traced = path_traced_direct(scene, camera, 8);
+  const Eigen::Vector3f eye = camera.camera_to_world.translation().cast<float>();
+  int metal_cells = 0, dielectric_cells = 0;
+  for (const Expected& e : cell_centres(gbuffer)) {
+    const bool red = e.radiance.x() > e.radiance.z();
+    const Rgb8 texel = red ? dielectric : metal;
+    Phong at = phong_from_metallic_roughness(
+        {Eigen::Vector3f::Constant(0.8f), float(texel.b) / 255.f, float(texel.g) / 255.f});
+    at = with_kd_factor(at, linear(red ? kRed : kBlue));
+    const Float3& p = gbuffer.position(e.y, e.x);
+    const Eigen::Vector3f point(p.x, p.y, p.z);
+    const Eigen::Vector3f expected =
+        phong_brdf(at, Eigen::Vector3f::UnitZ().eval(), scene.lights[0].direction, (eye - point).normalized().eval()) *
+        kSun;
+    for (const DifferentialImages* images : {&dir, &traced}) {
+      const Float3& c = images->real_virtual(e.y, e.x);
+      EXPECT_LT((Eigen::Vector3f(c.x, c.y, c.z) - expected).norm(), 0.01f * expected.norm() + 1e-4f)
+          << "pixel " << e.x << "," << e.y << (images == &dir ? " (DIR)" : " (path tracer)");
+    }
+    if (red) {
+      ++dielectric_cells;
+    } else {
+      ++metal_cells;
+      const Float3& c = dir.real_virtual(e.y, e.x);
+      EXPECT_LT(c.z, 1.2f * c.x) << "a metal's white highlight, not the base texture's blue";
+      EXPECT_GT(c.x, 0.05f) << "k_s = 0.8 with n = " << at.n;
+    }
+  }
+  EXPECT_GT(metal_cells, 100);
+  EXPECT_GT(dielectric_cells, 100);
 }
 
 TEST(TexturedRendering, PathTracerFollowsTheTexture) {

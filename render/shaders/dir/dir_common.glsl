@@ -5,8 +5,8 @@ const float PI = 3.14159265358979;
 struct Vpl {  // vpl_buffer.h: GpuVpl
   vec4 position_material;  // w: material index (bits)
   vec4 normal_flags;       // w: bit 0 r(VPL), bit 1 in_real_virtual, bit 2 in_real, bit 3 emitter (bits)
-  vec4 incident;
-  vec4 flux;
+  vec4 incident;    // w: Vpl::metallic_roughness.y (roughness texel)
+  vec4 flux;        // w: Vpl::metallic_roughness.z (metallic texel)
   vec4 kd_texture;  // Vpl::kd_texture
 };
 

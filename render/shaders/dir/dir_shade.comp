@@ -24,7 +24,9 @@ layout(local_size_x = 8, local_size_y = 8) in;
 struct Material {
   vec4 kd_ks;        // k_d, k_s
   vec4 emission_n;   // emission, Phong exponent n
-  vec4 texture;      // x, y: its base-colour and emission textures' headers in texture_words (bits); 0xffffffff: none
+  vec4 texture;      // x, y, z: its base-colour, emission and metallic-roughness textures' headers in
+                     // texture_words (bits; 0xffffffff: none); w: roughness factor
+  vec4 pbr;          // MetallicRoughness (mr_scene.h): base colour factor, metallic factor
 };
 struct Light {
   vec4 position_kind;      // w: 0 point, 1 spot, 2 directional, 3 directional through its emitter VPL (bits)
@@ -68,6 +70,19 @@ layout(push_constant) uniform Params {
   vec4 virtual_bounds;  // IsmPointPools::virtual_bounds
   vec4 scene_bounds;    // IsmPointPools::scene_bounds
 } params;
+
+// surface_phong() (mr_scene.h): the material's Phong parameters where its metallic-roughness
+// texture reads `mr` (G roughness, B metallic), through phong_from_metallic_roughness().
+Material surface_material(Material m, vec3 mr) {
+  if (floatBitsToUint(m.texture.z) == 0xffffffffu) return m;
+  const float metallic = clamp(m.pbr.w * mr.z, 0.0, 1.0), roughness = clamp(m.texture.w * mr.y, 0.0, 1.0);
+  const vec3 base = m.pbr.xyz;
+  m.kd_ks.xyz = base * (1.0 - metallic);
+  m.kd_ks.w = 0.04 * (1.0 - metallic) + dot(base, vec3(0.2126, 0.7152, 0.0722)) * metallic;
+  const float alpha = max(1e-3, roughness * roughness);
+  m.emission_n.w = clamp(2.0 / (alpha * alpha) - 2.0, 1.0, 10000.0);
+  return m;
+}
 
 // phong_brdf() (core/phong.h, core/shaders/phong.glsl) of a packed material.
 vec3 phong(Material m, vec3 n, vec3 wi, vec3 wo) { return phong_brdf(m.kd_ks.xyz, m.kd_ks.w, m.emission_n.w, n, wi, wo); }
@@ -144,9 +159,10 @@ void main() {
   const vec3 point = position.xyz, n = normal_material.xyz;
   const float real_pixel = position.w > 0.0 ? 1.0 : 0.0;  // r(p)
   const vec3 wo = normalize(params.camera_centre.xyz - point);
-  const Material own = materials[uint(normal_material.w)];
   // texture_factors() (gbuffer.h): the textures at the pixel's coordinates and footprint.
   const vec4 t = gbuffer[2u * pixels + i];
+  const Material material = materials[uint(normal_material.w)];
+  const Material own = surface_material(material, material_texture(floatBitsToUint(material.texture.z), t));
   const vec3 kd_texture = material_texture(floatBitsToUint(own.texture.x), t);
   Material m = own;  // textured: for the direct light
   m.kd_ks.xyz *= kd_texture;
@@ -219,7 +235,9 @@ void main() {
       const vec3 wi = to_vpl / sqrt(d2);
       const float cos_x = dot(wi, n), cos_y = -dot(wi, vpl.normal_flags.xyz);
       if (cos_x <= 0.0 || cos_y <= 0.0) continue;
-      Material mv = materials[floatBitsToUint(vpl.position_material.w)];
+      // vpl_phong() (vpl.h).
+      Material mv = surface_material(materials[floatBitsToUint(vpl.position_material.w)],
+                                     vec3(1.0, vpl.incident.w, vpl.flux.w));
       mv.kd_ks.xyz *= vpl.kd_texture.xyz;
       const vec3 contribution = vpl.flux.xyz * phong(mv, vpl.normal_flags.xyz, vpl.incident.xyz, -wi) *
                                 phong(own, n, wi, wo) * (cos_x * cos_y / max(d2, min_d2));

@@ -1,16 +1,18 @@
-// Base-colour textures in a storage buffer: the GLSL twin of Texture::sample (render/scene/
+// Material textures in a storage buffer: the GLSL twin of Texture::sample (render/scene/
 // texture.h), reading the words pack_textures() (dir_vk.cpp) writes. The includer declares
 //   readonly buffer Textures { uint texture_words[]; };
 // A texture starts at word `header`: levels, wrap u, wrap v, the longer side of level 0, then per
-// level (absolute word index of its first texel, width, height, 0), texels r | g << 8 | b << 16
-// (sRGB-encoded).
+// level (absolute word index of its first texel, width, height, encoding: 0 sRGB, 1 linear),
+// texels r | g << 8 | b << 16.
 
 float srgb_to_linear(uint value) {
   const float c = float(value) / 255.0;
   return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
 }
 
-vec3 texel_linear(uint word) {
+// Texture::decode.
+vec3 texel_linear(uint word, uint encoding) {
+  if (encoding == 1u) return vec3(float(word & 0xffu), float((word >> 8) & 0xffu), float((word >> 16) & 0xffu)) / 255.0;
   return vec3(srgb_to_linear(word & 0xffu), srgb_to_linear((word >> 8) & 0xffu), srgb_to_linear((word >> 16) & 0xffu));
 }
 
@@ -29,6 +31,7 @@ vec3 texture_bilinear(uint header, uint level, vec2 uv) {
   const uint base = header + 4u + 4u * level;
   const uint first = texture_words[base];
   const int w = int(texture_words[base + 1u]), h = int(texture_words[base + 2u]);
+  const uint encoding = texture_words[base + 3u];
   const uint wrap_u = texture_words[header + 1u], wrap_v = texture_words[header + 2u];
   const vec2 xy = uv * vec2(w, h) - 0.5;
   const vec2 corner = floor(xy);
@@ -37,16 +40,16 @@ vec3 texture_bilinear(uint header, uint level, vec2 uv) {
   const int x0 = int(mod(corner.x, 2.0 * float(w) * 1024.0)), y0 = int(mod(corner.y, 2.0 * float(h) * 1024.0));
   const int xa = wrapped_texel(x0, w, wrap_u), xb = wrapped_texel(x0 + 1, w, wrap_u);
   const int ya = wrapped_texel(y0, h, wrap_v), yb = wrapped_texel(y0 + 1, h, wrap_v);
-  const vec3 c00 = texel_linear(texture_words[first + uint(ya * w + xa)]);
-  const vec3 c10 = texel_linear(texture_words[first + uint(ya * w + xb)]);
-  const vec3 c01 = texel_linear(texture_words[first + uint(yb * w + xa)]);
-  const vec3 c11 = texel_linear(texture_words[first + uint(yb * w + xb)]);
+  const vec3 c00 = texel_linear(texture_words[first + uint(ya * w + xa)], encoding);
+  const vec3 c10 = texel_linear(texture_words[first + uint(ya * w + xb)], encoding);
+  const vec3 c01 = texel_linear(texture_words[first + uint(yb * w + xa)], encoding);
+  const vec3 c11 = texel_linear(texture_words[first + uint(yb * w + xb)], encoding);
   return (1.0 - f.y) * ((1.0 - f.x) * c00 + f.x * c10) + f.y * ((1.0 - f.x) * c01 + f.x * c11);
 }
 
 vec3 texture_mean(uint header) {
-  const uint levels = texture_words[header];
-  return texel_linear(texture_words[texture_words[header + 4u + 4u * (levels - 1u)]]);
+  const uint top = header + 4u + 4u * (texture_words[header] - 1u);
+  return texel_linear(texture_words[texture_words[top]], texture_words[top + 3u]);
 }
 
 // Texture::level_of_detail.

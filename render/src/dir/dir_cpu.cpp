@@ -33,10 +33,12 @@ class MapShader {
         first_emitter_(vpls.size() - emitter_count(vpls)),
         options_(options) {}
 
-  /// Direct light with k_d textured by `kd_texture`; the indirect light with the material's own
-  /// k_d, textured after the interleaved merge (merged_pixel), so that the merge's average over
-  /// neighbouring pixels does not blur the texture into it.
-  [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const PhongMaterial& m,
+  /// Direct light with k_d textured by `kd_texture`; the indirect light with the surface's k_d
+  /// before that texture, textured after the interleaved merge (merged_pixel), so that the merge's
+  /// average over neighbouring pixels does not blur the texture into it. `m` is the surface's
+  /// Phong (surface_phong(): its metallic-roughness texture applied; that, k_s and n vary
+  /// slowly enough for the merge, and are not demodulated).
+  [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const Phong& m,
                                const Vec3& kd_texture, const Vec3& emission, float real_pixel,
                                std::uint32_t subset) const {
     Radiance out;
@@ -190,6 +192,7 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
   const MapShader shader(scene, layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
   const RadianceImage kd_texture = texture_factors(gbuffer, scene, MaterialTexture::BaseColor);
   const RadianceImage emission_texture = texture_factors(gbuffer, scene, MaterialTexture::Emission);
+  const RadianceImage metallic_roughness = texture_factors(gbuffer, scene, MaterialTexture::MetallicRoughness);
   const Vec3 environment = scene.environment.radiance;
   const int n = options.interleave;
   Image<Radiance> shaded(width, height);
@@ -207,8 +210,10 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
         const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));
         const Float3 t = kd_texture.empty() ? Float3{1.f, 1.f, 1.f} : kd_texture(y, x);
         const Float3 e = emission_texture.empty() ? Float3{1.f, 1.f, 1.f} : emission_texture(y, x);
+        const Float3 mr = metallic_roughness.empty() ? Float3{1.f, 1.f, 1.f} : metallic_roughness(y, x);
         const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
-        shaded(y, x) = shader.shade(point, normal, (camera_centre - point).normalized(), material, Vec3(t.x, t.y, t.z),
+        shaded(y, x) = shader.shade(point, normal, (camera_centre - point).normalized(),
+                                    surface_phong(material, Vec3(mr.x, mr.y, mr.z)), Vec3(t.x, t.y, t.z),
                                     material.emission.cwiseProduct(Vec3(e.x, e.y, e.z)), real_pixel, subset);
       }
   }, 4);

@@ -49,16 +49,18 @@ using detail::ShadeParams;
 float bits(std::uint32_t value) { return std::bit_cast<float>(value); }
 
 constexpr std::uint32_t kNoTexture = 0xffffffffu;
+/// A material's base-colour, emission and metallic-roughness textures (material_textures).
+constexpr std::size_t kTexturesPerMaterial = 3;
 
 /// The scenes' textures as dir_texture.glsl reads them, and the header words of each material's
-/// base-colour and emission textures (two per material; kNoTexture: none). A texture shared by
+/// textures (kTexturesPerMaterial per material; kNoTexture: none). A texture shared by
 /// several materials (or slots) is packed once.
 struct PackedTextures {
   std::vector<std::uint32_t> words;
   std::vector<std::uint32_t> material_headers;
 };
 
-/// Per material its base-colour and its emission texture (null: none): when a new scene's list
+/// Per material its base-colour, emission and metallic-roughness textures (null: none): when a new scene's list
 /// equals the last one's, the packed textures on the device still hold (scenes are rebuilt every
 /// frame, textures are shared). Held, not just compared: a texture freed and another made at its
 /// address would look unchanged.
@@ -67,6 +69,7 @@ std::vector<std::shared_ptr<const Texture>> material_textures(const MrScene& sce
   for (const PhongMaterial& m : scene.materials) {
     out.push_back(m.base_color);
     out.push_back(m.emission_texture);
+    out.push_back(m.metallic_roughness_texture);
   }
   return out;
 }
@@ -93,7 +96,8 @@ PackedTextures pack_textures(const std::vector<std::shared_ptr<const Texture>>& 
     for (int l = 0; l < texture->levels(); ++l)
       out.words.insert(out.words.end(), {first_texel + static_cast<std::uint32_t>(texture->level_offset(l)),
                                          static_cast<std::uint32_t>(texture->level_width(l)),
-                                         static_cast<std::uint32_t>(texture->level_height(l)), 0u});
+                                         static_cast<std::uint32_t>(texture->level_height(l)),
+                                         static_cast<std::uint32_t>(texture->encoding())});
     out.words.insert(out.words.end(), texture->texels().begin(), texture->texels().end());
     headers.emplace(texture, header);
     out.material_headers.push_back(header);
@@ -105,8 +109,12 @@ std::vector<float> pack_materials(const MrScene& scene, const std::vector<std::u
   std::vector<float> out;
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     const PhongMaterial& m = scene.materials[i];
-    out.insert(out.end(), {m.kd.x(), m.kd.y(), m.kd.z(), m.ks, m.emission.x(), m.emission.y(), m.emission.z(), m.n,
-                           bits(texture_headers[2 * i]), bits(texture_headers[2 * i + 1]), 0.f, 0.f});
+    const MetallicRoughness& pbr = m.metallic_roughness;
+    out.insert(out.end(),
+               {m.kd.x(), m.kd.y(), m.kd.z(), m.ks, m.emission.x(), m.emission.y(), m.emission.z(), m.n,
+                bits(texture_headers[kTexturesPerMaterial * i]), bits(texture_headers[kTexturesPerMaterial * i + 1]),
+                bits(texture_headers[kTexturesPerMaterial * i + 2]), pbr.roughness, pbr.base_color.x(),
+                pbr.base_color.y(), pbr.base_color.z(), pbr.metallic});
   }
   return out;
 }
@@ -150,8 +158,8 @@ std::vector<float> pack_vpls(std::span<const Vpl> vpls) {
         (v.on_real_surface ? 1u : 0u) | (v.in_real_virtual ? 2u : 0u) | (v.in_real ? 4u : 0u) | (v.emitter() ? 8u : 0u);
     out.insert(out.end(), {v.position.x(),   v.position.y(),   v.position.z(),   bits(v.material),
                            v.normal.x(),     v.normal.y(),     v.normal.z(),     bits(flags),
-                           v.incident.x(),   v.incident.y(),   v.incident.z(),   0.f,
-                           v.flux.x(),       v.flux.y(),       v.flux.z(),       0.f,
+                           v.incident.x(),   v.incident.y(),   v.incident.z(),   v.metallic_roughness.y(),
+                           v.flux.x(),       v.flux.y(),       v.flux.z(),       v.metallic_roughness.z(),
                            v.kd_texture.x(), v.kd_texture.y(), v.kd_texture.z(), 0.f});
   }
   return out;
@@ -206,7 +214,7 @@ struct DirRendererVk::Impl {
   vk::UniqueDescriptorSet merge_set;
   std::unique_ptr<vk::VulkanBuffer> materials, lights, views, vpls, textures;
   std::vector<std::shared_ptr<const Texture>> uploaded_textures;  // per material, of the packed `textures`
-  std::vector<std::uint32_t> texture_headers;                     // two per material
+  std::vector<std::uint32_t> texture_headers;                     // kTexturesPerMaterial per material
   vk::UniqueDescriptorSet shade_set;
   std::array<vk::GpuTimer, 6> timers;
   std::optional<MrScene> scene;

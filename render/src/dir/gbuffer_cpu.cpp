@@ -20,13 +20,19 @@ float texcoord_step(const SurfaceHit& hit, const Eigen::Vector3f& origin, const 
 }  // namespace
 
 bool has_textures(const MrScene& scene) {
-  return std::any_of(scene.materials.begin(), scene.materials.end(),
-                     [](const PhongMaterial& m) { return m.base_color != nullptr || m.emission_texture != nullptr; });
+  return std::any_of(scene.materials.begin(), scene.materials.end(), [](const PhongMaterial& m) {
+    return m.base_color != nullptr || m.emission_texture != nullptr || m.metallic_roughness_texture != nullptr;
+  });
 }
 
 RadianceImage texture_factors(const GBuffer& gbuffer, const MrScene& scene, MaterialTexture which) {
   const auto texture_of = [which](const PhongMaterial& m) {
-    return which == MaterialTexture::BaseColor ? m.base_color.get() : m.emission_texture.get();
+    switch (which) {
+      case MaterialTexture::BaseColor: return m.base_color.get();
+      case MaterialTexture::Emission: return m.emission_texture.get();
+      case MaterialTexture::MetallicRoughness: break;
+    }
+    return m.metallic_roughness_texture.get();
   };
   if (gbuffer.texcoord.empty() || std::none_of(scene.materials.begin(), scene.materials.end(),
                                                [&](const PhongMaterial& m) { return texture_of(m); }))

@@ -117,8 +117,14 @@ Eigen::Vector3f emission_at(const MrScene& scene, const SurfaceHit& hit) {
       texture_at(material.emission_texture.get(), hit.has_texcoord ? &hit.texcoord : nullptr));
 }
 
+Eigen::Vector3f metallic_roughness_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
+  return texture_at(scene.materials[hit.material].metallic_roughness_texture.get(),
+                    hit.has_texcoord ? &hit.texcoord : nullptr, lod);
+}
+
 Phong phong_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
-  return with_kd_factor(scene.materials[hit.material], base_color_at(scene, hit, lod));
+  return with_kd_factor(surface_phong(scene.materials[hit.material], metallic_roughness_at(scene, hit, lod)),
+                        base_color_at(scene, hit, lod));
 }
 
 struct RayTracer::Impl {

@@ -3,6 +3,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -10,6 +11,7 @@
 #include <optional>
 #include <span>
 #include <sstream>
+#include <tuple>
 
 #include "relight/core/atomic_file.h"
 #include "relight/core/error.h"
@@ -46,13 +48,9 @@ PhongMaterial from_gltf(const tinygltf::Material& m) {
   if (const auto phong = phong_extras(m)) {
     out = *phong;
   } else {
-    const auto metallic = static_cast<float>(std::clamp(pbr.metallicFactor, 0.0, 1.0));
-    const auto roughness = static_cast<float>(std::clamp(pbr.roughnessFactor, 0.0, 1.0));
+    out.metallic_roughness = {base, static_cast<float>(pbr.metallicFactor), static_cast<float>(pbr.roughnessFactor)};
+    static_cast<Phong&>(out) = phong_from_metallic_roughness(out.metallic_roughness);
     out.name = m.name;
-    out.kd = base * (1.f - metallic);
-    out.ks = 0.04f * (1.f - metallic) + (0.2126f * base.x() + 0.7152f * base.y() + 0.0722f * base.z()) * metallic;
-    const float alpha = std::max(1e-3f, roughness * roughness);
-    out.n = std::clamp(2.f / (alpha * alpha) - 2.f, 1.f, 10000.f);
   }
   float strength = 1.f;
   if (const auto found = m.extensions.find("KHR_materials_emissive_strength"); found != m.extensions.end())
@@ -248,14 +246,19 @@ class GltfMeshCollector {
     if (material < 0 || static_cast<std::size_t>(material) >= gltf_.materials.size()) return std::nullopt;
     const PhongMaterial& ours = out_.materials[static_cast<std::size_t>(material)];
     const tinygltf::Material& theirs = gltf_.materials[static_cast<std::size_t>(material)];
-    const int base = theirs.pbrMetallicRoughness.baseColorTexture.texCoord, emissive = theirs.emissiveTexture.texCoord;
-    if (ours.base_color && ours.emission_texture && base != emissive)
-      throw Error(file_ + ": mesh '" + mesh +
-                  "': the material's base-colour and emissive textures use different TEXCOORD sets (" +
-                  std::to_string(base) + ", " + std::to_string(emissive) + "); relight reads one");
-    if (ours.base_color) return base;
-    if (ours.emission_texture) return emissive;
-    return std::nullopt;
+    const std::array<std::pair<bool, int>, 3> sets{
+        {{ours.base_color != nullptr, theirs.pbrMetallicRoughness.baseColorTexture.texCoord},
+         {ours.emission_texture != nullptr, theirs.emissiveTexture.texCoord},
+         {ours.metallic_roughness_texture != nullptr, theirs.pbrMetallicRoughness.metallicRoughnessTexture.texCoord}}};
+    std::optional<int> out;
+    for (const auto& [used, set] : sets) {
+      if (!used) continue;
+      if (out && *out != set)
+        throw Error(file_ + ": mesh '" + mesh + "': the material's textures use different TEXCOORD sets (" +
+                    std::to_string(*out) + ", " + std::to_string(set) + "); relight reads one");
+      out = set;
+    }
+    return out;
   }
 
   const tinygltf::Model& gltf_;
@@ -303,15 +306,16 @@ TextureWrap wrap_of(int gl_wrap) {
   }
 }
 
-/// The base-colour textures of a model's materials, each (image, sampler) decoded once.
+/// The textures of a model's materials, each (image, sampler, encoding) decoded once.
 class GltfTextures {
  public:
   GltfTextures(const tinygltf::Model& gltf, const EncodedImages& images, std::string file)
       : gltf_(gltf), images_(images), file_(std::move(file)) {}
 
-  /// The texture a material refers to with `index` (its base colour's or its emission's), or
-  /// null for -1.
-  std::shared_ptr<const Texture> texture(const tinygltf::Material& material, int index) {
+  /// The texture a material refers to with `index` (its base colour's, emission's or
+  /// metallic-roughness's, whose texels are `encoding`), or null for -1.
+  std::shared_ptr<const Texture> texture(const tinygltf::Material& material, int index,
+                                         TextureEncoding encoding = TextureEncoding::Srgb) {
     if (index < 0) return nullptr;
     if (static_cast<std::size_t>(index) >= gltf_.textures.size())
       fail("material '" + material.name + "' uses texture " + std::to_string(index) + ", but the file has " +
@@ -321,7 +325,7 @@ class GltfTextures {
       fail("texture " + std::to_string(index) + " has no image");
     if (texture.sampler >= 0 && static_cast<std::size_t>(texture.sampler) >= gltf_.samplers.size())
       fail("texture " + std::to_string(index) + " uses a missing sampler");
-    const std::pair key{texture.source, texture.sampler};
+    const std::tuple key{texture.source, texture.sampler, encoding};
     if (const auto found = decoded_.find(key); found != decoded_.end()) return found->second;
     const tinygltf::Image& image = gltf_.images[static_cast<std::size_t>(texture.source)];
     const std::string what = file_ + ": image " + std::to_string(texture.source) +
@@ -338,7 +342,7 @@ class GltfTextures {
       wrap_v = wrap_of(sampler.wrapT);
     }
     auto out = std::make_shared<const Texture>(
-        image.name.empty() ? "image " + std::to_string(texture.source) : image.name, decoded, wrap_u, wrap_v);
+        image.name.empty() ? "image " + std::to_string(texture.source) : image.name, decoded, wrap_u, wrap_v, encoding);
     decoded_.emplace(key, out);
     return out;
   }
@@ -367,7 +371,7 @@ class GltfTextures {
   const tinygltf::Model& gltf_;
   const EncodedImages& images_;
   std::string file_;
-  std::map<std::pair<int, int>, std::shared_ptr<const Texture>> decoded_;
+  std::map<std::tuple<int, int, TextureEncoding>, std::shared_ptr<const Texture>> decoded_;
   std::size_t texels_ = 0;  // decoded so far
 };
 
@@ -403,6 +407,11 @@ VirtualModel load_gltf(const std::filesystem::path& path) {
     model.materials.push_back(from_gltf(m));
     model.materials.back().base_color = textures.texture(m, m.pbrMetallicRoughness.baseColorTexture.index);
     model.materials.back().emission_texture = textures.texture(m, m.emissiveTexture.index);
+    // relight's own Phong parameters (extras) are taken as they are, without the metallic-
+    // roughness mapping the texture would feed.
+    if (!phong_extras(m))
+      model.materials.back().metallic_roughness_texture =
+          textures.texture(m, m.pbrMetallicRoughness.metallicRoughnessTexture.index, TextureEncoding::Linear);
   }
   const auto default_material = static_cast<std::uint32_t>(model.materials.size());
   model.materials.push_back(PhongMaterial{{{0.8f, 0.8f, 0.8f}, 0.f, 1.f}, "default", {0.f, 0.f, 0.f}});

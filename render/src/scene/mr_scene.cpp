@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -31,6 +32,26 @@ Phong with_kd_factor(const Phong& material, const Eigen::Vector3f& factor) {
   Phong out = material;
   out.kd = out.kd.cwiseProduct(factor);
   return out;
+}
+
+Phong phong_from_metallic_roughness(const MetallicRoughness& parameters) {
+  const float metallic = std::clamp(parameters.metallic, 0.f, 1.f);
+  const float roughness = std::clamp(parameters.roughness, 0.f, 1.f);
+  const Eigen::Vector3f& base = parameters.base_color;
+  Phong out;
+  out.kd = base * (1.f - metallic);
+  out.ks = 0.04f * (1.f - metallic) + (0.2126f * base.x() + 0.7152f * base.y() + 0.0722f * base.z()) * metallic;
+  const float alpha = std::max(1e-3f, roughness * roughness);
+  out.n = std::clamp(2.f / (alpha * alpha) - 2.f, 1.f, 10000.f);
+  return out;
+}
+
+Phong surface_phong(const PhongMaterial& material, const Eigen::Vector3f& metallic_roughness_texel) {
+  if (!material.metallic_roughness_texture) return material;
+  MetallicRoughness at = material.metallic_roughness;
+  at.roughness *= metallic_roughness_texel.y();
+  at.metallic *= metallic_roughness_texel.z();
+  return phong_from_metallic_roughness(at);
 }
 
 std::uint32_t MrScene::add_material(PhongMaterial material) {

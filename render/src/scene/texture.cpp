@@ -21,14 +21,8 @@ const std::array<float, 256>& srgb_table() {
   return table;
 }
 
-std::uint32_t pack(const Eigen::Vector3f& linear) {
-  return std::uint32_t(linear_to_srgb(linear.x())) | (std::uint32_t(linear_to_srgb(linear.y())) << 8) |
-         (std::uint32_t(linear_to_srgb(linear.z())) << 16);
-}
-
-Eigen::Vector3f unpack(std::uint32_t texel) {
-  const auto& table = srgb_table();
-  return {table[texel & 0xffu], table[(texel >> 8) & 0xffu], table[(texel >> 16) & 0xffu]};
+std::uint8_t to_byte(float value) {
+  return static_cast<std::uint8_t>(std::lround(255.f * std::clamp(value, 0.f, 1.f)));
 }
 
 /// Texel index along an axis of `size` texels for the integer coordinate `i` (any sign).
@@ -55,14 +49,15 @@ std::uint8_t linear_to_srgb(float linear) {
   return static_cast<std::uint8_t>(std::lround(255.f * encoded));
 }
 
-Texture::Texture(std::string name, const ColorImage& srgb, TextureWrap wrap_u, TextureWrap wrap_v)
-    : name_(std::move(name)), wrap_u_(wrap_u), wrap_v_(wrap_v) {
-  if (srgb.width() <= 0 || srgb.height() <= 0) throw Error("texture " + name_ + " is empty");
-  widths_.push_back(srgb.width());
-  heights_.push_back(srgb.height());
+Texture::Texture(std::string name, const ColorImage& texels, TextureWrap wrap_u, TextureWrap wrap_v,
+                 TextureEncoding encoding)
+    : name_(std::move(name)), wrap_u_(wrap_u), wrap_v_(wrap_v), encoding_(encoding) {
+  if (texels.width() <= 0 || texels.height() <= 0) throw Error("texture " + name_ + " is empty");
+  widths_.push_back(texels.width());
+  heights_.push_back(texels.height());
   offsets_.push_back(0);
-  texels_.reserve(srgb.size() * 4 / 3 + 1);
-  for (const Rgb8& p : srgb.pixels())
+  texels_.reserve(texels.size() * 4 / 3 + 1);
+  for (const Rgb8& p : texels.pixels())
     texels_.push_back(std::uint32_t(p.r) | (std::uint32_t(p.g) << 8) | (std::uint32_t(p.b) << 16));
   // Each level halves (rounding down, at least 1) and averages the 2x2 texels above in linear
   // RGB; an odd row or column of the level above is folded into its last texel's neighbour.
@@ -78,9 +73,9 @@ Texture::Texture(std::string name, const ColorImage& srgb, TextureWrap wrap_u, T
         Eigen::Vector3f sum = Eigen::Vector3f::Zero();
         for (int v = 2 * y; v < y1; ++v)
           for (int u = 2 * x; u < x1; ++u)
-            sum += unpack(texels_[above + static_cast<std::size_t>(v) * static_cast<std::size_t>(above_w) +
+            sum += decode(texels_[above + static_cast<std::size_t>(v) * static_cast<std::size_t>(above_w) +
                                   static_cast<std::size_t>(u)]);
-        texels_.push_back(pack(sum / static_cast<float>((x1 - 2 * x) * (y1 - 2 * y))));
+        texels_.push_back(encode(sum / static_cast<float>((x1 - 2 * x) * (y1 - 2 * y))));
       }
     widths_.push_back(w);
     heights_.push_back(h);
@@ -97,7 +92,7 @@ Eigen::Vector3f Texture::bilinear(int level, float u, float v) const {
   const auto y0 = static_cast<int>(std::fmod(fy0, 2.f * static_cast<float>(h) * 1024.f));
   const std::uint32_t* base = texels_.data() + level_offset(level);
   const auto at = [&](int i, int j) {
-    return unpack(base[static_cast<std::size_t>(wrapped(j, h, wrap_v_)) * static_cast<std::size_t>(w) +
+    return decode(base[static_cast<std::size_t>(wrapped(j, h, wrap_v_)) * static_cast<std::size_t>(w) +
                        static_cast<std::size_t>(wrapped(i, w, wrap_u_))]);
   };
   return (1.f - fy) * ((1.f - fx) * at(x0, y0) + fx * at(x0 + 1, y0)) +
@@ -114,7 +109,24 @@ Eigen::Vector3f Texture::sample(float u, float v, float lod) const {
   return (1.f - f) * near + f * bilinear(l0 + 1, u, v);
 }
 
-Eigen::Vector3f Texture::mean() const { return unpack(texels_.back()); }
+Eigen::Vector3f Texture::mean() const { return decode(texels_.back()); }
+
+Eigen::Vector3f Texture::decode(std::uint32_t texel) const {
+  if (encoding_ == TextureEncoding::Linear)
+    return Eigen::Vector3f(static_cast<float>(texel & 0xffu), static_cast<float>((texel >> 8) & 0xffu),
+                           static_cast<float>((texel >> 16) & 0xffu)) /
+           255.f;
+  const auto& table = srgb_table();
+  return {table[texel & 0xffu], table[(texel >> 8) & 0xffu], table[(texel >> 16) & 0xffu]};
+}
+
+std::uint32_t Texture::encode(const Eigen::Vector3f& value) const {
+  if (encoding_ == TextureEncoding::Linear)
+    return std::uint32_t(to_byte(value.x())) | (std::uint32_t(to_byte(value.y())) << 8) |
+           (std::uint32_t(to_byte(value.z())) << 16);
+  return std::uint32_t(linear_to_srgb(value.x())) | (std::uint32_t(linear_to_srgb(value.y())) << 8) |
+         (std::uint32_t(linear_to_srgb(value.z())) << 16);
+}
 
 float Texture::level_of_detail(float footprint) const {
   const float texels = footprint * static_cast<float>(std::max(width(), height()));

@@ -145,6 +145,7 @@ class VplTracer {
     vpl.flux = flux;
     vpl.material = hit.material;
     vpl.kd_texture = base_color_at(scene_, hit);
+    vpl.metallic_roughness = metallic_roughness_at(scene_, hit);
     vpl.on_real_surface = hit.real;
     vpl.in_real_virtual = in_real_virtual;
     vpl.in_real = in_real;

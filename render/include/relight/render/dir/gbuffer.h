@@ -28,8 +28,9 @@ struct GBuffer {
 /// Whether any material of `scene` has a texture (then G-buffers carry texcoord).
 [[nodiscard]] bool has_textures(const MrScene& scene);
 
-enum class MaterialTexture { BaseColor, Emission };
-/// The factor a material texture gives k_d (BaseColor) or the emission at each pixel of
+enum class MaterialTexture { BaseColor, Emission, MetallicRoughness };
+/// The factor a material texture gives k_d (BaseColor) or the emission, or the metallic-
+/// roughness texel surface_phong() reads (MetallicRoughness), at each pixel of
 /// `gbuffer` (Texture::sample at the pixel's coordinates and footprint; the texture's mean on a
 /// textured material without coordinates there); 1 elsewhere. Empty when `gbuffer` carries no
 /// texture coordinates or no material has such a texture.

@@ -34,7 +34,10 @@ struct SurfaceHit {
 [[nodiscard]] Eigen::Vector3f base_color_at(const MrScene& scene, const SurfaceHit& hit, float lod = 0.f);
 /// The radiance a hit's material emits there (its emission times its emission texture).
 [[nodiscard]] Eigen::Vector3f emission_at(const MrScene& scene, const SurfaceHit& hit);
-/// The Phong parameters at a hit: the material's with k_d times base_color_at().
+/// Its material's metallic-roughness texture at a hit (texture_at(); 1 without one).
+[[nodiscard]] Eigen::Vector3f metallic_roughness_at(const MrScene& scene, const SurfaceHit& hit, float lod = 0.f);
+/// The Phong parameters at a hit: surface_phong() with metallic_roughness_at(), k_d times
+/// base_color_at().
 [[nodiscard]] Phong phong_at(const MrScene& scene, const SurfaceHit& hit, float lod = 0.f);
 
 class RayTracer {

@@ -6,19 +6,22 @@
 // - MTL: k_d = Kd, k_s = mean of Ks (highlights are white), n = Ns, emission = Ke.
 // - glTF: a material's extras {"relight_phong": {"kd": [r, g, b], "ks": s, "n": n}} are taken
 //   as they are (relight writes them, so its own models round-trip exactly). Otherwise the
-//   metallic-roughness parameters are mapped: k_d = baseColor (1 - metallic),
-//   k_s = 0.04 (1 - metallic) + luminance(baseColor) metallic, and the Phong exponent that
-//   matches a Beckmann lobe of slope alpha = roughness^2, n = 2 / alpha^2 - 2 (Walter et al.
-//   2007), clamped to [1, 10000]; emission = emissiveFactor times KHR_materials_emissive_strength.
-// glTF base-colour and emissive textures (PNG or JPEG; a data URI, a GLB buffer view or a file
-// beside the model) become the material's Textures (texture.h) with their samplers' wrap modes,
-// and the primitive's TEXCOORD_n (float, or normalised unsigned byte/short; one set per
-// material, so the two textures must share it) its mesh's texcoords; only
+//   metallic-roughness parameters are mapped by phong_from_metallic_roughness() (mr_scene.h):
+//   k_d = baseColor (1 - metallic), k_s = 0.04 (1 - metallic) + luminance(baseColor) metallic,
+//   and the Phong exponent that matches a Beckmann lobe of slope alpha = roughness^2,
+//   n = 2 / alpha^2 - 2 (Walter et al. 2007), clamped to [1, 10000]; emission = emissiveFactor
+//   times KHR_materials_emissive_strength.
+// glTF base-colour, emissive and metallic-roughness textures (PNG or JPEG; a data URI, a GLB
+// buffer view or a file beside the model) become the material's Textures (texture.h) with their
+// samplers' wrap modes, and the primitive's TEXCOORD_n (float, or normalised unsigned byte/short;
+// one set per material, so its textures must share it) its mesh's texcoords; only
 // the images a material uses are decoded, each checked against 8192 px a side from its header
 // before decoding (and all of a model's together against 8192^2 texels). The base colour
-// multiplies k_d only, so a fully metallic material (k_d = 0) shows no texture and k_s keeps the
-// factor's luminance; the emissive texture multiplies the emission. Other textures (normal,
-// metallic-roughness, occlusion), MTL texture maps, KHR_texture_transform and the base colour's
+// multiplies k_d only, so a fully metallic point (k_d = 0) shows no base texture and k_s keeps the
+// factor's luminance; the emissive texture multiplies the emission; the metallic-roughness
+// texture (linear data: G roughness, B metallic) multiplies the factors and feeds the mapping
+// above at each point (surface_phong(); not on materials with relight's own extras). Other
+// textures (normal, occlusion), MTL texture maps, KHR_texture_transform and the base colour's
 // alpha are ignored. Meshes keep the file's axes (y-up, see virtual_model.h); glTF node
 // transforms are applied. save_gltf writes no textures.
 #include <filesystem>

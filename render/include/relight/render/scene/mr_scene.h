@@ -21,17 +21,37 @@
 
 namespace relight::render {
 
+/// glTF 2.0's metallic-roughness parameters and relight's mapping of them to Phong (model_io.h):
+/// k_d = base (1 - metallic), k_s = 0.04 (1 - metallic) + luminance(base) metallic, and the
+/// Phong exponent of a Beckmann lobe of slope alpha = roughness^2, n = 2 / alpha^2 - 2 (Walter
+/// et al. 2007), clamped to [1, 10000].
+struct MetallicRoughness {
+  Eigen::Vector3f base_color{1.f, 1.f, 1.f};
+  float metallic = 1.f;
+  float roughness = 1.f;
+};
+[[nodiscard]] Phong phong_from_metallic_roughness(const MetallicRoughness& parameters);
+
 /// A material of the scene: relight's Phong model (core/phong.h; sampled in phong_brdf.h), a name,
-/// an emitted radiance (a virtual light source shaped like its mesh) and, optionally, a base-colour
-/// texture that multiplies k_d and an emission texture that multiplies the emission, per channel
-/// at each surface point (texture.h; the triangles need texture coordinates). Textures are
-/// shared: scenes are copied every frame, texels are not.
+/// an emitted radiance (a virtual light source shaped like its mesh) and, optionally, textures
+/// read at each surface point (texture.h; the triangles need texture coordinates): a base colour
+/// that multiplies k_d and an emission texture that multiplies the emission, per channel, and a
+/// metallic-roughness texture (glTF's: G roughness, B metallic, linear) whose values multiply
+/// `metallic_roughness`'s factors and give k_d (before the base colour), k_s and n through the
+/// mapping above. Textures are shared: scenes are copied every frame, texels are not.
 struct PhongMaterial : Phong {
   std::string name;
   Eigen::Vector3f emission{0.f, 0.f, 0.f};
   std::shared_ptr<const Texture> base_color{};
   std::shared_ptr<const Texture> emission_texture{};
+  std::shared_ptr<const Texture> metallic_roughness_texture{};
+  MetallicRoughness metallic_roughness{};  ///< the factors; read only with metallic_roughness_texture
 };
+
+/// `material`'s Phong parameters at a point where its metallic-roughness texture reads
+/// `metallic_roughness_texel` (texture_at()), before the base-colour texture; the material's
+/// own without that texture.
+[[nodiscard]] Phong surface_phong(const PhongMaterial& material, const Eigen::Vector3f& metallic_roughness_texel);
 
 /// A texture's colour at a point with coordinates `uv` (mip level `lod`), or its mean where the
 /// point has none; 1 without a texture.

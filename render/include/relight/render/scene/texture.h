@@ -1,9 +1,11 @@
 #pragma once
-// A texture of a virtual object's material (glTF 2.0 `baseColorTexture`, `emissiveTexture`): the
-// factor its material's k_d (or emission) is multiplied by at a surface point, per channel, from
-// the point's texture coordinates.
+// A texture of a virtual object's material (glTF 2.0 `baseColorTexture`, `emissiveTexture`,
+// `metallicRoughnessTexture`): the factor its material's k_d (or emission) is multiplied by at a
+// surface point, per channel, from the point's texture coordinates, or (metallic-roughness) the
+// per-point parameters of the material's mapping to Phong (mr_scene.h).
 //
-// Texels are kept as the file has them, 8-bit sRGB (glTF's base colour is sRGB-encoded), with a
+// Texels are kept as the file has them, 8 bits per channel: sRGB-encoded (glTF's base colour and
+// emission) or linear (glTF's metallic-roughness data, TextureEncoding::Linear), with a
 // mip chain made in linear RGB (each level a 2x2 box filter of the one above, re-encoded), so
 // that the CPU renderers and the Vulkan shading sample the same packed words (dir_texture.glsl
 // is this file's GLSL twin). A sample is trilinear: bilinear within the two levels around `lod`,
@@ -25,6 +27,8 @@
 namespace relight::render {
 
 enum class TextureWrap : std::uint32_t { Repeat = 0, ClampToEdge = 1, MirroredRepeat = 2 };
+/// How a texel's 8-bit values map to [0, 1]: the sRGB curve (colours) or value / 255 (data).
+enum class TextureEncoding : std::uint32_t { Srgb = 0, Linear = 1 };
 
 /// sRGB-encoded 8-bit value -> linear, the exact IEC 61966-2-1 curve.
 [[nodiscard]] float srgb_to_linear(std::uint8_t value);
@@ -32,10 +36,10 @@ enum class TextureWrap : std::uint32_t { Repeat = 0, ClampToEdge = 1, MirroredRe
 
 class Texture {
  public:
-  /// Builds the mip chain from sRGB-encoded RGB texels; throws relight::Error when the image is
-  /// empty.
-  Texture(std::string name, const ColorImage& srgb, TextureWrap wrap_u = TextureWrap::Repeat,
-          TextureWrap wrap_v = TextureWrap::Repeat);
+  /// Builds the mip chain from RGB texels encoded as `encoding` says; throws relight::Error when
+  /// the image is empty.
+  Texture(std::string name, const ColorImage& texels, TextureWrap wrap_u = TextureWrap::Repeat,
+          TextureWrap wrap_v = TextureWrap::Repeat, TextureEncoding encoding = TextureEncoding::Srgb);
 
   /// Linear RGB at texture coordinates (u, v) (glTF's: (0, 0) is the image's top-left corner)
   /// and mip level `lod` (clamped to the chain).
@@ -55,19 +59,23 @@ class Texture {
   [[nodiscard]] int level_height(int level) const { return heights_[static_cast<std::size_t>(level)]; }
   /// Index of level `level`'s first texel in texels().
   [[nodiscard]] std::size_t level_offset(int level) const { return offsets_[static_cast<std::size_t>(level)]; }
-  /// Every level's texels, row by row, as r | g << 8 | b << 16 (sRGB-encoded).
+  /// Every level's texels, row by row, as r | g << 8 | b << 16 (encoded as encoding() says).
   [[nodiscard]] std::span<const std::uint32_t> texels() const { return texels_; }
   [[nodiscard]] TextureWrap wrap_u() const { return wrap_u_; }
   [[nodiscard]] TextureWrap wrap_v() const { return wrap_v_; }
+  [[nodiscard]] TextureEncoding encoding() const { return encoding_; }
 
  private:
   [[nodiscard]] Eigen::Vector3f bilinear(int level, float u, float v) const;
+  [[nodiscard]] Eigen::Vector3f decode(std::uint32_t texel) const;
+  [[nodiscard]] std::uint32_t encode(const Eigen::Vector3f& value) const;
 
   std::string name_;
   std::vector<std::uint32_t> texels_;
   std::vector<int> widths_, heights_;
   std::vector<std::size_t> offsets_;
   TextureWrap wrap_u_, wrap_v_;
+  TextureEncoding encoding_;
 };
 
 }  // namespace relight::render

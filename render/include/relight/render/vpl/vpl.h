@@ -73,6 +73,8 @@ struct Vpl {
   std::uint32_t material = 0;
   /// The factor of the material's k_d from its base-colour texture at the VPL (1: untextured).
   Eigen::Vector3f kd_texture = Eigen::Vector3f::Ones();
+  /// The material's metallic-roughness texture at the VPL (surface_phong(); 1: none).
+  Eigen::Vector3f metallic_roughness = Eigen::Vector3f::Ones();
   bool on_real_surface = true;  ///< r(VPL)
   bool in_real_virtual = true;
   bool in_real = true;
@@ -84,9 +86,9 @@ struct Vpl {
   [[nodiscard]] bool emitter() const { return bounce == 0; }
 };
 
-/// The Phong parameters of the surface a VPL lies on (its material, k_d textured at the VPL).
+/// The Phong parameters of the surface a VPL lies on (its material, textured at the VPL).
 [[nodiscard]] inline Phong vpl_phong(const MrScene& scene, const Vpl& vpl) {
-  return with_kd_factor(scene.materials[vpl.material], vpl.kd_texture);
+  return with_kd_factor(surface_phong(scene.materials[vpl.material], vpl.metallic_roughness), vpl.kd_texture);
 }
 
 /// How far out along its light an emitter VPL sits, in radii of the scene's bounding sphere.
