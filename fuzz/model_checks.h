@@ -24,7 +24,8 @@ inline void check_loaded_model(const render::VirtualModel& model) {
       if (m >= model.materials.size()) std::abort();
   }
   for (const render::PhongMaterial& m : model.materials)
-    for (const render::Texture* t : {m.base_color.get(), m.emission_texture.get(), m.metallic_roughness_texture.get()})
+    for (const render::Texture* t :
+         {m.base_color.get(), m.emission_texture.get(), m.metallic_roughness_texture.get(), m.normal_texture.get()})
       if (t && (!t->sample(0.3f, 0.7f, 1.5f).allFinite() || !t->mean().allFinite())) std::abort();
   render::MrScene scene;
   render::add_virtual_model(scene, model, render::Placement{});

@@ -214,8 +214,13 @@ TEST_F(DirVkTest, TexturedShadingMatchesTheCpuMirror) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   MrScene scene = cube_scene();
   test::texture_virtual_meshes(scene);
+  // With a KHR_texture_transform (rotated, stretched, shifted): the GPU applies it as the CPU.
+  const auto transformed = std::make_shared<const Texture>(
+      "checker", test::checkerboard(32, 8, Rgb8{230, 40, 30}, Rgb8{240, 240, 240}), TextureWrap::Repeat,
+      TextureWrap::Repeat, TextureEncoding::Srgb, UvTransform::gltf({0.3f, -0.2f}, 0.5f, {0.9f, 0.7f}));
   for (PhongMaterial& m : scene.materials)
     if (m.base_color) {
+      m.base_color = transformed;
       m.kd = Eigen::Vector3f::Constant(0.8f);         // the colours come from the texture alone
       m.emission = Eigen::Vector3f::Constant(0.02f);  // and a faint glow through the same texture
       m.emission_texture = m.base_color;
@@ -254,6 +259,36 @@ TEST_F(DirVkTest, MetallicRoughnessShadingMatchesTheCpuMirror) {
       m.metallic_roughness_texture = mr;
     }
   expect_shading_matches_cpu(context, scene);
+}
+
+// A normal map (cells tilted 30 degrees towards T and towards B) on the textured cube: the GPU
+// G-buffer's tangent frames from screen derivatives and the shading's bent normals match the CPU
+// mirror reading the same G-buffer; and the bend shows (the cube shades unlike its flat self).
+TEST_F(DirVkTest, NormalMappedShadingMatchesTheCpuMirror) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  MrScene scene = cube_scene();
+  test::texture_virtual_meshes(scene);
+  const MrScene flat = scene;
+  const auto normals =
+      std::make_shared<const Texture>("normals", test::checkerboard(16, 4, Rgb8{192, 128, 239}, Rgb8{128, 64, 239}),
+                                      TextureWrap::Repeat, TextureWrap::Repeat, TextureEncoding::Linear);
+  for (PhongMaterial& m : scene.materials)
+    if (m.base_color) m.normal_texture = normals;
+  expect_shading_matches_cpu(context, scene);
+  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 64, 48);
+  DirRendererVk renderer(context, 64, 48);
+  renderer.set_scene(flat, test_options());
+  const DifferentialImages before = renderer.render(camera, make_vpls(flat, 64), test_options());
+  renderer.set_scene(scene, test_options());
+  const DifferentialImages after = renderer.render(camera, make_vpls(scene, 64), test_options());
+  int changed = 0, virtual_pixels = 0;
+  for (std::size_t i = 0; i < after.real_virtual.size(); ++i) {
+    if (after.virtual_coverage.pixels()[i] < 0.5f) continue;
+    ++virtual_pixels;
+    const float a = luminance(after.real_virtual.pixels()[i]), b = luminance(before.real_virtual.pixels()[i]);
+    if (std::abs(a - b) > 0.05f * std::max(a, b)) ++changed;
+  }
+  EXPECT_GT(changed, virtual_pixels / 3) << "of " << virtual_pixels << " cube pixels";
 }
 
 // An emitter VPL's tiles look at the scene from far away (ism.h) and it shades like a

@@ -4,10 +4,11 @@
 
 #include <gtest/gtest.h>
 
-#include "support/vulkan_test_env.h"
 #include "relight/core/error.h"
+#include "relight/render/scene/normal_map.h"
 #include "relight/synth/trajectory.h"
 #include "relight/vk/context.h"
+#include "support/vulkan_test_env.h"
 #include "test_scenes.h"
 
 namespace relight::render {
@@ -50,8 +51,8 @@ TEST_F(GBufferVkTest, MatchesTheRayCastGBuffer) {
   }
 }
 
-// Texture coordinates and footprints: the rasteriser's interpolation and screen derivatives
-// against the ray tracer's barycentrics and ray differentials.
+// Texture coordinates, footprints and tangent frames: the rasteriser's interpolation and screen
+// derivatives against the ray tracer's barycentrics, ray differentials and gradients.
 TEST_F(GBufferVkTest, TextureCoordinatesMatchTheRayDifferentials) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   MrScene scene = test::indoor_with_pebble();
@@ -62,7 +63,7 @@ TEST_F(GBufferVkTest, TextureCoordinatesMatchTheRayDifferentials) {
   const GBuffer gpu = renderer.render(camera);
   const GBuffer cpu = gbuffer_cpu(RayTracer(scene), camera);
   ASSERT_FALSE(cpu.texcoord.empty());
-  int compared = 0, close_footprint = 0;
+  int compared = 0, close_footprint = 0, close_frame = 0;
   for (int row = 1; row < 119; ++row)
     for (int col = 1; col < 159; ++col) {
       if (!cpu.virtual_surface(row, col) || !gpu.virtual_surface(row, col)) continue;
@@ -74,9 +75,15 @@ TEST_F(GBufferVkTest, TextureCoordinatesMatchTheRayDifferentials) {
       // dFdx differences within a 2x2 quad against differentials to the next pixel: close, not
       // equal, and on a curved surface the neighbour's ray meets another triangle.
       if (std::abs(g.z - c.z) <= 0.25f * c.z) ++close_footprint;
+      // The tangent frame: the triangle's, from screen derivatives against the hit's gradient.
+      const Float3 &gn = gpu.normal(row, col), &cn = cpu.normal(row, col);
+      const auto gf = decode_tangent(gpu.tangent(row, col), Eigen::Vector3f(gn.x, gn.y, gn.z));
+      const auto cf = decode_tangent(cpu.tangent(row, col), Eigen::Vector3f(cn.x, cn.y, cn.z));
+      if (gf && cf && gf->handedness == cf->handedness && gf->tangent.dot(cf->tangent) > 0.995f) ++close_frame;
     }
   ASSERT_GT(compared, 300) << "the pebble fills part of the view";
   EXPECT_GT(close_footprint, compared * 9 / 10);
+  EXPECT_GT(close_frame, compared * 95 / 100);
   for (std::size_t i = 0; i < cpu.texcoord.size(); ++i) {
     if (!cpu.virtual_surface.pixels()[i]) {
       EXPECT_EQ(cpu.texcoord.pixels()[i].z, 0.f) << "real surfaces have no coordinates";

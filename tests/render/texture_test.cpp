@@ -63,6 +63,29 @@ TEST(Texture, LinearTexturesHoldDataNotColours) {
   EXPECT_NEAR(colour.sample(0.25f, 0.5f).y(), srgb_to_linear(51), 1e-6f);
 }
 
+// KHR_texture_transform: the README's example "only the lower left quadrant of the source image,
+// rotated clockwise 90 degrees" (offset (0, 1), rotation pi/2, scale 0.5).
+TEST(Texture, TheGltfTextureTransformMapsCoordinatesFirst) {
+  ColorImage quadrants(4, 4);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) quadrants(y, x) = y < 2 ? (x < 2 ? kRed : kGreen) : (x < 2 ? kBlue : kWhite);
+  const UvTransform transform = UvTransform::gltf({0.f, 1.f}, std::numbers::pi_v<float> / 2.f, {0.5f, 0.5f});
+  const Texture texture("quadrants", quadrants, TextureWrap::ClampToEdge, TextureWrap::ClampToEdge,
+                        TextureEncoding::Srgb, transform);
+  for (const auto& [u, v] :
+       {std::pair{0.1f, 0.1f}, std::pair{0.5f, 0.5f}, std::pair{0.7f, 0.2f}, std::pair{0.3f, 0.7f}})
+    EXPECT_LT((texture.sample(u, v) - linear(kBlue)).norm(), 1e-6f) << "lower left (blue) at " << u << "," << v;
+  // Rotated clockwise as the image shows it: the quadrant's top edge (v' = 0.5) lands on the
+  // coordinates' right edge (u = 1), its left edge (u' = 0) on the top (v = 0).
+  EXPECT_LT((transform.apply({1.f, 0.3f}) - Eigen::Vector2f(0.15f, 0.5f)).norm(), 1e-6f);
+  EXPECT_LT((transform.apply({0.3f, 0.f}) - Eigen::Vector2f(0.f, 0.85f)).norm(), 1e-6f);
+  EXPECT_NEAR(transform.stretch(), 0.5f, 1e-6f);
+  EXPECT_NEAR(UvTransform::gltf({}, 0.4f, {3.f, -0.5f}).stretch(), 3.f, 1e-5f);
+  // Half the scale, half the texels under a footprint: one level finer.
+  const Texture plain("plain", quadrants);
+  EXPECT_NEAR(plain.level_of_detail(0.5f) - texture.level_of_detail(0.5f), 1.f, 1e-6f);
+}
+
 TEST(Texture, WrapModesFollowTheGltfSampler) {
   const ColorImage image = image_of(2, 2, {kRed, kGreen, kBlue, kWhite});
   const Texture repeat("repeat", image, TextureWrap::Repeat, TextureWrap::Repeat);
@@ -185,6 +208,24 @@ TEST(TexturedGltf, AnEmissiveTextureMultipliesTheEmission) {
   EXPECT_NE(error.find("different TEXCOORD sets (0, 1)"), std::string::npos) << error;
 }
 
+TEST(TexturedGltf, TextureTransformsAreReadWithTheirTexcoordOverride) {
+  const relight::test::TempDir dir;
+  write_color(dir.path() / "texture.png", checkerboard(4, 2, kRed, kBlue));
+  const std::string transformed = R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
+      "extensions": {"KHR_texture_transform": {"offset": [0.5, 0], "rotation": 0.3, "scale": [2, 3]}}}}})";
+  const VirtualModel model = load_model(write_textured_triangle(dir.path(), true, transformed));
+  const Texture* texture = model.materials.at(0).base_color.get();
+  ASSERT_NE(texture, nullptr);
+  const UvTransform expected = UvTransform::gltf({0.5f, 0.f}, 0.3f, {2.f, 3.f});
+  EXPECT_TRUE(texture->transform().linear.isApprox(expected.linear, 1e-6f));
+  EXPECT_TRUE(texture->transform().offset.isApprox(expected.offset, 1e-6f));
+  // The extension's texCoord overrides the reference's: set 1 against the emission's 0.
+  const std::string overridden = R"({"pbrMetallicRoughness": {"baseColorTexture": {"index": 0,
+      "extensions": {"KHR_texture_transform": {"texCoord": 1}}}}, "emissiveTexture": {"index": 0}})";
+  const std::string error = load_error(write_textured_triangle(dir.path(), true, overridden));
+  EXPECT_NE(error.find("different TEXCOORD sets (1, 0)"), std::string::npos) << error;
+}
+
 TEST(TexturedGltf, AMetallicRoughnessTextureIsReadAsLinearDataWithItsFactors) {
   const relight::test::TempDir dir;
   write_color(dir.path() / "texture.png", checkerboard(4, 2, kRed, kBlue));
@@ -219,6 +260,19 @@ TEST(TexturedGltf, AMetallicRoughnessTextureIsReadAsLinearDataWithItsFactors) {
       "metallicRoughnessTexture": {"index": 0, "texCoord": 2}}})";
   const std::string error = load_error(write_textured_triangle(dir.path(), true, two_sets));
   EXPECT_NE(error.find("different TEXCOORD sets (0, 2)"), std::string::npos) << error;
+}
+
+TEST(TexturedGltf, ANormalTextureIsReadAsLinearDataWithItsScale) {
+  const relight::test::TempDir dir;
+  write_color(dir.path() / "texture.png", checkerboard(4, 2, kRed, kBlue));
+  const VirtualModel model =
+      load_model(write_textured_triangle(dir.path(), true, R"({"normalTexture": {"index": 0, "scale": 0.5}})"));
+  const PhongMaterial& material = model.materials.at(0);
+  ASSERT_NE(material.normal_texture, nullptr);
+  EXPECT_EQ(material.normal_texture->encoding(), TextureEncoding::Linear) << "normals are data, not colours";
+  EXPECT_FLOAT_EQ(material.normal_scale, 0.5f);
+  EXPECT_LT((material.normal_texture->sample(0.25f, 0.25f) - Eigen::Vector3f(200.f, 30.f, 20.f) / 255.f).norm(), 1e-6f);
+  EXPECT_EQ(model.meshes.at(0).texcoords.size(), 3u) << "read for the normal texture alone";
 }
 
 TEST(TexturedGltf, AJpegTextureIsDecodedByItsSignature) {

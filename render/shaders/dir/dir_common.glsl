@@ -1,4 +1,6 @@
 // Shared by the DIR compute shaders; each function mirrors the C++ function named beside it.
+#include "basis.glsl"
+
 const float EMPTY = 1e30;  // kShadowEmpty (shadow_maps.h)
 const float PI = 3.14159265358979;
 
@@ -9,15 +11,6 @@ struct Vpl {  // vpl_buffer.h: GpuVpl
   vec4 flux;        // w: Vpl::metallic_roughness.z (metallic texel)
   vec4 kd_texture;  // Vpl::kd_texture
 };
-
-// orthonormal_basis() (phong_brdf.h), Duff et al. 2017.
-void orthonormal_basis(vec3 n, out vec3 t, out vec3 b) {
-  const float s = n.z >= 0.0 ? 1.0 : -1.0;
-  const float a = -1.0 / (s + n.z);
-  const float c = n.x * n.y * a;
-  t = vec3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
-  b = vec3(c, s + n.y * n.y * a, -n.y);
-}
 
 // paraboloid_texel() (ism.h).
 vec2 paraboloid_texel(vec3 d, int tile) {

@@ -27,6 +27,7 @@ struct Material {
   vec4 texture;      // x, y, z: its base-colour, emission and metallic-roughness textures' headers in
                      // texture_words (bits; 0xffffffff: none); w: roughness factor
   vec4 pbr;          // MetallicRoughness (mr_scene.h): base colour factor, metallic factor
+  vec4 normal_map;   // x: its normal texture's header (bits; 0xffffffff: none), y: its scale
 };
 struct Light {
   vec4 position_kind;      // w: 0 point, 1 spot, 2 directional, 3 directional through its emitter VPL (bits)
@@ -51,6 +52,7 @@ layout(std430, set = 0, binding = 6) readonly buffer IsmAtlas { float ism_atlas[
 layout(std430, set = 0, binding = 7) writeonly buffer Radiance { vec4 radiance[]; };
 layout(std430, set = 0, binding = 8) readonly buffer Textures { uint texture_words[]; };
 #include "dir_texture.glsl"
+#include "normal_map.glsl"
 
 layout(push_constant) uniform Params {
   uint width;
@@ -156,13 +158,20 @@ void main() {
     return;
   }
   const vec4 normal_material = gbuffer[pixels + i];
-  const vec3 point = position.xyz, n = normal_material.xyz;
+  const vec3 point = position.xyz;
   const float real_pixel = position.w > 0.0 ? 1.0 : 0.0;  // r(p)
   const vec3 wo = normalize(params.camera_centre.xyz - point);
   // texture_factors() (gbuffer.h): the textures at the pixel's coordinates and footprint.
   const vec4 t = gbuffer[2u * pixels + i];
   const Material material = materials[uint(normal_material.w)];
   const Material own = surface_material(material, material_texture(floatBitsToUint(material.texture.z), t));
+  // shading_normals() (gbuffer.h): the G-buffer's normal bent by the material's normal texture.
+  vec3 n = normal_material.xyz;
+  const uint normal_header = floatBitsToUint(material.normal_map.x);
+  vec3 tangent;
+  float handedness;
+  if (normal_header != 0xffffffffu && decode_tangent(t.w, n, tangent, handedness))
+    n = mapped_normal(n, tangent, handedness, material_texture(normal_header, t), material.normal_map.y);
   const vec3 kd_texture = material_texture(floatBitsToUint(own.texture.x), t);
   Material m = own;  // textured: for the direct light
   m.kd_ks.xyz *= kd_texture;

@@ -1,9 +1,10 @@
 // Material textures in a storage buffer: the GLSL twin of Texture::sample (render/scene/
 // texture.h), reading the words pack_textures() (dir_vk.cpp) writes. The includer declares
 //   readonly buffer Textures { uint texture_words[]; };
-// A texture starts at word `header`: levels, wrap u, wrap v, the longer side of level 0, then per
-// level (absolute word index of its first texel, width, height, encoding: 0 sRGB, 1 linear),
-// texels r | g << 8 | b << 16.
+// A texture starts at word `header`: levels, wrap u, wrap v, the longer side of level 0, its
+// UvTransform (linear row by row, offset; floats as bits), its stretch(), 0; then per level
+// (absolute word index of its first texel, width, height, encoding: 0 sRGB, 1 linear), texels
+// r | g << 8 | b << 16.
 
 float srgb_to_linear(uint value) {
   const float c = float(value) / 255.0;
@@ -27,8 +28,18 @@ int wrapped_texel(int i, int size, uint wrap) {
   return ((i % size) + size) % size;
 }
 
+const uint TEXTURE_HEADER = 12u;  // kTextureHeaderWords (dir_vk.cpp)
+
+// UvTransform::apply.
+vec2 texture_transform(uint header, vec2 uv) {
+  const vec2 row0 = vec2(uintBitsToFloat(texture_words[header + 4u]), uintBitsToFloat(texture_words[header + 5u]));
+  const vec2 row1 = vec2(uintBitsToFloat(texture_words[header + 6u]), uintBitsToFloat(texture_words[header + 7u]));
+  const vec2 offset = vec2(uintBitsToFloat(texture_words[header + 8u]), uintBitsToFloat(texture_words[header + 9u]));
+  return vec2(dot(row0, uv), dot(row1, uv)) + offset;
+}
+
 vec3 texture_bilinear(uint header, uint level, vec2 uv) {
-  const uint base = header + 4u + 4u * level;
+  const uint base = header + TEXTURE_HEADER + 4u * level;
   const uint first = texture_words[base];
   const int w = int(texture_words[base + 1u]), h = int(texture_words[base + 2u]);
   const uint encoding = texture_words[base + 3u];
@@ -48,18 +59,19 @@ vec3 texture_bilinear(uint header, uint level, vec2 uv) {
 }
 
 vec3 texture_mean(uint header) {
-  const uint top = header + 4u + 4u * (texture_words[header] - 1u);
+  const uint top = header + TEXTURE_HEADER + 4u * (texture_words[header] - 1u);
   return texel_linear(texture_words[texture_words[top]], texture_words[top + 3u]);
 }
 
 // Texture::level_of_detail.
 float texture_level(uint header, float footprint) {
-  const float texels = footprint * float(texture_words[header + 3u]);
+  const float texels = footprint * uintBitsToFloat(texture_words[header + 10u]) * float(texture_words[header + 3u]);
   if (!(texels > 1.0)) return 0.0;
   return min(log2(texels), float(texture_words[header] - 1u));
 }
 
-vec3 texture_sample(uint header, vec2 uv, float lod) {
+vec3 texture_sample(uint header, vec2 coordinates, float lod) {
+  const vec2 uv = texture_transform(header, coordinates);
   const uint levels = texture_words[header];
   const float level = clamp(lod, 0.0, float(levels - 1u));
   const uint l0 = uint(level);

@@ -193,6 +193,9 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
   const RadianceImage kd_texture = texture_factors(gbuffer, scene, MaterialTexture::BaseColor);
   const RadianceImage emission_texture = texture_factors(gbuffer, scene, MaterialTexture::Emission);
   const RadianceImage metallic_roughness = texture_factors(gbuffer, scene, MaterialTexture::MetallicRoughness);
+  // Bent by normal maps for the shading; the merge compares the G-buffer's own normals.
+  const NormalMap bent = shading_normals(gbuffer, scene);
+  const NormalMap& normals = bent.empty() ? gbuffer.normal : bent;
   const Vec3 environment = scene.environment.radiance;
   const int n = options.interleave;
   Image<Radiance> shaded(width, height);
@@ -204,7 +207,7 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
           continue;
         }
         const auto& p = gbuffer.position(y, x);
-        const auto& nn = gbuffer.normal(y, x);
+        const auto& nn = normals(y, x);
         const Vec3 point(p.x, p.y, p.z), normal(nn.x, nn.y, nn.z);
         const float real_pixel = gbuffer.virtual_surface(y, x) ? 0.f : 1.f;
         const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));

@@ -49,8 +49,10 @@ using detail::ShadeParams;
 float bits(std::uint32_t value) { return std::bit_cast<float>(value); }
 
 constexpr std::uint32_t kNoTexture = 0xffffffffu;
-/// A material's base-colour, emission and metallic-roughness textures (material_textures).
-constexpr std::size_t kTexturesPerMaterial = 3;
+/// A packed texture's header before its levels' (dir_texture.glsl).
+constexpr std::uint32_t kTextureHeaderWords = 12;
+/// A material's base-colour, emission, metallic-roughness and normal textures (material_textures).
+constexpr std::size_t kTexturesPerMaterial = 4;
 
 /// The scenes' textures as dir_texture.glsl reads them, and the header words of each material's
 /// textures (kTexturesPerMaterial per material; kNoTexture: none). A texture shared by
@@ -60,7 +62,7 @@ struct PackedTextures {
   std::vector<std::uint32_t> material_headers;
 };
 
-/// Per material its base-colour, emission and metallic-roughness textures (null: none): when a new scene's list
+/// Per material its base-colour, emission, metallic-roughness and normal textures (null: none): when a new scene's list
 /// equals the last one's, the packed textures on the device still hold (scenes are rebuilt every
 /// frame, textures are shared). Held, not just compared: a texture freed and another made at its
 /// address would look unchanged.
@@ -70,6 +72,7 @@ std::vector<std::shared_ptr<const Texture>> material_textures(const MrScene& sce
     out.push_back(m.base_color);
     out.push_back(m.emission_texture);
     out.push_back(m.metallic_roughness_texture);
+    out.push_back(m.normal_texture);
   }
   return out;
 }
@@ -89,10 +92,15 @@ PackedTextures pack_textures(const std::vector<std::shared_ptr<const Texture>>& 
     }
     const auto header = static_cast<std::uint32_t>(out.words.size());
     const auto levels = static_cast<std::uint32_t>(texture->levels());
-    out.words.insert(out.words.end(), {levels, static_cast<std::uint32_t>(texture->wrap_u()),
-                                       static_cast<std::uint32_t>(texture->wrap_v()),
-                                       static_cast<std::uint32_t>(std::max(texture->width(), texture->height()))});
-    const std::uint32_t first_texel = header + 4 + 4 * levels;
+    const UvTransform& uv = texture->transform();
+    const auto word = [](float value) { return std::bit_cast<std::uint32_t>(value); };
+    out.words.insert(
+        out.words.end(),
+        {levels, static_cast<std::uint32_t>(texture->wrap_u()), static_cast<std::uint32_t>(texture->wrap_v()),
+         static_cast<std::uint32_t>(std::max(texture->width(), texture->height())), word(uv.linear(0, 0)),
+         word(uv.linear(0, 1)), word(uv.linear(1, 0)), word(uv.linear(1, 1)), word(uv.offset.x()), word(uv.offset.y()),
+         word(uv.stretch()), 0u});
+    const std::uint32_t first_texel = header + kTextureHeaderWords + 4 * levels;
     for (int l = 0; l < texture->levels(); ++l)
       out.words.insert(out.words.end(), {first_texel + static_cast<std::uint32_t>(texture->level_offset(l)),
                                          static_cast<std::uint32_t>(texture->level_width(l)),
@@ -110,11 +118,26 @@ std::vector<float> pack_materials(const MrScene& scene, const std::vector<std::u
   for (std::size_t i = 0; i < scene.materials.size(); ++i) {
     const PhongMaterial& m = scene.materials[i];
     const MetallicRoughness& pbr = m.metallic_roughness;
-    out.insert(out.end(),
-               {m.kd.x(), m.kd.y(), m.kd.z(), m.ks, m.emission.x(), m.emission.y(), m.emission.z(), m.n,
-                bits(texture_headers[kTexturesPerMaterial * i]), bits(texture_headers[kTexturesPerMaterial * i + 1]),
-                bits(texture_headers[kTexturesPerMaterial * i + 2]), pbr.roughness, pbr.base_color.x(),
-                pbr.base_color.y(), pbr.base_color.z(), pbr.metallic});
+    out.insert(out.end(), {m.kd.x(),
+                           m.kd.y(),
+                           m.kd.z(),
+                           m.ks,
+                           m.emission.x(),
+                           m.emission.y(),
+                           m.emission.z(),
+                           m.n,
+                           bits(texture_headers[kTexturesPerMaterial * i]),
+                           bits(texture_headers[kTexturesPerMaterial * i + 1]),
+                           bits(texture_headers[kTexturesPerMaterial * i + 2]),
+                           pbr.roughness,
+                           pbr.base_color.x(),
+                           pbr.base_color.y(),
+                           pbr.base_color.z(),
+                           pbr.metallic,
+                           bits(texture_headers[kTexturesPerMaterial * i + 3]),
+                           m.normal_scale,
+                           0.f,
+                           0.f});
   }
   return out;
 }

@@ -3,6 +3,7 @@
 
 #include "relight/core/parallel.h"
 #include "relight/render/dir/gbuffer.h"
+#include "relight/render/scene/normal_map.h"
 
 namespace relight::render {
 namespace {
@@ -21,7 +22,8 @@ float texcoord_step(const SurfaceHit& hit, const Eigen::Vector3f& origin, const 
 
 bool has_textures(const MrScene& scene) {
   return std::any_of(scene.materials.begin(), scene.materials.end(), [](const PhongMaterial& m) {
-    return m.base_color != nullptr || m.emission_texture != nullptr || m.metallic_roughness_texture != nullptr;
+    return m.base_color != nullptr || m.emission_texture != nullptr || m.metallic_roughness_texture != nullptr ||
+           m.normal_texture != nullptr;
   });
 }
 
@@ -30,9 +32,10 @@ RadianceImage texture_factors(const GBuffer& gbuffer, const MrScene& scene, Mate
     switch (which) {
       case MaterialTexture::BaseColor: return m.base_color.get();
       case MaterialTexture::Emission: return m.emission_texture.get();
-      case MaterialTexture::MetallicRoughness: break;
+      case MaterialTexture::MetallicRoughness: return m.metallic_roughness_texture.get();
+      case MaterialTexture::Normal: break;
     }
-    return m.metallic_roughness_texture.get();
+    return m.normal_texture.get();
   };
   if (gbuffer.texcoord.empty() || std::none_of(scene.materials.begin(), scene.materials.end(),
                                                [&](const PhongMaterial& m) { return texture_of(m); }))
@@ -53,12 +56,34 @@ RadianceImage texture_factors(const GBuffer& gbuffer, const MrScene& scene, Mate
   return out;
 }
 
+NormalMap shading_normals(const GBuffer& gbuffer, const MrScene& scene) {
+  const RadianceImage texels = texture_factors(gbuffer, scene, MaterialTexture::Normal);
+  if (texels.empty() || gbuffer.tangent.empty()) return {};
+  NormalMap out = gbuffer.normal;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const std::uint16_t label = gbuffer.material.pixels()[i];
+    if (label == 0) continue;
+    const PhongMaterial& material = scene.materials.at(label - 1u);
+    const Float3& n = gbuffer.normal.pixels()[i];
+    const Eigen::Vector3f normal(n.x, n.y, n.z);
+    const std::optional<TangentFrame> frame = decode_tangent(gbuffer.tangent.pixels()[i], normal);
+    if (!material.normal_texture || !frame) continue;
+    const Float3& t = texels.pixels()[i];
+    const Eigen::Vector3f bent = mapped_normal(normal, *frame, Eigen::Vector3f(t.x, t.y, t.z), material.normal_scale);
+    out.pixels()[i] = {bent.x(), bent.y(), bent.z()};
+  }
+  return out;
+}
+
 GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads) {
   const PinholeIntrinsics& k = camera.intrinsics;
   GBuffer out{PositionMap(k.width, k.height), NormalMap(k.width, k.height), LabelImage(k.width, k.height),
               Mask(k.width, k.height), DepthMap(k.width, k.height)};
   const bool textured = has_textures(tracer.scene());
-  if (textured) out.texcoord = Image<Float3>(k.width, k.height);
+  if (textured) {
+    out.texcoord = Image<Float3>(k.width, k.height);
+    out.tangent = Image<float>(k.width, k.height);
+  }
   const Eigen::Vector3f origin = camera.camera_to_world.translation().cast<float>();
   const auto ray = [&](int col, int row) {
     return (camera.camera_to_world.linear() * k.ray(col, row).normalized()).cast<float>().eval();
@@ -72,8 +97,8 @@ GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads
             tracer.intersect(Layer::Virtual, origin, d, real ? real->t : std::numeric_limits<float>::infinity());
         const auto& hit = virtual_hit ? virtual_hit : real;
         if (!hit) continue;
-        Eigen::Vector3f n = hit->shading_normal;
-        if (n.dot(d) > 0.f) n = -n;
+        const bool back = hit->interpolated_normal.dot(d) > 0.f;
+        const Eigen::Vector3f n = back ? Eigen::Vector3f(-hit->interpolated_normal) : hit->interpolated_normal;
         out.position(row, col) = {hit->point.x(), hit->point.y(), hit->point.z()};
         out.normal(row, col) = {n.x(), n.y(), n.z()};
         out.material(row, col) = static_cast<std::uint16_t>(hit->material + 1);
@@ -84,6 +109,9 @@ GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads
               std::max(texcoord_step(*hit, origin, ray(col + 1, row)), texcoord_step(*hit, origin, ray(col, row + 1)));
           // At least a little above zero: zero marks "no coordinates" (texture_factors).
           out.texcoord(row, col) = {hit->texcoord.x(), hit->texcoord.y(), std::max(footprint, 1e-12f)};
+          std::optional<TangentFrame> frame = tangent_frame(hit->texcoord_gradient, hit->interpolated_normal);
+          if (frame && back) frame = flipped(*frame);
+          out.tangent(row, col) = encode_tangent(frame, n);
         }
       }
   }, 4);

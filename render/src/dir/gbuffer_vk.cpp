@@ -163,7 +163,10 @@ GBuffer GBufferVk::unpack(std::span<const float> data, int width, int height) {
   const bool texcoords = data.size() >= 12 * pixels;
   GBuffer out{PositionMap(width, height), NormalMap(width, height), LabelImage(width, height), Mask(width, height),
               DepthMap(width, height)};
-  if (texcoords) out.texcoord = Image<Float3>(width, height);
+  if (texcoords) {
+    out.texcoord = Image<Float3>(width, height);
+    out.tangent = Image<float>(width, height);
+  }
   for (std::size_t i = 0; i < pixels; ++i) {
     const float* p = &data[4 * i];
     const float* n = &data[4 * (pixels + i)];
@@ -176,6 +179,7 @@ GBuffer GBufferVk::unpack(std::span<const float> data, int width, int height) {
     if (texcoords) {
       const float* t = &data[4 * (2 * pixels + i)];
       out.texcoord.pixels()[i] = {t[0], t[1], t[2]};
+      out.tangent.pixels()[i] = t[3];
     }
   }
   return out;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "relight/core/error.h"
+#include "relight/render/scene/normal_map.h"
 
 namespace relight::render {
 namespace {
@@ -180,17 +181,27 @@ std::optional<SurfaceHit> RayTracer::intersect(Layer which, const Eigen::Vector3
   hit.point = origin + hit.t * direction;
   hit.geometric_normal = Eigen::Vector3f(query.hit.Ng_x, query.hit.Ng_y, query.hit.Ng_z).normalized();
   if (mesh.normals.empty()) {
-    hit.shading_normal = hit.geometric_normal;
+    hit.interpolated_normal = hit.geometric_normal;
   } else {
     const float u = query.hit.u, v = query.hit.v;
     const Eigen::Vector3f n = (1.f - u - v) * mesh.normals[triangle[0]] + u * mesh.normals[triangle[1]] +
                               v * mesh.normals[triangle[2]];
     const float length = n.norm();
-    hit.shading_normal = length > 0.f ? Eigen::Vector3f(n / length) : hit.geometric_normal;
+    hit.interpolated_normal = length > 0.f ? Eigen::Vector3f(n / length) : hit.geometric_normal;
   }
+  hit.shading_normal = hit.interpolated_normal;
   hit.material = mesh.triangle_material[query.hit.primID];
   hit.real = mesh.real;
-  if (!mesh.texcoords.empty()) add_texcoords(mesh, triangle, query.hit.u, query.hit.v, hit);
+  if (!mesh.texcoords.empty()) {
+    add_texcoords(mesh, triangle, query.hit.u, query.hit.v, hit);
+    const PhongMaterial& material = impl_->scene.materials[hit.material];
+    if (material.normal_texture) {
+      if (const std::optional<TangentFrame> frame = tangent_frame(hit.texcoord_gradient, hit.interpolated_normal))
+        hit.shading_normal =
+            mapped_normal(hit.interpolated_normal, *frame,
+                          material.normal_texture->sample(hit.texcoord.x(), hit.texcoord.y()), material.normal_scale);
+    }
+  }
   return hit;
 }
 

@@ -28,6 +28,32 @@ float number(const Value& object, const char* key, float fallback) {
                                                        : fallback;
 }
 
+/// A texture reference's KHR_texture_transform (identity without one) and its TEXCOORD set (the
+/// extension's texCoord overrides the reference's).
+template <typename Info>
+UvTransform uv_transform(const Info& info) {
+  const auto found = info.extensions.find("KHR_texture_transform");
+  if (found == info.extensions.end() || !found->second.IsObject()) return {};
+  const Value& t = found->second;
+  const auto pair = [&t](const char* key, Eigen::Vector2f fallback) {
+    if (!t.Has(key) || !t.Get(key).IsArray() || t.Get(key).ArrayLen() != 2) return fallback;
+    for (int i = 0; i < 2; ++i)
+      if (t.Get(key).Get(i).IsNumber()) fallback[i] = static_cast<float>(t.Get(key).Get(i).GetNumberAsDouble());
+    return fallback;
+  };
+  return UvTransform::gltf(pair("offset", Eigen::Vector2f::Zero()), number(t, "rotation", 0.f),
+                           pair("scale", Eigen::Vector2f::Ones()));
+}
+
+template <typename Info>
+int texcoord_set_of(const Info& info) {
+  const auto found = info.extensions.find("KHR_texture_transform");
+  if (found != info.extensions.end() && found->second.IsObject() && found->second.Has("texCoord") &&
+      found->second.Get("texCoord").IsInt())
+    return found->second.Get("texCoord").GetNumberAsInt();
+  return info.texCoord;
+}
+
 std::optional<PhongMaterial> phong_extras(const tinygltf::Material& m) {
   if (!m.extras.IsObject() || !m.extras.Has("relight_phong")) return std::nullopt;
   const Value& phong = m.extras.Get("relight_phong");
@@ -246,10 +272,12 @@ class GltfMeshCollector {
     if (material < 0 || static_cast<std::size_t>(material) >= gltf_.materials.size()) return std::nullopt;
     const PhongMaterial& ours = out_.materials[static_cast<std::size_t>(material)];
     const tinygltf::Material& theirs = gltf_.materials[static_cast<std::size_t>(material)];
-    const std::array<std::pair<bool, int>, 3> sets{
-        {{ours.base_color != nullptr, theirs.pbrMetallicRoughness.baseColorTexture.texCoord},
-         {ours.emission_texture != nullptr, theirs.emissiveTexture.texCoord},
-         {ours.metallic_roughness_texture != nullptr, theirs.pbrMetallicRoughness.metallicRoughnessTexture.texCoord}}};
+    const std::array<std::pair<bool, int>, 4> sets{
+        {{ours.base_color != nullptr, texcoord_set_of(theirs.pbrMetallicRoughness.baseColorTexture)},
+         {ours.emission_texture != nullptr, texcoord_set_of(theirs.emissiveTexture)},
+         {ours.metallic_roughness_texture != nullptr,
+          texcoord_set_of(theirs.pbrMetallicRoughness.metallicRoughnessTexture)},
+         {ours.normal_texture != nullptr, texcoord_set_of(theirs.normalTexture)}}};
     std::optional<int> out;
     for (const auto& [used, set] : sets) {
       if (!used) continue;
@@ -312,10 +340,13 @@ class GltfTextures {
   GltfTextures(const tinygltf::Model& gltf, const EncodedImages& images, std::string file)
       : gltf_(gltf), images_(images), file_(std::move(file)) {}
 
-  /// The texture a material refers to with `index` (its base colour's, emission's or
-  /// metallic-roughness's, whose texels are `encoding`), or null for -1.
-  std::shared_ptr<const Texture> texture(const tinygltf::Material& material, int index,
+  /// The texture a material refers to with `info` (its base colour's, emission's, metallic-
+  /// roughness's or normal's, whose texels are `encoding`; with its KHR_texture_transform), or
+  /// null for index -1.
+  template <typename Info>
+  std::shared_ptr<const Texture> texture(const tinygltf::Material& material, const Info& info,
                                          TextureEncoding encoding = TextureEncoding::Srgb) {
+    const int index = info.index;
     if (index < 0) return nullptr;
     if (static_cast<std::size_t>(index) >= gltf_.textures.size())
       fail("material '" + material.name + "' uses texture " + std::to_string(index) + ", but the file has " +
@@ -325,7 +356,12 @@ class GltfTextures {
       fail("texture " + std::to_string(index) + " has no image");
     if (texture.sampler >= 0 && static_cast<std::size_t>(texture.sampler) >= gltf_.samplers.size())
       fail("texture " + std::to_string(index) + " uses a missing sampler");
-    const std::tuple key{texture.source, texture.sampler, encoding};
+    const UvTransform transform = uv_transform(info);
+    if (!transform.linear.allFinite() || !transform.offset.allFinite())
+      fail("texture " + std::to_string(index) + " has a non-finite KHR_texture_transform");
+    const std::tuple key{texture.source, texture.sampler, encoding,
+                         std::array<float, 6>{transform.linear(0, 0), transform.linear(0, 1), transform.linear(1, 0),
+                                              transform.linear(1, 1), transform.offset.x(), transform.offset.y()}};
     if (const auto found = decoded_.find(key); found != decoded_.end()) return found->second;
     const tinygltf::Image& image = gltf_.images[static_cast<std::size_t>(texture.source)];
     const std::string what = file_ + ": image " + std::to_string(texture.source) +
@@ -341,8 +377,9 @@ class GltfTextures {
       wrap_u = wrap_of(sampler.wrapS);
       wrap_v = wrap_of(sampler.wrapT);
     }
-    auto out = std::make_shared<const Texture>(
-        image.name.empty() ? "image " + std::to_string(texture.source) : image.name, decoded, wrap_u, wrap_v, encoding);
+    auto out =
+        std::make_shared<const Texture>(image.name.empty() ? "image " + std::to_string(texture.source) : image.name,
+                                        decoded, wrap_u, wrap_v, encoding, transform);
     decoded_.emplace(key, out);
     return out;
   }
@@ -371,7 +408,7 @@ class GltfTextures {
   const tinygltf::Model& gltf_;
   const EncodedImages& images_;
   std::string file_;
-  std::map<std::tuple<int, int, TextureEncoding>, std::shared_ptr<const Texture>> decoded_;
+  std::map<std::tuple<int, int, TextureEncoding, std::array<float, 6>>, std::shared_ptr<const Texture>> decoded_;
   std::size_t texels_ = 0;  // decoded so far
 };
 
@@ -405,13 +442,15 @@ VirtualModel load_gltf(const std::filesystem::path& path) {
   GltfTextures textures(gltf, images, path.string());
   for (const tinygltf::Material& m : gltf.materials) {
     model.materials.push_back(from_gltf(m));
-    model.materials.back().base_color = textures.texture(m, m.pbrMetallicRoughness.baseColorTexture.index);
-    model.materials.back().emission_texture = textures.texture(m, m.emissiveTexture.index);
+    model.materials.back().base_color = textures.texture(m, m.pbrMetallicRoughness.baseColorTexture);
+    model.materials.back().emission_texture = textures.texture(m, m.emissiveTexture);
     // relight's own Phong parameters (extras) are taken as they are, without the metallic-
     // roughness mapping the texture would feed.
     if (!phong_extras(m))
       model.materials.back().metallic_roughness_texture =
-          textures.texture(m, m.pbrMetallicRoughness.metallicRoughnessTexture.index, TextureEncoding::Linear);
+          textures.texture(m, m.pbrMetallicRoughness.metallicRoughnessTexture, TextureEncoding::Linear);
+    model.materials.back().normal_texture = textures.texture(m, m.normalTexture, TextureEncoding::Linear);
+    model.materials.back().normal_scale = static_cast<float>(m.normalTexture.scale);
   }
   const auto default_material = static_cast<std::uint32_t>(model.materials.size());
   model.materials.push_back(PhongMaterial{{{0.8f, 0.8f, 0.8f}, 0.f, 1.f}, "default", {0.f, 0.f, 0.f}});

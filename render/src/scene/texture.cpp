@@ -49,9 +49,25 @@ std::uint8_t linear_to_srgb(float linear) {
   return static_cast<std::uint8_t>(std::lround(255.f * encoded));
 }
 
+UvTransform UvTransform::gltf(const Eigen::Vector2f& offset, float rotation, const Eigen::Vector2f& scale) {
+  const float c = std::cos(rotation), s = std::sin(rotation);
+  UvTransform out;
+  out.linear << c * scale.x(), s * scale.y(), -s * scale.x(), c * scale.y();
+  out.offset = offset;
+  return out;
+}
+
+float UvTransform::stretch() const {
+  // The 2x2 singular values: s1^2 + s2^2 = |A|_F^2, s1 s2 = |det A|.
+  const float frobenius = linear.squaredNorm();
+  const float determinant = linear(0, 0) * linear(1, 1) - linear(0, 1) * linear(1, 0);
+  const float root = std::sqrt(std::max(frobenius * frobenius - 4.f * determinant * determinant, 0.f));
+  return std::sqrt(0.5f * (frobenius + root));
+}
+
 Texture::Texture(std::string name, const ColorImage& texels, TextureWrap wrap_u, TextureWrap wrap_v,
-                 TextureEncoding encoding)
-    : name_(std::move(name)), wrap_u_(wrap_u), wrap_v_(wrap_v), encoding_(encoding) {
+                 TextureEncoding encoding, UvTransform transform)
+    : name_(std::move(name)), wrap_u_(wrap_u), wrap_v_(wrap_v), encoding_(encoding), transform_(std::move(transform)) {
   if (texels.width() <= 0 || texels.height() <= 0) throw Error("texture " + name_ + " is empty");
   widths_.push_back(texels.width());
   heights_.push_back(texels.height());
@@ -99,7 +115,9 @@ Eigen::Vector3f Texture::bilinear(int level, float u, float v) const {
          fy * ((1.f - fx) * at(x0, y0 + 1) + fx * at(x0 + 1, y0 + 1));
 }
 
-Eigen::Vector3f Texture::sample(float u, float v, float lod) const {
+Eigen::Vector3f Texture::sample(float u_in, float v_in, float lod) const {
+  const Eigen::Vector2f uv = transform_.apply({u_in, v_in});
+  const float u = uv.x(), v = uv.y();
   if (!std::isfinite(u) || !std::isfinite(v)) return mean();
   const float level = std::clamp(std::isfinite(lod) ? lod : 0.f, 0.f, static_cast<float>(levels() - 1));
   const int l0 = static_cast<int>(level);
@@ -129,7 +147,7 @@ std::uint32_t Texture::encode(const Eigen::Vector3f& value) const {
 }
 
 float Texture::level_of_detail(float footprint) const {
-  const float texels = footprint * static_cast<float>(std::max(width(), height()));
+  const float texels = footprint * transform_.stretch() * static_cast<float>(std::max(width(), height()));
   if (!(texels > 1.f)) return 0.f;
   return std::min(std::log2(texels), static_cast<float>(levels() - 1));
 }

@@ -44,7 +44,7 @@ std::optional<SurfaceHit> hit_at(const GBuffer& g, std::size_t i) {
   const Float3& p = g.position.pixels()[i];
   const Float3& n = g.normal.pixels()[i];
   hit.point = {p.x, p.y, p.z};
-  hit.geometric_normal = hit.shading_normal = Eigen::Vector3f(n.x, n.y, n.z);
+  hit.geometric_normal = hit.interpolated_normal = hit.shading_normal = Eigen::Vector3f(n.x, n.y, n.z);
   hit.material = static_cast<std::uint32_t>(label - 1);
   hit.real = g.virtual_surface.pixels()[i] == 0;
   return hit;

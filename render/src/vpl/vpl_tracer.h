@@ -72,7 +72,7 @@ class ConeSearch {
     SurfaceHit out;
     out.t = hit.t;
     out.point = segment.origin + hit.t * segment.direction;
-    out.geometric_normal = out.shading_normal = point.normal;
+    out.geometric_normal = out.interpolated_normal = out.shading_normal = point.normal;
     out.material = point.material;
     out.real = real;
     return out;

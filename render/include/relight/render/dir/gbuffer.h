@@ -12,7 +12,7 @@ namespace relight::render {
 
 struct GBuffer {
   PositionMap position;  ///< world frame, metres; (0,0,0) where nothing is seen
-  NormalMap normal;      ///< world frame, unit, facing the camera (interpolated vertex normal)
+  NormalMap normal;      ///< world frame, unit, facing the camera (interpolated vertex normal, before any normal map)
   LabelImage material;   ///< MrScene material index + 1; 0 where nothing is seen
   Mask virtual_surface;  ///< 1 where the surface belongs to a virtual object (r(p) = 0)
   DepthMap distance;     ///< from the camera centre, metres; 0 where nothing is seen
@@ -21,6 +21,9 @@ struct GBuffer {
   /// next pixel right and below (Texture::level_of_detail); empty when no material of the scene
   /// has a texture.
   Image<Float3> texcoord{};
+  /// The tangent frame where the surface has texture coordinates (encode_tangent(), normal_map.h:
+  /// for the normal as stored, facing the camera), 0 elsewhere; empty with texcoord.
+  Image<float> tangent{};
 
   static constexpr const char* type_name = "GBuffer";
 };
@@ -28,13 +31,20 @@ struct GBuffer {
 /// Whether any material of `scene` has a texture (then G-buffers carry texcoord).
 [[nodiscard]] bool has_textures(const MrScene& scene);
 
-enum class MaterialTexture { BaseColor, Emission, MetallicRoughness };
+enum class MaterialTexture { BaseColor, Emission, MetallicRoughness, Normal };
 /// The factor a material texture gives k_d (BaseColor) or the emission, or the metallic-
-/// roughness texel surface_phong() reads (MetallicRoughness), at each pixel of
+/// roughness texel surface_phong() reads (MetallicRoughness), or the normal texture's texel
+/// (Normal), at each pixel of
 /// `gbuffer` (Texture::sample at the pixel's coordinates and footprint; the texture's mean on a
 /// textured material without coordinates there); 1 elsewhere. Empty when `gbuffer` carries no
 /// texture coordinates or no material has such a texture.
 [[nodiscard]] RadianceImage texture_factors(const GBuffer& gbuffer, const MrScene& scene, MaterialTexture which);
+
+/// The shading normal at each pixel of `gbuffer`: its normal bent by its material's normal
+/// texture (normal_map.h; at the pixel's footprint, in its tangent frame), the normal itself
+/// where the material has none or the pixel no frame. Empty when no material has a normal
+/// texture or `gbuffer` no texture coordinates.
+[[nodiscard]] NormalMap shading_normals(const GBuffer& gbuffer, const MrScene& scene);
 
 [[nodiscard]] GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads = 0);
 

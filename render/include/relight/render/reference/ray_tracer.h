@@ -19,7 +19,10 @@ struct SurfaceHit {
   float t = 0.f;
   Eigen::Vector3f point;
   Eigen::Vector3f geometric_normal;  ///< unit, as the triangle's winding gives it
-  Eigen::Vector3f shading_normal;    ///< unit, interpolated vertex normal (or the geometric one)
+  Eigen::Vector3f interpolated_normal;  ///< unit, interpolated vertex normal (or the geometric one)
+  /// unit: interpolated_normal bent by the material's normal texture (normal_map.h, level 0, in
+  /// the triangle's tangent frame), where it has one and the hit texture coordinates
+  Eigen::Vector3f shading_normal;
   std::uint32_t material = 0;
   bool real = true;
   /// Interpolated texture coordinates, and how they change with the point on the triangle's plane

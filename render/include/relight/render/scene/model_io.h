@@ -11,19 +11,21 @@
 //   and the Phong exponent that matches a Beckmann lobe of slope alpha = roughness^2,
 //   n = 2 / alpha^2 - 2 (Walter et al. 2007), clamped to [1, 10000]; emission = emissiveFactor
 //   times KHR_materials_emissive_strength.
-// glTF base-colour, emissive and metallic-roughness textures (PNG or JPEG; a data URI, a GLB
-// buffer view or a file beside the model) become the material's Textures (texture.h) with their
-// samplers' wrap modes, and the primitive's TEXCOORD_n (float, or normalised unsigned byte/short;
-// one set per material, so its textures must share it) its mesh's texcoords; only
+// glTF base-colour, emissive, metallic-roughness and normal textures (PNG or JPEG; a data URI, a
+// GLB buffer view or a file beside the model) become the material's Textures (texture.h) with
+// their samplers' wrap modes, and the primitive's TEXCOORD_n (float, or normalised unsigned
+// byte/short; one set per material, so its textures must share it) its mesh's texcoords; only
 // the images a material uses are decoded, each checked against 8192 px a side from its header
 // before decoding (and all of a model's together against 8192^2 texels). The base colour
 // multiplies k_d only, so a fully metallic point (k_d = 0) shows no base texture and k_s keeps the
 // factor's luminance; the emissive texture multiplies the emission; the metallic-roughness
 // texture (linear data: G roughness, B metallic) multiplies the factors and feeds the mapping
-// above at each point (surface_phong(); not on materials with relight's own extras). Other
-// textures (normal, occlusion), MTL texture maps, KHR_texture_transform and the base colour's
-// alpha are ignored. Meshes keep the file's axes (y-up, see virtual_model.h); glTF node
-// transforms are applied. save_gltf writes no textures.
+// above at each point (surface_phong(); not on materials with relight's own extras); the normal
+// texture (with its scale) bends the shading normal in the triangle's tangent frame
+// (normal_map.h; TANGENT attributes are not read). Each texture reference's
+// KHR_texture_transform (and its texCoord override) is applied (UvTransform, texture.h).
+// Occlusion textures, MTL texture maps and the base colour's alpha are ignored. Meshes keep the file's axes
+// (y-up, see virtual_model.h); glTF node transforms are applied. save_gltf writes no textures.
 #include <filesystem>
 
 #include "relight/render/scene/virtual_model.h"

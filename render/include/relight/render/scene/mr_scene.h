@@ -38,7 +38,9 @@ struct MetallicRoughness {
 /// that multiplies k_d and an emission texture that multiplies the emission, per channel, and a
 /// metallic-roughness texture (glTF's: G roughness, B metallic, linear) whose values multiply
 /// `metallic_roughness`'s factors and give k_d (before the base colour), k_s and n through the
-/// mapping above. Textures are shared: scenes are copied every frame, texels are not.
+/// mapping above, and a normal texture (glTF's, linear; normal_map.h) that bends the shading
+/// normal, its x and y times `normal_scale`. Textures are shared: scenes are copied every frame,
+/// texels are not.
 struct PhongMaterial : Phong {
   std::string name;
   Eigen::Vector3f emission{0.f, 0.f, 0.f};
@@ -46,6 +48,8 @@ struct PhongMaterial : Phong {
   std::shared_ptr<const Texture> emission_texture{};
   std::shared_ptr<const Texture> metallic_roughness_texture{};
   MetallicRoughness metallic_roughness{};  ///< the factors; read only with metallic_roughness_texture
+  std::shared_ptr<const Texture> normal_texture{};
+  float normal_scale = 1.f;
 };
 
 /// `material`'s Phong parameters at a point where its metallic-roughness texture reads
