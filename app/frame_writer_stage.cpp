@@ -25,12 +25,13 @@ void FrameWriterStage::run(StageContext& context) {
     std::filesystem::create_directories(folder_, ec);
     if (ec) throw Error("cannot create " + folder_.string() + ": " + ec.message());
   }
+  // Copies: the graph reuses its buffers for the next frame while the queue writes these.
   previews_.for_each(context, [&](const std::string& buffer, const ColorImage& picture) {
-    write_color(file_for(context.frame_index(), buffer), picture);
+    queue_.push([path = file_for(context.frame_index(), buffer), picture] { write_color(path, picture); });
   });
   for (std::size_t i = 0; i < radiances_.size(); ++i) {
-    write_radiance(file_for(context.frame_index(), std::string(radiance_names_[i].name()), ".exr"),
-                   context.get(radiances_[i]));
+    queue_.push([path = file_for(context.frame_index(), std::string(radiance_names_[i].name()), ".exr"),
+                 image = context.get(radiances_[i])] { write_radiance(path, image); });
   }
 }
 

@@ -5,17 +5,11 @@
 #include <cmath>
 
 #include "relight/core/error.h"
+#include "relight/core/parallel.h"
+#include "relight/core/srgb.h"
 
 namespace relight::brdf {
 namespace {
-
-std::uint8_t srgb8(float linear) {
-  const float c = std::clamp(linear, 0.f, 1.f);
-  const float encoded = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
-  return static_cast<std::uint8_t>(std::lround(encoded * 255.f));
-}
-
-Rgb8 srgb8(const Float3& linear) { return {srgb8(linear.x), srgb8(linear.y), srgb8(linear.z)}; }
 
 /// Distinct colours for cluster ids 1.. (id 0, no material, stays black).
 Rgb8 cluster_colour(std::uint16_t id) {
@@ -40,15 +34,16 @@ ColorImage brdf_preview(const ColorImage& color, const Mask& highlights, const R
                                       std::pair{rerender.width(), rerender.height()}})
     if (width != w || height != h) throw Error("brdf preview: the panels differ in size from the colour image");
   ColorImage out(5 * w, h);
-  for (int row = 0; row < h; ++row)
+  parallel_for_each_row(h, 0, [&](int row) {
     for (int col = 0; col < w; ++col) {
       out(row, col) = color(row, col);
       const std::uint8_t m = highlights(row, col) ? 255 : 0;
       out(row, w + col) = {m, m, m};
-      out(row, 2 * w + col) = srgb8(kd(row, col));
+      out(row, 2 * w + col) = encode_srgb8(kd(row, col));
       out(row, 3 * w + col) = cluster_colour(materials.ids(row, col));
-      out(row, 4 * w + col) = srgb8(rerender(row, col));
+      out(row, 4 * w + col) = encode_srgb8(rerender(row, col));
     }
+  });
   return out;
 }
 

@@ -5,21 +5,10 @@
 #include <cmath>
 
 #include "relight/core/error.h"
+#include "relight/core/srgb.h"
 
 namespace relight::render {
 namespace {
-
-const std::array<float, 256>& srgb_table() {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> out{};
-    for (int i = 0; i < 256; ++i) {
-      const float c = static_cast<float>(i) / 255.f;
-      out[static_cast<std::size_t>(i)] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-    }
-    return out;
-  }();
-  return table;
-}
 
 std::uint8_t to_byte(float value) {
   return static_cast<std::uint8_t>(std::lround(255.f * std::clamp(value, 0.f, 1.f)));
@@ -41,13 +30,9 @@ int wrapped(int i, int size, TextureWrap wrap) {
 
 }  // namespace
 
-float srgb_to_linear(std::uint8_t value) { return srgb_table()[value]; }
+float srgb_to_linear(std::uint8_t value) { return srgb8_to_linear(value); }
 
-std::uint8_t linear_to_srgb(float linear) {
-  const float c = std::clamp(linear, 0.f, 1.f);
-  const float encoded = c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
-  return static_cast<std::uint8_t>(std::lround(255.f * encoded));
-}
+std::uint8_t linear_to_srgb(float linear) { return encode_srgb8_channel(linear); }
 
 UvTransform UvTransform::gltf(const Eigen::Vector2f& offset, float rotation, const Eigen::Vector2f& scale) {
   const float c = std::cos(rotation), s = std::sin(rotation);
@@ -134,8 +119,9 @@ Eigen::Vector3f Texture::decode(std::uint32_t texel) const {
     return Eigen::Vector3f(static_cast<float>(texel & 0xffu), static_cast<float>((texel >> 8) & 0xffu),
                            static_cast<float>((texel >> 16) & 0xffu)) /
            255.f;
-  const auto& table = srgb_table();
-  return {table[texel & 0xffu], table[(texel >> 8) & 0xffu], table[(texel >> 16) & 0xffu]};
+  return {srgb8_to_linear(static_cast<std::uint8_t>(texel & 0xffu)),
+          srgb8_to_linear(static_cast<std::uint8_t>((texel >> 8) & 0xffu)),
+          srgb8_to_linear(static_cast<std::uint8_t>((texel >> 16) & 0xffu))};
 }
 
 std::uint32_t Texture::encode(const Eigen::Vector3f& value) const {

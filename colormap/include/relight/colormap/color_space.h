@@ -19,6 +19,7 @@
 #include <cstdint>
 
 #include "relight/core/pixel.h"
+#include "relight/core/srgb.h"
 
 namespace relight::colormap {
 
@@ -77,15 +78,12 @@ using LabPixel = Float3;
 [[nodiscard]] LabPixel linear_srgb_to_lab(const Float3& rgb);
 [[nodiscard]] Float3 lab_to_linear_srgb(const LabPixel& lab);
 
-/// sRGB transfer curve (IEC 61966-2-1) on [0, 1]: encoded -> linear and back.
-[[nodiscard]] float srgb_to_linear(float encoded);
-[[nodiscard]] float linear_to_srgb(float linear);
-/// 8-bit sRGB -> linear through a 256-entry table (exact to float rounding).
-[[nodiscard]] float srgb8_to_linear(std::uint8_t encoded);
-[[nodiscard]] Float3 decode_srgb8(const Rgb8& pixel);
-/// Linear -> 8-bit sRGB, clamped to [0, 1] and rounded to nearest: exactly
-/// lround(255 linear_to_srgb(c)), by a search over the 255 thresholds between codes (no pow).
-[[nodiscard]] std::uint8_t encode_srgb8_channel(float linear);
-[[nodiscard]] Rgb8 encode_srgb8(const Float3& linear);
+// The sRGB curve lives in core (srgb.h); the colour mapping names it as its own.
+using relight::decode_srgb8;
+using relight::encode_srgb8;
+using relight::encode_srgb8_channel;
+using relight::linear_to_srgb;
+using relight::srgb8_to_linear;
+using relight::srgb_to_linear;
 
 }  // namespace relight::colormap

@@ -51,7 +51,8 @@ struct UvTransform {
   [[nodiscard]] bool identity() const { return linear.isIdentity(0.f) && offset.isZero(0.f); }
 };
 
-/// sRGB-encoded 8-bit value -> linear, the exact IEC 61966-2-1 curve.
+/// sRGB-encoded 8-bit value -> linear and back (core/srgb.h's srgb8_to_linear and
+/// encode_srgb8_channel), by the names the texture code uses.
 [[nodiscard]] float srgb_to_linear(std::uint8_t value);
 [[nodiscard]] std::uint8_t linear_to_srgb(float linear);
 
