@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "relight/core/allocator_tuning.h"
 #include "relight/core/error.h"
 
 namespace {
@@ -40,6 +41,7 @@ std::string usage_problem(const CLI::App& app, const CLI::ParseError& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  relight::keep_freed_memory_for_reuse();
   CLI::App app{"relight: reconstruct a real scene from RGB-D, estimate its light and materials,\n"
                "and render virtual objects into it with differential instant radiosity."};
   app.require_subcommand(1);

@@ -6,8 +6,10 @@
 
 #include "bench.h"
 #include "bench_report.h"
+#include "relight/core/allocator_tuning.h"
 
 int main(int argc, char** argv) {
+  relight::keep_freed_memory_for_reuse();
   CLI::App app{"relight-bench: speed and quality of relight's stages against their baselines.\n"
                "Prints one JSON object per line per case."};
   bool list = false;
