@@ -71,21 +71,6 @@ Eigen::Vector3f phong_radiance(const ShadingLights& lights, const Eigen::Vector3
   return radiance;
 }
 
-float srgb8_to_linear(std::uint8_t value) { return srgb8_linear_table()[value]; }
-
-const std::array<float, 256>& srgb8_linear_table() {
-  static const std::array<float, 256> table = [] {
-    std::array<float, 256> t{};
-    for (int i = 0; i < 256; ++i) {
-      const double e = i / 255.0;
-      t[static_cast<std::size_t>(i)] =
-          static_cast<float>(e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4));
-    }
-    return t;
-  }();
-  return table;
-}
-
 RadianceImage linearize(const ColorImage& color) {
   RadianceImage out(color.width(), color.height());
   for (std::size_t i = 0; i < color.size(); ++i) {

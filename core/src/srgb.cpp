@@ -32,10 +32,12 @@ float linear_to_srgb(float linear) {
   return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.f / 2.4f) - 0.055f;
 }
 
-float srgb8_to_linear(std::uint8_t encoded) {
+const std::array<float, 256>& srgb8_linear_table() {
   static const std::array<float, 256> table = make_srgb8_table();
-  return table[encoded];
+  return table;
 }
+
+float srgb8_to_linear(std::uint8_t encoded) { return srgb8_linear_table()[encoded]; }
 
 Float3 decode_srgb8(const Rgb8& pixel) {
   return {srgb8_to_linear(pixel.r), srgb8_to_linear(pixel.g), srgb8_to_linear(pixel.b)};

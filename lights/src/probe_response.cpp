@@ -7,16 +7,12 @@
 #include <string>
 
 #include "relight/core/error.h"
+#include "relight/core/srgb.h"
 
 namespace relight::lights {
 
 std::array<std::array<float, 256>, 3> ProbeResponse::srgb_inverse() {
-  std::array<float, 256> channel{};
-  for (int code = 0; code < 256; ++code) {
-    const double c = code / 255.0;
-    channel[static_cast<std::size_t>(code)] =
-        static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-  }
+  const std::array<float, 256>& channel = srgb8_linear_table();
   return {channel, channel, channel};
 }
 

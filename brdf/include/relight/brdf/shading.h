@@ -24,6 +24,7 @@
 
 #include "relight/core/image.h"
 #include "relight/core/pose.h"
+#include "relight/core/srgb.h"
 #include "relight/lights/light_set.h"
 
 namespace relight::brdf {
@@ -75,10 +76,9 @@ struct LightAtPoint {
                                              const Eigen::Vector3f& normal, const Eigen::Vector3f& kd, float ks,
                                              float n);
 
-/// sRGB (IEC 61966-2-1) 8-bit value -> linear, through a 256-entry table.
-[[nodiscard]] float srgb8_to_linear(std::uint8_t value);
-/// That table, for loops over many pixels.
-[[nodiscard]] const std::array<float, 256>& srgb8_linear_table();
+/// sRGB (IEC 61966-2-1) 8-bit value -> linear, and its 256-entry table (core/srgb.h).
+using relight::srgb8_linear_table;
+using relight::srgb8_to_linear;
 /// The camera image as linear RGB (the inverse of synth::encode_color with exposure 1).
 [[nodiscard]] RadianceImage linearize(const ColorImage& color);
 
