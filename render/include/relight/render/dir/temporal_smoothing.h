@@ -31,6 +31,7 @@ struct TemporalOptions {
   float w_n = 1.f;
   float w_i = 0.025f;
   float c_b = 0.9f;
+  int threads = 0;  ///< 0: all cores (core/parallel.h)
 };
 
 struct TemporalHistory {
