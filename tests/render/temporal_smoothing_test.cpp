@@ -25,10 +25,11 @@ constexpr int kSize = 8;
 
 /// A wall at depth `depth` facing a camera at the origin (identity pose), every pixel real.
 GBuffer wall(float depth, const MrCamera& camera) {
-  GBuffer g{PositionMap(kSize, kSize), NormalMap(kSize, kSize), LabelImage(kSize, kSize), Mask(kSize, kSize),
-            DepthMap(kSize, kSize)};
-  for (int row = 0; row < kSize; ++row)
-    for (int col = 0; col < kSize; ++col) {
+  const int size = camera.intrinsics.width;
+  GBuffer g{PositionMap(size, size), NormalMap(size, size), LabelImage(size, size), Mask(size, size),
+            DepthMap(size, size)};
+  for (int row = 0; row < size; ++row)
+    for (int col = 0; col < size; ++col) {
       const Eigen::Vector3d ray = camera.intrinsics.ray(col, row);
       const Eigen::Vector3d p = ray * (depth / ray.z());
       g.position(row, col) = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
@@ -39,16 +40,17 @@ GBuffer wall(float depth, const MrCamera& camera) {
   return g;
 }
 
-DifferentialImages indirect(float value) {
-  DifferentialImages images{RadianceImage(kSize, kSize), RadianceImage(kSize, kSize), CoverageImage(kSize, kSize), 1,
-                            RadianceImage(kSize, kSize), RadianceImage(kSize, kSize)};
+DifferentialImages indirect(float value, int size = kSize) {
+  DifferentialImages images{RadianceImage(size, size), RadianceImage(size, size), CoverageImage(size, size), 1,
+                            RadianceImage(size, size), RadianceImage(size, size)};
   for (auto* image : {&images.real_virtual, &images.real, &images.indirect_real_virtual, &images.indirect_real})
     for (Float3& p : image->pixels()) p = {value, value, value};
   return images;
 }
 
-MrCamera small_camera() {
-  return {PinholeIntrinsics{8.0, 8.0, 3.5, 3.5, kSize, kSize}, Pose::Identity()};
+MrCamera small_camera(int size = kSize) {
+  const double f = size;
+  return {PinholeIntrinsics{f, f, (size - 1) / 2.0, (size - 1) / 2.0, size, size}, Pose::Identity()};
 }
 
 TEST(TemporalSmoothing, BlendsTheSameSurfaceWithConfidenceCb) {
@@ -62,6 +64,38 @@ TEST(TemporalSmoothing, BlendsTheSameSurfaceWithConfidenceCb) {
   // Same surface: eps_pos = eps_n = 0, eps_ill = 0.1^3 * 0.025: c ~ 0.9.
   EXPECT_NEAR(second.indirect_real(3, 3).x, 0.9f * 0.5f + 0.1f * 0.6f, 1e-4f);
   EXPECT_NEAR(second.real(3, 3).x, second.indirect_real(3, 3).x, 1e-6f) << "the total follows its indirect part";
+}
+
+// The rows run in parallel; every pixel reads the previous frame and writes only itself, so
+// one thread and several give the same images, bit for bit.
+TEST(TemporalSmoothing, ParallelRowsGiveTheSerialResult) {
+  constexpr int kLarge = 96;
+  const MrCamera before = small_camera(kLarge);
+  MrCamera after = before;
+  after.camera_to_world.translation() = Eigen::Vector3d(0.002, -0.001, 0.0);  // the camera moved a little
+  DifferentialImages first = indirect(0.5f, kLarge);
+  const TemporalHistory history = smooth_indirect(first, wall(2.f, before), before, nullptr);
+  const auto value = [](std::size_t i) { return 0.4f + 0.3f * static_cast<float>((i * 7919) % 101) / 101.f; };
+  const auto smoothed = [&](int threads) {
+    DifferentialImages next = indirect(0.f, kLarge);
+    for (std::size_t i = 0; i < next.indirect_real.size(); ++i) {
+      const float v = value(i);  // varies per pixel
+      next.indirect_real.pixels()[i] = {v, v, v};
+      next.indirect_real_virtual.pixels()[i] = {v, 0.5f * v, v};
+    }
+    TemporalOptions options;
+    options.threads = threads;
+    (void)smooth_indirect(next, wall(2.f, after), after, &history, options);
+    return next;
+  };
+  const DifferentialImages serial = smoothed(1), parallel = smoothed(2);
+  int blended = 0;
+  for (std::size_t i = 0; i < serial.indirect_real.size(); ++i) {
+    EXPECT_EQ(serial.indirect_real.pixels()[i], parallel.indirect_real.pixels()[i]) << i;
+    EXPECT_EQ(serial.real_virtual.pixels()[i], parallel.real_virtual.pixels()[i]) << i;
+    if (serial.indirect_real.pixels()[i].x != value(i)) ++blended;
+  }
+  EXPECT_GT(blended, kLarge * kLarge / 2) << "most pixels found their previous value";
 }
 
 TEST(TemporalSmoothing, TakesTheNewValueAtDisocclusionsAndWhereRealAndVirtualSwap) {
