@@ -7,6 +7,7 @@
 
 #include "relight/colormap/color_space.h"
 #include "relight/core/error.h"
+#include "relight/core/parallel.h"
 
 namespace relight::render {
 
@@ -44,7 +45,8 @@ colormap::VirtualLayer separated_layer(const CoverageImage& coverage, const Mask
     if (n == 0) return std::nullopt;
     return (1.f / float(n)) * sum;
   };
-  for (int row = 0; row < height; ++row) {
+  // Rows in parallel: a pixel reads its neighbours' inputs and writes only itself.
+  parallel_for_each_row(height, 0, [&](int row) {
     for (int col = 0; col < width; ++col) {
       const std::size_t i =
           static_cast<std::size_t>(row) * static_cast<std::size_t>(width) + static_cast<std::size_t>(col);
@@ -59,7 +61,7 @@ colormap::VirtualLayer separated_layer(const CoverageImage& coverage, const Mask
       layer.virtual_color.pixels()[i] = c * v;
       layer.delta.pixels()[i] = (1.f - c) * d;
     }
-  }
+  });
   return layer;
 }
 
