@@ -240,7 +240,7 @@ struct DirRendererVk::Impl {
   std::vector<std::uint32_t> texture_headers;                     // kTexturesPerMaterial per material
   vk::UniqueDescriptorSet shade_set;
   std::array<vk::GpuTimer, 6> timers;
-  std::optional<MrScene> scene;
+  std::optional<MrScene> scene;  ///< the last set_scene's materials, lights and environment (no meshes)
   ShadowLayout layout;
   IsmPointPools points;
   DirVkTimings timings;
@@ -296,7 +296,9 @@ void DirRendererVk::set_scene(const MrScene& scene, const DirRenderOptions& opti
   d.upload(d.materials, pack_materials(scene, d.texture_headers));
   d.upload(d.lights, pack_lights(scene, d.layout));
   d.upload(d.views, pack_views(d.layout));
-  d.scene = scene;
+  // Kept for the shading, which reads the materials, lights and environment; the meshes are on
+  // the device already (copying them would copy the whole reconstruction every frame).
+  d.scene = MrScene{scene.materials, {}, scene.lights, scene.environment};
 }
 
 DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const Vpl> vpls, const DirRenderOptions& options) {
