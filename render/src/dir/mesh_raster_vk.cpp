@@ -37,6 +37,34 @@ void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, Mes
   out.count = static_cast<std::uint32_t>(vertices.size());
 }
 
+void upload_scene_positions(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers, ScenePositions& out) {
+  scene.validate();
+  std::size_t vertex_count = 0, index_count = 0;
+  for (const TriangleMesh& mesh : scene.meshes) {
+    if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
+    vertex_count += mesh.positions.size();
+    index_count += 3 * mesh.triangles.size();
+  }
+  std::vector<float> positions;
+  std::vector<std::uint32_t> indices;
+  positions.reserve(3 * vertex_count);
+  indices.reserve(index_count);
+  for (const TriangleMesh& mesh : scene.meshes) {
+    if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
+    const auto base = static_cast<std::uint32_t>(positions.size() / 3);
+    for (const Eigen::Vector3f& p : mesh.positions) positions.insert(positions.end(), {p.x(), p.y(), p.z()});
+    for (const auto& tri : mesh.triangles)
+      for (std::uint32_t v : tri) indices.push_back(base + v);
+  }
+  vk::reserve_with_headroom(out.positions, context, std::max<std::size_t>(4, positions.size() * sizeof(float)),
+                            vk::BufferDomain::Upload, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  vk::reserve_with_headroom(out.indices, context, std::max<std::size_t>(4, indices.size() * sizeof(std::uint32_t)),
+                            vk::BufferDomain::Upload, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+  if (!positions.empty()) out.positions->write(std::as_bytes(std::span(positions)));
+  if (!indices.empty()) out.indices->write(std::as_bytes(std::span(indices)));
+  out.index_count = static_cast<std::uint32_t>(indices.size());
+}
+
 vk::UniqueRenderPass create_raster_pass(VkDevice device, std::span<const VkFormat> colour_formats, VkFormat depth_format) {
   std::vector<VkAttachmentDescription> attachments;
   std::vector<VkAttachmentReference> colour;
@@ -122,9 +150,13 @@ MeshPipeline create_mesh_pipeline(VkDevice device, const MeshPipelineInfo& info)
       {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO, nullptr, 0, VK_SHADER_STAGE_FRAGMENT_BIT,
        out.fragment_shader.get(), "main", nullptr},
   }};
-  const VkVertexInputBindingDescription binding{0, sizeof(RasterVertex), VK_VERTEX_INPUT_RATE_VERTEX};
+  const VkVertexInputBindingDescription binding{0,
+                                                info.position_only ? static_cast<std::uint32_t>(3 * sizeof(float))
+                                                                   : static_cast<std::uint32_t>(sizeof(RasterVertex)),
+                                                VK_VERTEX_INPUT_RATE_VERTEX};
   const std::array<VkVertexInputAttributeDescription, 4> attributes{{
-      {0, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(RasterVertex, position)},
+      {0, 0, VK_FORMAT_R32G32B32_SFLOAT,
+       info.position_only ? 0u : static_cast<std::uint32_t>(offsetof(RasterVertex, position))},
       {1, 0, VK_FORMAT_R32G32B32_SFLOAT, offsetof(RasterVertex, normal)},
       {2, 0, VK_FORMAT_R32_UINT, offsetof(RasterVertex, info)},
       {3, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(RasterVertex, texcoord)},
@@ -189,9 +221,11 @@ MeshPipeline create_mesh_pipeline(VkDevice device, const MeshPipelineInfo& info)
   return out;
 }
 
-void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const SceneVertices& vertices,
-                std::span<const std::byte> constants, const VkRect2D& area) {
-  if (vertices.count == 0) return;
+namespace {
+
+/// Binds `pipeline` and sets the viewport, scissor and push constants of a draw into `area`.
+void begin_draw(VkCommandBuffer cmd, const MeshPipeline& pipeline, std::span<const std::byte> constants,
+                const VkRect2D& area) {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
   const VkViewport viewport{static_cast<float>(area.offset.x), static_cast<float>(area.offset.y),
                             static_cast<float>(area.extent.width), static_cast<float>(area.extent.height), 0.f, 1.f};
@@ -200,10 +234,29 @@ void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const SceneVe
   if (!constants.empty())
     vkCmdPushConstants(cmd, pipeline.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                        static_cast<std::uint32_t>(constants.size()), constants.data());
+}
+
+}  // namespace
+
+void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const SceneVertices& vertices,
+                std::span<const std::byte> constants, const VkRect2D& area) {
+  if (vertices.count == 0) return;
+  begin_draw(cmd, pipeline, constants, area);
   const VkBuffer buffer = vertices.buffer->handle();
   const VkDeviceSize offset = 0;
   vkCmdBindVertexBuffers(cmd, 0, 1, &buffer, &offset);
   vkCmdDraw(cmd, vertices.count, 1, 0, 0);
+}
+
+void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const ScenePositions& positions,
+                std::span<const std::byte> constants, const VkRect2D& area) {
+  if (positions.index_count == 0) return;
+  begin_draw(cmd, pipeline, constants, area);
+  const VkBuffer buffer = positions.positions->handle();
+  const VkDeviceSize offset = 0;
+  vkCmdBindVertexBuffers(cmd, 0, 1, &buffer, &offset);
+  vkCmdBindIndexBuffer(cmd, positions.indices->handle(), 0, VK_INDEX_TYPE_UINT32);
+  vkCmdDrawIndexed(cmd, positions.index_count, 1, 0, 0, 0);
 }
 
 }  // namespace relight::render::detail

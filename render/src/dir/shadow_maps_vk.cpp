@@ -31,8 +31,8 @@ ShadowMapsVk::ShadowMapsVk(vk::VulkanContext& context)
                                                         .position_only = true})) {}
 
 void ShadowMapsVk::set_scene(const MrScene& scene) {
-  upload_scene_vertices(context_, scene, MeshLayers::Real, real_vertices_);
-  upload_scene_vertices(context_, scene, MeshLayers::Virtual, virtual_vertices_);
+  upload_scene_positions(context_, scene, MeshLayers::Real, real_positions_);
+  upload_scene_positions(context_, scene, MeshLayers::Virtual, virtual_positions_);
 }
 
 void ShadowMapsVk::ensure_targets(int width, int height) {
@@ -71,7 +71,7 @@ void ShadowMapsVk::record(VkCommandBuffer cmd, const ShadowLayout& layout) {
       std::memcpy(constants.eye, layout.view(v, layer).eye.data(), sizeof constants.eye);
       const auto [x, y] = layout.tile_origin(static_cast<int>(v), layer);
       const VkRect2D area{{x, y}, {tile, tile}};
-      draw_scene(cmd, pipeline_, layer == 0 ? real_vertices_ : virtual_vertices_,
+      draw_scene(cmd, pipeline_, layer == 0 ? real_positions_ : virtual_positions_,
                  std::as_bytes(std::span(&constants, 1)), area);
     }
   }

@@ -35,7 +35,7 @@ class ShadowMapsVk {
   vk::VulkanContext& context_;
   vk::UniqueRenderPass render_pass_;
   MeshPipeline pipeline_;
-  SceneVertices real_vertices_, virtual_vertices_;
+  ScenePositions real_positions_, virtual_positions_;
   std::optional<Targets> targets_;
   std::unique_ptr<vk::VulkanBuffer> atlas_buffer_;
 };
