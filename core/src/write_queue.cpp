@@ -1,7 +1,7 @@
 #include "relight/core/write_queue.h"
 
-#include <pthread.h>
-#include <sched.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include <oneapi/tbb/task_arena.h>
 
@@ -11,16 +11,7 @@
 namespace relight {
 
 WriteQueue::WriteQueue(std::size_t capacity)
-    : capacity_(std::max<std::size_t>(capacity, 1)), worker_([this] { work(); }) {
-#ifdef __linux__
-  // The worker takes only CPU time the pipeline leaves idle: at normal priority it competed with
-  // the parallel loops and lavapipe's threads on two cores and made the frame slower, not faster
-  // (pipeline/replay_640x480: 719 ms serial, 880-930 ms with the writer at normal priority). A
-  // full queue still makes room: push() then waits, and the idle core runs the worker.
-  sched_param idle{};
-  (void)pthread_setschedparam(worker_.native_handle(), SCHED_IDLE, &idle);
-#endif
-}
+    : capacity_(std::max<std::size_t>(capacity, 1)), worker_([this] { work(); }) {}
 
 WriteQueue::~WriteQueue() {
   {
@@ -60,6 +51,13 @@ std::size_t WriteQueue::peak_depth() const {
 }
 
 void WriteQueue::work() {
+#ifdef __linux__
+  // Niced: the worker yields to the pipeline's own threads (at the same priority it competed with
+  // the parallel loops and lavapipe's threads on two cores), yet keeps a share of a busy machine
+  // (SCHED_IDLE would starve it - and, through the queue's back-pressure, the pipeline - while
+  // anything else runs, e.g. a build). A full queue makes room: push() then waits.
+  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), 10);
+#endif
   std::unique_lock lock(mutex_);
   while (true) {
     changed_.wait(lock, [this] { return !jobs_.empty() || stopping_; });
