@@ -9,12 +9,19 @@
 #include "relight/vk/storage_buffer_sets.h"  // create_shader_module
 
 namespace relight::render::detail {
+namespace {
+
+bool in_layers(const TriangleMesh& mesh, MeshLayers layers) {
+  return layers == MeshLayers::All || mesh.real == (layers == MeshLayers::Real);
+}
+
+}  // namespace
 
 void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers, SceneVertices& out) {
   scene.validate();
   std::vector<RasterVertex> vertices;
   for (const TriangleMesh& mesh : scene.meshes) {
-    if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
+    if (!in_layers(mesh, layers)) continue;
     const bool textured = !mesh.texcoords.empty();
     for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
       const std::uint32_t info =
@@ -41,7 +48,7 @@ void upload_scene_positions(vk::VulkanContext& context, const MrScene& scene, Me
   scene.validate();
   std::size_t vertex_count = 0, index_count = 0;
   for (const TriangleMesh& mesh : scene.meshes) {
-    if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
+    if (!in_layers(mesh, layers)) continue;
     vertex_count += mesh.positions.size();
     index_count += 3 * mesh.triangles.size();
   }
@@ -50,7 +57,7 @@ void upload_scene_positions(vk::VulkanContext& context, const MrScene& scene, Me
   positions.reserve(3 * vertex_count);
   indices.reserve(index_count);
   for (const TriangleMesh& mesh : scene.meshes) {
-    if ((layers == MeshLayers::Real && !mesh.real) || (layers == MeshLayers::Virtual && mesh.real)) continue;
+    if (!in_layers(mesh, layers)) continue;
     const auto base = static_cast<std::uint32_t>(positions.size() / 3);
     for (const Eigen::Vector3f& p : mesh.positions) positions.insert(positions.end(), {p.x(), p.y(), p.z()});
     for (const auto& tri : mesh.triangles)
@@ -223,9 +230,10 @@ MeshPipeline create_mesh_pipeline(VkDevice device, const MeshPipelineInfo& info)
 
 namespace {
 
-/// Binds `pipeline` and sets the viewport, scissor and push constants of a draw into `area`.
-void begin_draw(VkCommandBuffer cmd, const MeshPipeline& pipeline, std::span<const std::byte> constants,
-                const VkRect2D& area) {
+/// Binds `pipeline` and `vertex_buffer` and sets the viewport, scissor and push constants of a
+/// draw into `area`.
+void begin_draw(VkCommandBuffer cmd, const MeshPipeline& pipeline, VkBuffer vertex_buffer,
+                std::span<const std::byte> constants, const VkRect2D& area) {
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, pipeline.pipeline.get());
   const VkViewport viewport{static_cast<float>(area.offset.x), static_cast<float>(area.offset.y),
                             static_cast<float>(area.extent.width), static_cast<float>(area.extent.height), 0.f, 1.f};
@@ -234,6 +242,8 @@ void begin_draw(VkCommandBuffer cmd, const MeshPipeline& pipeline, std::span<con
   if (!constants.empty())
     vkCmdPushConstants(cmd, pipeline.layout.get(), VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
                        static_cast<std::uint32_t>(constants.size()), constants.data());
+  const VkDeviceSize offset = 0;
+  vkCmdBindVertexBuffers(cmd, 0, 1, &vertex_buffer, &offset);
 }
 
 }  // namespace
@@ -241,20 +251,14 @@ void begin_draw(VkCommandBuffer cmd, const MeshPipeline& pipeline, std::span<con
 void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const SceneVertices& vertices,
                 std::span<const std::byte> constants, const VkRect2D& area) {
   if (vertices.count == 0) return;
-  begin_draw(cmd, pipeline, constants, area);
-  const VkBuffer buffer = vertices.buffer->handle();
-  const VkDeviceSize offset = 0;
-  vkCmdBindVertexBuffers(cmd, 0, 1, &buffer, &offset);
+  begin_draw(cmd, pipeline, vertices.buffer->handle(), constants, area);
   vkCmdDraw(cmd, vertices.count, 1, 0, 0);
 }
 
 void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const ScenePositions& positions,
                 std::span<const std::byte> constants, const VkRect2D& area) {
   if (positions.index_count == 0) return;
-  begin_draw(cmd, pipeline, constants, area);
-  const VkBuffer buffer = positions.positions->handle();
-  const VkDeviceSize offset = 0;
-  vkCmdBindVertexBuffers(cmd, 0, 1, &buffer, &offset);
+  begin_draw(cmd, pipeline, positions.positions->handle(), constants, area);
   vkCmdBindIndexBuffer(cmd, positions.indices->handle(), 0, VK_INDEX_TYPE_UINT32);
   vkCmdDrawIndexed(cmd, positions.index_count, 1, 0, 0, 0);
 }
