@@ -76,7 +76,7 @@ layout(push_constant) uniform Params {
 // surface_phong() (mr_scene.h): the material's Phong parameters where its metallic-roughness
 // texture reads `mr` (G roughness, B metallic), through phong_from_metallic_roughness().
 Material surface_material(Material m, vec3 mr) {
-  if (floatBitsToUint(m.texture.z) == 0xffffffffu) return m;
+  if (floatBitsToUint(m.texture.z) == NO_TEXTURE) return m;
   const float metallic = clamp(m.pbr.w * mr.z, 0.0, 1.0), roughness = clamp(m.texture.w * mr.y, 0.0, 1.0);
   const vec3 base = m.pbr.xyz;
   m.kd_ks.xyz = base * (1.0 - metallic);
@@ -170,7 +170,7 @@ void main() {
   const uint normal_header = floatBitsToUint(material.normal_map.x);
   vec3 tangent;
   float handedness;
-  if (normal_header != 0xffffffffu && decode_tangent(t.w, n, tangent, handedness))
+  if (normal_header != NO_TEXTURE && decode_tangent(t.w, n, tangent, handedness))
     n = mapped_normal(n, tangent, handedness, material_texture(normal_header, t), material.normal_map.y);
   const vec3 kd_texture = material_texture(floatBitsToUint(own.texture.x), t);
   Material m = own;  // textured: for the direct light

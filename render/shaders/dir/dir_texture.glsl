@@ -28,7 +28,8 @@ int wrapped_texel(int i, int size, uint wrap) {
   return ((i % size) + size) % size;
 }
 
-const uint TEXTURE_HEADER = 12u;  // kTextureHeaderWords (dir_vk.cpp)
+const uint TEXTURE_HEADER = 12u;     // kTextureHeaderWords (dir_vk.cpp)
+const uint NO_TEXTURE = 0xffffffffu;  // kNoTexture (dir_vk.cpp): a material slot without a texture
 
 // UvTransform::apply.
 vec2 texture_transform(uint header, vec2 uv) {
@@ -84,6 +85,6 @@ vec3 texture_sample(uint header, vec2 coordinates, float lod) {
 // texture_factors() (gbuffer.h) at one pixel: 1 without a texture (header 0xffffffff), the
 // texture's mean where the G-buffer's footprint (texcoord.z) marks no coordinates.
 vec3 material_texture(uint header, vec4 texcoord) {
-  if (header == 0xffffffffu) return vec3(1.0);
+  if (header == NO_TEXTURE) return vec3(1.0);
   return texcoord.z > 0.0 ? texture_sample(header, texcoord.xy, texture_level(header, texcoord.z)) : texture_mean(header);
 }

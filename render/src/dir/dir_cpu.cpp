@@ -211,13 +211,16 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
         const Vec3 point(p.x, p.y, p.z), normal(nn.x, nn.y, nn.z);
         const float real_pixel = gbuffer.virtual_surface(y, x) ? 0.f : 1.f;
         const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));
-        const Float3 t = kd_texture.empty() ? Float3{1.f, 1.f, 1.f} : kd_texture(y, x);
-        const Float3 e = emission_texture.empty() ? Float3{1.f, 1.f, 1.f} : emission_texture(y, x);
-        const Float3 mr = metallic_roughness.empty() ? Float3{1.f, 1.f, 1.f} : metallic_roughness(y, x);
+        // texture_factors() is empty where no material has that texture: the factor is 1.
+        const auto factor = [x, y](const RadianceImage& factors) {
+          if (factors.empty()) return Vec3::Ones().eval();
+          const Float3& f = factors(y, x);
+          return Vec3(f.x, f.y, f.z);
+        };
         const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
         shaded(y, x) = shader.shade(point, normal, (camera_centre - point).normalized(),
-                                    surface_phong(material, Vec3(mr.x, mr.y, mr.z)), Vec3(t.x, t.y, t.z),
-                                    material.emission.cwiseProduct(Vec3(e.x, e.y, e.z)), real_pixel, subset);
+                                    surface_phong(material, factor(metallic_roughness)), factor(kd_texture),
+                                    material.emission.cwiseProduct(factor(emission_texture)), real_pixel, subset);
       }
   }, 4);
   DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,

@@ -64,10 +64,11 @@ NormalMap shading_normals(const GBuffer& gbuffer, const MrScene& scene) {
     const std::uint16_t label = gbuffer.material.pixels()[i];
     if (label == 0) continue;
     const PhongMaterial& material = scene.materials.at(label - 1u);
+    if (!material.normal_texture) continue;
     const Float3& n = gbuffer.normal.pixels()[i];
     const Eigen::Vector3f normal(n.x, n.y, n.z);
     const std::optional<TangentFrame> frame = decode_tangent(gbuffer.tangent.pixels()[i], normal);
-    if (!material.normal_texture || !frame) continue;
+    if (!frame) continue;
     const Float3& t = texels.pixels()[i];
     const Eigen::Vector3f bent = mapped_normal(normal, *frame, Eigen::Vector3f(t.x, t.y, t.z), material.normal_scale);
     out.pixels()[i] = {bent.x(), bent.y(), bent.z()};

@@ -106,21 +106,24 @@ void add_texcoords(const TriangleMesh& mesh, const std::array<std::uint32_t, 3>&
   hit.texcoord_gradient = differences * gram.inverse() * edges;
 }
 
+/// texture_at() at a hit: at its coordinates, or the texture's mean where it has none.
+Eigen::Vector3f texture_at_hit(const std::shared_ptr<const Texture>& texture, const SurfaceHit& hit, float lod = 0.f) {
+  return texture_at(texture.get(), hit.has_texcoord ? &hit.texcoord : nullptr, lod);
+}
+
 }  // namespace
 
 Eigen::Vector3f base_color_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
-  return texture_at(scene.materials[hit.material].base_color.get(), hit.has_texcoord ? &hit.texcoord : nullptr, lod);
+  return texture_at_hit(scene.materials[hit.material].base_color, hit, lod);
 }
 
 Eigen::Vector3f emission_at(const MrScene& scene, const SurfaceHit& hit) {
   const PhongMaterial& material = scene.materials[hit.material];
-  return material.emission.cwiseProduct(
-      texture_at(material.emission_texture.get(), hit.has_texcoord ? &hit.texcoord : nullptr));
+  return material.emission.cwiseProduct(texture_at_hit(material.emission_texture, hit));
 }
 
 Eigen::Vector3f metallic_roughness_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
-  return texture_at(scene.materials[hit.material].metallic_roughness_texture.get(),
-                    hit.has_texcoord ? &hit.texcoord : nullptr, lod);
+  return texture_at_hit(scene.materials[hit.material].metallic_roughness_texture, hit, lod);
 }
 
 Phong phong_at(const MrScene& scene, const SurfaceHit& hit, float lod) {
@@ -197,9 +200,8 @@ std::optional<SurfaceHit> RayTracer::intersect(Layer which, const Eigen::Vector3
     const PhongMaterial& material = impl_->scene.materials[hit.material];
     if (material.normal_texture) {
       if (const std::optional<TangentFrame> frame = tangent_frame(hit.texcoord_gradient, hit.interpolated_normal))
-        hit.shading_normal =
-            mapped_normal(hit.interpolated_normal, *frame,
-                          material.normal_texture->sample(hit.texcoord.x(), hit.texcoord.y()), material.normal_scale);
+        hit.shading_normal = mapped_normal(hit.interpolated_normal, *frame,
+                                           texture_at_hit(material.normal_texture, hit), material.normal_scale);
     }
   }
   return hit;

@@ -28,13 +28,19 @@ float number(const Value& object, const char* key, float fallback) {
                                                        : fallback;
 }
 
-/// A texture reference's KHR_texture_transform (identity without one) and its TEXCOORD set (the
-/// extension's texCoord overrides the reference's).
+/// A texture reference's KHR_texture_transform object, or null without one.
+template <typename Info>
+const Value* texture_transform_of(const Info& info) {
+  const auto found = info.extensions.find("KHR_texture_transform");
+  return found != info.extensions.end() && found->second.IsObject() ? &found->second : nullptr;
+}
+
+/// A texture reference's KHR_texture_transform (identity without one).
 template <typename Info>
 UvTransform uv_transform(const Info& info) {
-  const auto found = info.extensions.find("KHR_texture_transform");
-  if (found == info.extensions.end() || !found->second.IsObject()) return {};
-  const Value& t = found->second;
+  const Value* transform = texture_transform_of(info);
+  if (!transform) return {};
+  const Value& t = *transform;
   const auto pair = [&t](const char* key, Eigen::Vector2f fallback) {
     if (!t.Has(key) || !t.Get(key).IsArray() || t.Get(key).ArrayLen() != 2) return fallback;
     for (int i = 0; i < 2; ++i)
@@ -45,12 +51,12 @@ UvTransform uv_transform(const Info& info) {
                            pair("scale", Eigen::Vector2f::Ones()));
 }
 
+/// A texture reference's TEXCOORD set: the extension's texCoord overrides the reference's.
 template <typename Info>
 int texcoord_set_of(const Info& info) {
-  const auto found = info.extensions.find("KHR_texture_transform");
-  if (found != info.extensions.end() && found->second.IsObject() && found->second.Has("texCoord") &&
-      found->second.Get("texCoord").IsInt())
-    return found->second.Get("texCoord").GetNumberAsInt();
+  const Value* transform = texture_transform_of(info);
+  if (transform && transform->Has("texCoord") && transform->Get("texCoord").IsInt())
+    return transform->Get("texCoord").GetNumberAsInt();
   return info.texCoord;
 }
 
