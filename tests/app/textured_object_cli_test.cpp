@@ -1,7 +1,7 @@
 // `relight replay` with a textured glTF object (data/models/box_textured.gltf, the Cesium logo on
 // a cube): the composite shows the texture on the object, an untextured copy of the same model
-// shows flat faces, the logo as a normal texture bends the shading, and a model whose texture
-// cannot be decoded is one error line.
+// shows flat faces, the logo as a normal texture bends the shading and as a metallic-roughness
+// texture varies the material, and a model whose texture cannot be decoded is one error line.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -100,6 +100,25 @@ TEST(TexturedObjectCli, ANormalTextureBendsTheShading) {
   const auto detail = detail_against_flat(dir, dir.path() / "bumped.gltf", "normal-mapped");
   ASSERT_TRUE(detail);
   EXPECT_GT(detail->first, 2.0 * detail->second + 0.5);  // measured 17.3 against 2.9
+}
+
+// The flat box with the logo as its metallic-roughness texture (the logo's blue metallic, its
+// green rough): k_d, k_s and n change across the faces.
+TEST(TexturedObjectCli, AMetallicRoughnessTextureVariesTheMaterial) {
+  test::TempDir dir;
+  std::string varied = untextured_box();
+  const std::size_t pbr = varied.find("\"pbrMetallicRoughness\": {");
+  ASSERT_NE(pbr, std::string::npos);
+  varied.insert(pbr + std::string("\"pbrMetallicRoughness\": {").size(),
+                "\"metallicRoughnessTexture\": {\"index\": 0}, ");
+  // metallicFactor 0 would zero the texture's metallic: let the texture decide.
+  const std::size_t factor = varied.find("\"metallicFactor\": 0.0");
+  ASSERT_NE(factor, std::string::npos);
+  varied.replace(factor, std::string("\"metallicFactor\": 0.0").size(), "\"metallicFactor\": 1.0");
+  write_file_atomically(dir.path() / "varied.gltf", varied);
+  const auto detail = detail_against_flat(dir, dir.path() / "varied.gltf", "metallic-roughness");
+  ASSERT_TRUE(detail);
+  EXPECT_GT(detail->first, 2.0 * detail->second + 0.5);
 }
 
 TEST(TexturedObjectCli, AnUndecodableTextureIsOneErrorLine) {
