@@ -142,6 +142,13 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                      "Indirect bounces the VPLs carry: 1 = light reflected once, 2 adds VPLs lit by VPLs")
       ->check(CLI::Range(1, 4))
       ->capture_default_str();
+  command
+      .add_option("--shadow-caster-stride", options.shadow_caster_stride,
+                  "Grid stride of the reconstruction as it casts the real lights' shadow maps, in pixels at 640 "
+                  "pixels across (scaled with the width): a coarser grid than the rendered mesh's (2) is still "
+                  "about as fine as a shadow-map texel and far cheaper to rasterise; 2 or less: the rendered mesh")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
   add_choice_option(command, "--bounce-method", options.bounce_method, render::kBounceMethodNames,
                     "How bounces after the first find their surface: rays (ray traced) or cone (the nearest of "
                     "the surface points within 5 degrees of the sampled direction, no ray tracing)");

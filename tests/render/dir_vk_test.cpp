@@ -134,6 +134,52 @@ TEST_F(DirVkTest, ShadowAtlasMatchesTheRayCastReference) {
   EXPECT_LT(coverage_mismatch, cpu.size() / 100);
 }
 
+// MrScene::real_shadow_casters replace the real meshes in the real layer of the shadow maps and
+// nowhere else: here a roof over the room, which only the real layer's views see.
+TEST_F(DirVkTest, ShadowCastersStandInForTheRealLayer) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  MrScene scene = test::indoor_with_pebble();
+  MrLight sun;
+  sun.kind = LightKind::Directional;
+  sun.direction = Eigen::Vector3f(0.2f, -0.1f, 1.f).normalized();
+  scene.lights = {sun};
+  TriangleMesh roof;
+  roof.name = "roof";
+  roof.positions = {{-10.f, -10.f, 2.5f}, {10.f, -10.f, 2.5f}, {10.f, 10.f, 2.5f}, {-10.f, 10.f, 2.5f}};
+  roof.triangles = {{0, 1, 2}, {0, 2, 3}};
+  roof.triangle_material = {0, 0};
+  scene.real_shadow_casters = {roof};
+  DirRenderOptions options = test_options();
+  options.shadow_tile = 64;
+  DirRendererVk renderer(context, 32, 24);
+  renderer.set_scene(scene, options);
+  (void)renderer.render(camera_at({1.3, -1.1, 1.4}, {0.2, -0.1, 0.75}, 32, 24), {}, options);
+  const ShadowLayout& layout = renderer.shadow_layout();
+  const std::vector<float> gpu = renderer.last_shadow_atlas();
+  const std::vector<float> cpu = shadow_atlas_cpu(RayTracer(shadow_caster_scene(scene)), layout);
+  const std::vector<float> without =
+      shadow_atlas_cpu(RayTracer(MrScene{scene.materials, scene.meshes, scene.lights, {}, {}}), layout);
+  ASSERT_EQ(gpu.size(), cpu.size());
+  const std::size_t half = cpu.size() / 2;  // the real layer's rows, then the virtual layer's
+  std::size_t real_agree = 0, real_differs_from_meshes = 0, virtual_agree = 0;
+  for (std::size_t i = 0; i < cpu.size(); ++i) {
+    const bool agree = (gpu[i] >= kShadowEmpty && cpu[i] >= kShadowEmpty) ||
+                       std::abs(gpu[i] - cpu[i]) <= 0.01f * std::abs(cpu[i]) + 0.005f;
+    if (i < half) {
+      real_agree += agree ? 1 : 0;
+      real_differs_from_meshes += std::abs(gpu[i] - without[i]) > 0.1f ? 1 : 0;
+    } else {
+      virtual_agree += agree && cpu[i] == without[i] ? 1 : 0;
+    }
+  }
+  EXPECT_GT(real_agree, half * 99 / 100) << "the rasterised real layer is the roof's";
+  EXPECT_GT(real_differs_from_meshes, half * 9 / 10) << "...not the room's";
+  EXPECT_GT(virtual_agree, half * 99 / 100) << "the virtual layer is the pebble's, as without stand-ins";
+  MrScene virtual_caster = scene;
+  virtual_caster.real_shadow_casters.front().real = false;
+  EXPECT_THROW(virtual_caster.validate(), Error);
+}
+
 /// The cube scene with a sun that reaches it through its emitter VPL (vpl.h).
 MrScene cube_scene_with_emitter() {
   MrScene scene = cube_scene();

@@ -1,5 +1,8 @@
 #include "relight/render/dir/dir_stage.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "relight/colormap/buffers.h"
 #include "relight/colormap/tone_map_stage.h"
 #include "relight/core/error.h"
@@ -64,6 +67,7 @@ DirStages add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* 
 MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& options)
     : content_(std::move(content)),
       mesh_(options.mesh),
+      shadow_caster_stride_(options.shadow_caster_stride),
       reconstruction_material_(options.reconstruction_material),
       environment_(options.environment),
       materials_buffer_(options.materials_buffer),
@@ -99,6 +103,21 @@ void MrSceneStage::run(StageContext& context) {
   scene.lights.insert(scene.lights.end(), content_.lights.begin(), content_.lights.end());
   if (environment_ == EnvironmentLight::Vpls)
     for (MrLight& light : scene.lights) light.through_vpl = light.kind == LightKind::Directional;
+  // Coarser stand-ins for the reconstruction in the shadow maps, when a light is shadow-mapped.
+  const bool shadow_mapped = std::ranges::any_of(scene.lights, [](const MrLight& l) { return !l.through_vpl; });
+  const auto caster_stride =
+      static_cast<int>(std::lround(shadow_caster_stride_ * static_cast<double>(positions.width()) / 640.0));
+  if (caster_stride > mesh_.stride && shadow_mapped) {
+    // The edge rule scaled with the grid step, so that the stand-in drops the same slopes (depth
+    // discontinuities) as the rendered mesh, no more and no fewer.
+    const float scale = static_cast<float>(caster_stride) / static_cast<float>(std::max(mesh_.stride, 1));
+    DepthMeshOptions casters = mesh_;
+    casters.stride = caster_stride;
+    casters.relative_edge *= scale;
+    casters.min_edge *= scale;
+    scene.real_shadow_casters.push_back(mesh_from_positions(positions, nullptr, camera_to_world, materials, casters));
+    scene.real_shadow_casters.back().name = "reconstruction (shadow casters)";
+  }
   if (!placements_buffer_) {
     for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
     return;

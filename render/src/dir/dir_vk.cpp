@@ -298,7 +298,7 @@ void DirRendererVk::set_scene(const MrScene& scene, const DirRenderOptions& opti
   d.upload(d.views, pack_views(d.layout));
   // Kept for the shading, which reads the materials, lights and environment; the meshes are on
   // the device already (copying them would copy the whole reconstruction every frame).
-  d.scene = MrScene{scene.materials, {}, scene.lights, scene.environment};
+  d.scene = MrScene{scene.materials, {}, scene.lights, scene.environment, {}};
 }
 
 DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const Vpl> vpls, const DirRenderOptions& options) {

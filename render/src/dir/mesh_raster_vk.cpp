@@ -44,10 +44,10 @@ void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, Mes
   out.count = static_cast<std::uint32_t>(vertices.size());
 }
 
-void upload_scene_positions(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers, ScenePositions& out) {
-  scene.validate();
+void upload_scene_positions(vk::VulkanContext& context, std::span<const TriangleMesh> meshes, MeshLayers layers,
+                            ScenePositions& out) {
   std::size_t vertex_count = 0, index_count = 0;
-  for (const TriangleMesh& mesh : scene.meshes) {
+  for (const TriangleMesh& mesh : meshes) {
     if (!in_layers(mesh, layers)) continue;
     vertex_count += mesh.positions.size();
     index_count += 3 * mesh.triangles.size();
@@ -56,7 +56,7 @@ void upload_scene_positions(vk::VulkanContext& context, const MrScene& scene, Me
   std::vector<std::uint32_t> indices;
   positions.reserve(3 * vertex_count);
   indices.reserve(index_count);
-  for (const TriangleMesh& mesh : scene.meshes) {
+  for (const TriangleMesh& mesh : meshes) {
     if (!in_layers(mesh, layers)) continue;
     const auto base = static_cast<std::uint32_t>(positions.size() / 3);
     for (const Eigen::Vector3f& p : mesh.positions) positions.insert(positions.end(), {p.x(), p.y(), p.z()});

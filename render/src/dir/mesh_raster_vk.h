@@ -56,7 +56,8 @@ struct ScenePositions {
   std::optional<vk::VulkanBuffer> positions, indices;
   std::uint32_t index_count = 0;
 };
-void upload_scene_positions(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers,
+/// `meshes` must be valid (MrScene::validate()).
+void upload_scene_positions(vk::VulkanContext& context, std::span<const TriangleMesh> meshes, MeshLayers layers,
                             ScenePositions& positions);
 
 /// Colour targets cleared and left in TRANSFER_SRC_OPTIMAL for a copy to a buffer; depth cleared

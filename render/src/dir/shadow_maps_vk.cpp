@@ -31,8 +31,10 @@ ShadowMapsVk::ShadowMapsVk(vk::VulkanContext& context)
                                                         .position_only = true})) {}
 
 void ShadowMapsVk::set_scene(const MrScene& scene) {
-  upload_scene_positions(context_, scene, MeshLayers::Real, real_positions_);
-  upload_scene_positions(context_, scene, MeshLayers::Virtual, virtual_positions_);
+  // The real layer's occluders: the scene's stand-ins when it has them (mr_scene.h).
+  upload_scene_positions(context_, scene.real_shadow_casters.empty() ? scene.meshes : scene.real_shadow_casters,
+                         MeshLayers::Real, real_positions_);
+  upload_scene_positions(context_, scene.meshes, MeshLayers::Virtual, virtual_positions_);
 }
 
 void ShadowMapsVk::ensure_targets(int width, int height) {

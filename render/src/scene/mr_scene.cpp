@@ -91,6 +91,10 @@ void validate_mesh(const TriangleMesh& mesh, std::size_t material_count) {
 
 void MrScene::validate() const {
   for (const TriangleMesh& mesh : meshes) validate_mesh(mesh, materials.size());
+  for (const TriangleMesh& caster : real_shadow_casters) {
+    validate_mesh(caster, materials.size());
+    if (!caster.real) throw Error("shadow caster '" + caster.name + "' is virtual: only real meshes have stand-ins");
+  }
   for (const PhongMaterial& material : materials)
     if (!material.kd.allFinite() || !std::isfinite(material.ks) || !std::isfinite(material.n) || material.n < 0.f ||
         !material.emission.allFinite())

@@ -8,7 +8,8 @@
 //                                   ObjectPlacements when `placements_buffer` is set,
 //                                   lights::LightSet when `real_lights_buffer` is set
 //                            writes MrScene "mr_scene": the reconstruction's position map as the
-//                                   real mesh, that frame's real lights (when set) and the
+//                                   real mesh (and on a wider grid as its stand-in in the shadow
+//                                   maps, MrScene::real_shadow_casters), that frame's real lights (when set) and the
 //                                   configured real and virtual lights, the
 //                                   configured virtual objects (at the placements of that
 //                                   buffer when set, none while it is unresolved); with
@@ -103,6 +104,16 @@ struct DirStageOptions {
   DirRenderOptions renderer{};
   VplOptions vpls{.count = 64};
   DepthMeshOptions mesh{.stride = 2};
+  /// The grid stride of the reconstruction's stand-in in the shadow maps of the shadow-mapped
+  /// lights (MrScene::real_shadow_casters), in pixels of a 640-pixel-wide image (scaled with the
+  /// width: the same angular spacing at every resolution, 2 at 320); when that is at or below
+  /// mesh.stride, the rendered mesh casts.
+  /// A wider grid's triangles are still about as fine as a shadow map's texels over a room (4 px
+  /// at 525 px focal length: 7.6 mm at 1 m, 2.3 cm at 3 m; a 256-texel view, replay's, over a
+  /// 6 m room: 2.3 cm), and a quarter of them, which is what rasterising costs on a CPU device.
+  /// The stand-in's edge rule (depth_mesh.h) grows with its grid step, so it drops the slopes
+  /// the rendered mesh drops (depth discontinuities), no more and no fewer.
+  int shadow_caster_stride = 4;
   PhongMaterial reconstruction_material{{{0.5f, 0.5f, 0.5f}, 0.f, 1.f}, "reconstruction", {0.f, 0.f, 0.f}};
   colormap::ToneMapOptions tone_map{};  ///< the operator of the composites (and the colour mappings)
   EnvironmentLight environment = EnvironmentLight::Directional;
@@ -155,6 +166,7 @@ class MrSceneStage final : public Stage {
  private:
   DirSceneContent content_;
   DepthMeshOptions mesh_;
+  int shadow_caster_stride_;
   PhongMaterial reconstruction_material_;
   EnvironmentLight environment_;
   std::optional<BufferName<brdf::Materials>> materials_buffer_;

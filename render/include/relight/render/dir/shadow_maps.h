@@ -16,6 +16,10 @@
 // spot lights, and the distance along the light's direction for a directional light
 // (light_depth()). Texels where nothing is seen hold kShadowEmpty.
 //
+// The real layer's occluders are the scene's real meshes, or their coarser stand-ins
+// MrScene::real_shadow_casters when it has them: a caster finer than a texel adds triangles to
+// rasterise (the rasteriser's cost on a CPU device) but nothing to the map.
+//
 // The atlas is one float image: `columns` tiles of `tile` x `tile` texels per row, the real
 // layer's views first (rows 0..rows-1) and then the virtual layer's. shadow_atlas_cpu() is the
 // ray-cast reference of the rasterised atlas (shadow_maps_vk.h); shadow_visibility() is the
@@ -71,7 +75,13 @@ struct ShadowLayout {
 [[nodiscard]] float light_depth(const ShadowView& view, const Eigen::Vector3f& point);
 
 /// The atlas by casting one ray per texel centre through each layer (row-major floats).
+/// `tracer` must hold the occluders the maps see: shadow_caster_scene()'s for a scene with
+/// MrScene::real_shadow_casters.
 [[nodiscard]] std::vector<float> shadow_atlas_cpu(const RayTracer& tracer, const ShadowLayout& layout, int threads = 0);
+
+/// The scene as the shadow maps see it: its real_shadow_casters in place of its real meshes
+/// (when it has any), its virtual meshes as they are.
+[[nodiscard]] MrScene shadow_caster_scene(const MrScene& scene);
 
 /// 1 when `point` (on a surface of unit normal `normal`, facing the light or not) is lit by light
 /// `light` through layer `layer` according to `atlas`, else 0. Points outside every view are lit.

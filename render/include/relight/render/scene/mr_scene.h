@@ -133,12 +133,18 @@ struct MrScene {
   std::vector<TriangleMesh> meshes;
   std::vector<MrLight> lights;
   Environment environment;
+  /// Empty, or real meshes that stand in for the real meshes as occluders in the primary lights'
+  /// shadow maps (shadow_maps.h) only: a coarser tessellation of the same surfaces, e.g. the
+  /// reconstruction on a wider grid (depth_mesh.h), whose vertices are a subset of the full
+  /// mesh's. Every other consumer (G-buffer, ISMs, VPLs, the path tracer) sees `meshes`.
+  std::vector<TriangleMesh> real_shadow_casters;
 
   /// Adds a material and returns its index.
   std::uint32_t add_material(PhongMaterial material);
   [[nodiscard]] std::size_t triangle_count(bool real) const;
-  /// Throws relight::Error when a mesh refers to a missing material or vertex, or has a
-  /// non-finite position, or a normal array of the wrong size.
+  /// Throws relight::Error when a mesh (or shadow caster) refers to a missing material or vertex,
+  /// or has a non-finite position, or a normal array of the wrong size, or a shadow caster is
+  /// virtual.
   void validate() const;
 
   static constexpr const char* type_name = "MrScene";
