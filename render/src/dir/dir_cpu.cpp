@@ -63,9 +63,10 @@ class MapShader {
       if (!sample) continue;
       const float cos_i = sample->wi.dot(n);
       if (cos_i <= 0.f) continue;
-      const Vec3 contribution = phong_brdf(m, n, sample->wi, wo).cwiseProduct(sample->irradiance) * cos_i;
+      // The real layer's shadow first: no BRDF to evaluate where it is dark.
       const auto index = static_cast<std::uint32_t>(l);
       if (shadow_visibility(layout_, shadow_atlas_, index, 0, point, n) == 0.f) continue;
+      const Vec3 contribution = phong_brdf(m, n, sample->wi, wo).cwiseProduct(sample->irradiance) * cos_i;
       if (want_rv()) out.real_virtual += contribution * shadow_visibility(layout_, shadow_atlas_, index, 1, point, n);
       out.real += contribution * ((light.real ? 1.f : 0.f) * real_pixel);
     }
@@ -76,9 +77,9 @@ class MapShader {
       const bool in_r = want_r() && vpl.in_real && real_pixel > 0.f;
       const float cos_x = vpl.incident.dot(n);
       if ((!in_rv && !in_r) || cos_x <= 0.f) continue;
-      const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(m, n, vpl.incident, wo)) * cos_x;
       const IsmLookup::Visibility seen = ism_(static_cast<std::uint32_t>(j), point);
       if (seen.real == 0.f) continue;
+      const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(m, n, vpl.incident, wo)) * cos_x;
       if (in_rv) out.real_virtual += contribution * seen.virtual_;
       if (in_r) out.real += contribution;
     }
@@ -101,11 +102,11 @@ class MapShader {
       const Vec3 wi = to_vpl / std::sqrt(distance2);
       const float cos_x = wi.dot(n), cos_y = -wi.dot(vpl.normal);
       if (cos_x <= 0.f || cos_y <= 0.f) continue;
+      const IsmLookup::Visibility seen = ism_(j, point);
+      if (seen.real == 0.f) continue;
       const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(vpl_phong(scene_, vpl), vpl.normal, vpl.incident, -wi))
                                     .cwiseProduct(phong_brdf(m, n, wi, wo)) *
                                 (cos_x * cos_y / std::max(distance2, min_distance2));
-      const IsmLookup::Visibility seen = ism_(j, point);
-      if (seen.real == 0.f) continue;
       if (in_rv) rv += contribution * seen.virtual_;
       if (in_r) r += contribution;
     }
@@ -122,15 +123,34 @@ class MapShader {
   const DirRenderOptions& options_;
 };
 
-/// Whether neighbour (qx, qy) may lend pixel (x, y) its indirect light: inside the image, on the
-/// same kind of surface, within 5 % of its distance and with a normal within ~25 degrees.
-bool similar(const GBuffer& g, int x, int y, int qx, int qy) {
-  if (qx < 0 || qy < 0 || qx >= g.distance.width() || qy >= g.distance.height()) return false;
-  const float distance = g.distance(y, x), dq = g.distance(qy, qx);
-  if (dq == 0.f || (g.virtual_surface(qy, qx) != 0) != (g.virtual_surface(y, x) != 0)) return false;
-  if (std::abs(dq - distance) > 0.05f * distance) return false;
-  return dot(g.normal(qy, qx), g.normal(y, x)) >= 0.9f;
-}
+/// Whether a neighbour may lend pixel (x, y) its indirect light: inside the image, on the same
+/// kind of surface, within 5 % of its distance and with a normal within ~25 degrees. The pixel's
+/// own G-buffer values are read once, not once per neighbour (the merge asks up to 135 times).
+class SimilarTo {
+ public:
+  SimilarTo(const GBuffer& g, int x, int y)
+      : g_(g),
+        width_(g.distance.width()),
+        height_(g.distance.height()),
+        distance_(g.distance(y, x)),
+        virtual_(g.virtual_surface(y, x) != 0),
+        normal_(g.normal(y, x)) {}
+
+  [[nodiscard]] bool operator()(int qx, int qy) const {
+    if (qx < 0 || qy < 0 || qx >= width_ || qy >= height_) return false;
+    const float dq = g_.distance(qy, qx);
+    if (dq == 0.f || (g_.virtual_surface(qy, qx) != 0) != virtual_) return false;
+    if (std::abs(dq - distance_) > 0.05f * distance_) return false;
+    return dot(g_.normal(qy, qx), normal_) >= 0.9f;
+  }
+
+ private:
+  const GBuffer& g_;
+  int width_, height_;
+  float distance_;
+  bool virtual_;
+  Float3 normal_;
+};
 
 /// merge_interleaved: dir_merge.comp's geometry-aware average of the indirect light, direct
 /// light added unblurred. The n x n window holds one pixel of every VPL subset; a subset whose
@@ -143,11 +163,12 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
   Vec3 sum_rv = own.indirect_real_virtual, sum_r = own.indirect_real;
   float weight = 1.f;
   if (n > 1 && g.distance(y, x) != 0.f) {
+    const SimilarTo similar(g, x, y);
     for (int dy = -n / 2; dy < n - n / 2; ++dy)
       for (int dx = -n / 2; dx < n - n / 2; ++dx) {
         if (dx == 0 && dy == 0) continue;
         const int qx = x + dx, qy = y + dy;
-        if (similar(g, x, y, qx, qy)) {
+        if (similar(qx, qy)) {
           sum_rv += shaded(qy, qx).indirect_real_virtual;
           sum_r += shaded(qy, qx).indirect_real;
           weight += 1.f;
@@ -158,7 +179,7 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
         for (int b = -1; b <= 1; ++b)
           for (int a = -1; a <= 1; ++a) {
             const int sx = qx + a * n, sy = qy + b * n;
-            if ((a == 0 && b == 0) || !similar(g, x, y, sx, sy)) continue;
+            if ((a == 0 && b == 0) || !similar(sx, sy)) continue;
             subset_rv += shaded(sy, sx).indirect_real_virtual;
             subset_r += shaded(sy, sx).indirect_real;
             found += 1.f;
