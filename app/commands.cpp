@@ -143,10 +143,11 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
       ->check(CLI::Range(1, 4))
       ->capture_default_str();
   command
-      .add_option("--shadow-caster-stride", options.shadow_caster_stride,
-                  "Grid stride of the reconstruction as it casts the real lights' shadow maps, in pixels at 640 "
-                  "pixels across (scaled with the width): a coarser grid than the rendered mesh's (2) is still "
-                  "about as fine as a shadow-map texel and far cheaper to rasterise; 2 or less: the rendered mesh")
+      .add_option("--coarse-mesh-stride", options.coarse_mesh_stride,
+                  "Grid stride of the reconstruction's coarse copy, which casts the real lights' shadow maps and "
+                  "receives the VPLs, in pixels at 640 pixels across (scaled with the width): coarser than the "
+                  "rendered mesh's (2), still about as fine as a shadow-map texel, and far cheaper to rasterise "
+                  "and ray trace; 2 or less: the rendered mesh does both")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
   add_choice_option(command, "--bounce-method", options.bounce_method, render::kBounceMethodNames,

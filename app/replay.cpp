@@ -196,7 +196,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.bounces = options.vpl_bounces;
   dir.vpls.bounce_method = options.bounce_method;
   dir.vpls.source = options.vpl_source;
-  dir.shadow_caster_stride = options.shadow_caster_stride;
+  dir.coarse_mesh_stride = options.coarse_mesh_stride;
   dir.tone_map = {.op = options.tone_map,
                   .exposure = options.exposure,
                   .key = options.tone_key,

@@ -88,10 +88,9 @@ struct ReplayOptions {
   render::VplBudget vpl_budget = render::VplBudget::ByPower;  ///< render/vpl/vpl.h
   std::vector<float> vpl_weights;              ///< per light (lights file order, then virtual lights)
   int vpl_bounces = 1;                         ///< indirect bounces carried by VPLs (render/vpl.h)
-  /// Grid stride of the reconstruction's stand-in in the shadow maps, in pixels at 640 across
-  /// (render/dir/dir_stage.h's DirStageOptions::shadow_caster_stride); 2 or less: the rendered
-  /// mesh casts.
-  int shadow_caster_stride = render::DirStageOptions{}.shadow_caster_stride;
+  /// Grid stride of the reconstruction's coarse copy (shadow casters, VPL surfaces), in pixels at
+  /// 640 across (render/dir/dir_stage.h's DirStageOptions::coarse_mesh_stride); 2 or less: none.
+  int coarse_mesh_stride = render::DirStageOptions{}.coarse_mesh_stride;
   render::BounceMethod bounce_method = render::BounceMethod::RayTraced;  ///< how bounces >= 2 find surfaces
   render::VplSource vpl_source = render::VplSource::RayTraced;           ///< where spot lights' first VPLs come from
   RealAlbedo real_albedo = RealAlbedo::Pixel;

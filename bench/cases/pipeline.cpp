@@ -87,16 +87,16 @@ bench::Json replay_640x480(const bench::Options& options) {
   TempFolder folder;
   const int frames = std::max(options.repetitions, 3);
   write_sequence(folder.path / "sequence", frames + 2);
-  const auto build = [&](const std::string& name, int shadow_caster_stride) {
+  const auto build = [&](const std::string& name, int coarse_mesh_stride) {
     app::ReplayOptions replay = replay_options(folder.path / "sequence", folder.path / name);
     replay.objects = {app::data_folder() / "models" / "glossy_pebble.gltf"};
     replay.vpls = 64;
-    replay.shadow_caster_stride = shadow_caster_stride;
+    replay.coarse_mesh_stride = coarse_mesh_stride;
     auto pipeline = app::build_replay_pipeline(app::open_replay_source(replay), replay);
     pipeline.graph->compile();
     return pipeline;
   };
-  auto ours = build("ours", app::ReplayOptions{}.shadow_caster_stride);
+  auto ours = build("ours", app::ReplayOptions{}.coarse_mesh_stride);
   auto exact = build("exact", 1);
   CompositeDifference difference;
   const auto run = [](app::ReplayPipeline& pipeline) {

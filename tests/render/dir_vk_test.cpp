@@ -134,9 +134,9 @@ TEST_F(DirVkTest, ShadowAtlasMatchesTheRayCastReference) {
   EXPECT_LT(coverage_mismatch, cpu.size() / 100);
 }
 
-// MrScene::real_shadow_casters replace the real meshes in the real layer of the shadow maps and
-// nowhere else: here a roof over the room, which only the real layer's views see.
-TEST_F(DirVkTest, ShadowCastersStandInForTheRealLayer) {
+// MrScene::coarse_real_meshes replace the real meshes in the real layer of the shadow maps: here
+// a roof over the room, which only the real layer's views see.
+TEST_F(DirVkTest, CoarseRealMeshesCastTheRealLayersShadows) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   MrScene scene = test::indoor_with_pebble();
   MrLight sun;
@@ -148,7 +148,7 @@ TEST_F(DirVkTest, ShadowCastersStandInForTheRealLayer) {
   roof.positions = {{-10.f, -10.f, 2.5f}, {10.f, -10.f, 2.5f}, {10.f, 10.f, 2.5f}, {-10.f, 10.f, 2.5f}};
   roof.triangles = {{0, 1, 2}, {0, 2, 3}};
   roof.triangle_material = {0, 0};
-  scene.real_shadow_casters = {roof};
+  scene.coarse_real_meshes = {roof};
   DirRenderOptions options = test_options();
   options.shadow_tile = 64;
   DirRendererVk renderer(context, 32, 24);
@@ -156,7 +156,7 @@ TEST_F(DirVkTest, ShadowCastersStandInForTheRealLayer) {
   (void)renderer.render(camera_at({1.3, -1.1, 1.4}, {0.2, -0.1, 0.75}, 32, 24), {}, options);
   const ShadowLayout& layout = renderer.shadow_layout();
   const std::vector<float> gpu = renderer.last_shadow_atlas();
-  const std::vector<float> cpu = shadow_atlas_cpu(RayTracer(shadow_caster_scene(scene)), layout);
+  const std::vector<float> cpu = shadow_atlas_cpu(RayTracer(coarse_scene(scene)), layout);
   const std::vector<float> without =
       shadow_atlas_cpu(RayTracer(MrScene{scene.materials, scene.meshes, scene.lights, {}, {}}), layout);
   ASSERT_EQ(gpu.size(), cpu.size());
@@ -175,9 +175,9 @@ TEST_F(DirVkTest, ShadowCastersStandInForTheRealLayer) {
   EXPECT_GT(real_agree, half * 99 / 100) << "the rasterised real layer is the roof's";
   EXPECT_GT(real_differs_from_meshes, half * 9 / 10) << "...not the room's";
   EXPECT_GT(virtual_agree, half * 99 / 100) << "the virtual layer is the pebble's, as without stand-ins";
-  MrScene virtual_caster = scene;
-  virtual_caster.real_shadow_casters.front().real = false;
-  EXPECT_THROW(virtual_caster.validate(), Error);
+  MrScene virtual_copy = scene;
+  virtual_copy.coarse_real_meshes.front().real = false;
+  EXPECT_THROW(virtual_copy.validate(), Error);
 }
 
 /// The cube scene with a sun that reaches it through its emitter VPL (vpl.h).

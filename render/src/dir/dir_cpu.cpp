@@ -268,9 +268,9 @@ DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, 
   gbuffer = gbuffer_cpu(tracer, camera, options.shading.threads);
   const ShadowLayout layout = plan_shadow_views(scene, options.shadow_tile);
   const std::vector<float> shadow_atlas =
-      scene.real_shadow_casters.empty()
+      scene.coarse_real_meshes.empty()
           ? shadow_atlas_cpu(tracer, layout, options.shading.threads)
-          : shadow_atlas_cpu(RayTracer(shadow_caster_scene(scene)), layout, options.shading.threads);
+          : shadow_atlas_cpu(RayTracer(coarse_scene(scene)), layout, options.shading.threads);
   const IsmPointPools points = sample_ism_points(scene, options.ism);
   const std::vector<float> ism_atlas = ism_atlas_cpu(points, vpls, options.ism);
   return shade_dir_from_maps(gbuffer, scene, camera.camera_to_world.translation().cast<float>(), layout, shadow_atlas,

@@ -67,7 +67,7 @@ DirStages add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* 
 MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& options)
     : content_(std::move(content)),
       mesh_(options.mesh),
-      shadow_caster_stride_(options.shadow_caster_stride),
+      coarse_mesh_stride_(options.coarse_mesh_stride),
       reconstruction_material_(options.reconstruction_material),
       environment_(options.environment),
       materials_buffer_(options.materials_buffer),
@@ -103,20 +103,20 @@ void MrSceneStage::run(StageContext& context) {
   scene.lights.insert(scene.lights.end(), content_.lights.begin(), content_.lights.end());
   if (environment_ == EnvironmentLight::Vpls)
     for (MrLight& light : scene.lights) light.through_vpl = light.kind == LightKind::Directional;
-  // Coarser stand-ins for the reconstruction in the shadow maps, when a light is shadow-mapped.
-  const bool shadow_mapped = std::ranges::any_of(scene.lights, [](const MrLight& l) { return !l.through_vpl; });
-  const auto caster_stride =
-      static_cast<int>(std::lround(shadow_caster_stride_ * static_cast<double>(positions.width()) / 640.0));
-  if (caster_stride > mesh_.stride && shadow_mapped) {
+  // The reconstruction's coarse copy for the shadow maps and the VPLs (dir_stage.h).
+  const auto coarse_stride =
+      static_cast<int>(std::lround(coarse_mesh_stride_ * static_cast<double>(positions.width()) / 640.0));
+  if (coarse_stride > mesh_.stride) {
     // The edge rule scaled with the grid step, so that the stand-in drops the same slopes (depth
     // discontinuities) as the rendered mesh, no more and no fewer.
-    const float scale = static_cast<float>(caster_stride) / static_cast<float>(std::max(mesh_.stride, 1));
-    DepthMeshOptions casters = mesh_;
-    casters.stride = caster_stride;
-    casters.relative_edge *= scale;
-    casters.min_edge *= scale;
-    scene.real_shadow_casters.push_back(mesh_from_positions(positions, nullptr, camera_to_world, materials, casters));
-    scene.real_shadow_casters.back().name = "reconstruction (shadow casters)";
+    const float scale = static_cast<float>(coarse_stride) / static_cast<float>(std::max(mesh_.stride, 1));
+    DepthMeshOptions coarse = mesh_;
+    coarse.stride = coarse_stride;
+    coarse.relative_edge *= scale;
+    coarse.min_edge *= scale;
+    scene.coarse_real_meshes.push_back(
+        mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, coarse));
+    scene.coarse_real_meshes.back().name = "reconstruction (coarse)";
   }
   if (!placements_buffer_) {
     for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);
@@ -155,9 +155,12 @@ void VplStage::run(StageContext& context) {
     options_.previous_flux = previous ? vpl_flux_per_light(previous->vpls, scene.lights.size()) : std::vector<double>{};
   }
   if (reflective_shadow_maps_) reflective_shadow_maps_->set_scene(scene);
-  context.get(vpls_).vpls = generate_vpls(scene, RayTracer(scene, RayTracer::Build::Fast), options_,
-                                          {.cone_search = cone_search_.get(),
-                                           .reflective_shadow_maps = reflective_shadow_maps_.get()});
+  // Onto the coarse copy of the reconstruction when there is one: its BVH builds in a quarter of
+  // the time, and a VPL lands on the same surface within a few millimetres.
+  const RayTracer tracer(scene.coarse_real_meshes.empty() ? scene : coarse_scene(scene), RayTracer::Build::Fast);
+  context.get(vpls_).vpls =
+      generate_vpls(scene, tracer, options_,
+                    {.cone_search = cone_search_.get(), .reflective_shadow_maps = reflective_shadow_maps_.get()});
   // The GPU time of this frame's searches and RSM passes (the helpers count since the last take).
   const double gpu_ms = (cone_search_ ? cone_search_->take_gpu_ms() : 0.0) +
                         (reflective_shadow_maps_ ? reflective_shadow_maps_->take_gpu_ms() : 0.0);

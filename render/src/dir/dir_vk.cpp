@@ -218,12 +218,17 @@ struct DirRendererVk::Impl {
         timers{vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context),
                vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context)} {}
 
-  /// `slot` holds at least `data` (grown, never shrunk) with `data` uploaded.
+  /// `slot` holds at least `data` (grown with a quarter's headroom, never shrunk) with `data`
+  /// uploaded. The headroom: the VPLs and lights of a frame vary in number (rays that miss), and
+  /// a steady run should not allocate device memory every time a frame has one more.
   template <class T>
   void upload(std::unique_ptr<vk::VulkanBuffer>& slot, const std::vector<T>& data) {
     static_assert(sizeof(T) == sizeof(float));
     const std::size_t bytes = std::max<std::size_t>(data.size(), 4) * sizeof(float);
-    if (!slot || slot->size_bytes() < bytes) slot = std::make_unique<vk::VulkanBuffer>(context, bytes);
+    if (!slot || slot->size_bytes() < bytes) {
+      slot.reset();  // free the old memory before the new allocation
+      slot = std::make_unique<vk::VulkanBuffer>(context, bytes + bytes / 4);
+    }
     if (!data.empty()) context.transfer().upload(std::as_bytes(std::span(data)), *slot);
   }
 

@@ -108,14 +108,6 @@ float light_depth(const ShadowView& view, const Vec3& point) {
   return view.eye.w() > 0.5f ? (point - eye).norm() : -point.dot(eye);
 }
 
-MrScene shadow_caster_scene(const MrScene& scene) {
-  MrScene out{scene.materials, {}, scene.lights, scene.environment, {}};
-  for (const TriangleMesh& mesh : scene.meshes)
-    if (!mesh.real || scene.real_shadow_casters.empty()) out.meshes.push_back(mesh);
-  out.meshes.insert(out.meshes.end(), scene.real_shadow_casters.begin(), scene.real_shadow_casters.end());
-  return out;
-}
-
 std::vector<float> shadow_atlas_cpu(const RayTracer& tracer, const ShadowLayout& layout, int threads) {
   const int width = layout.atlas_width(), height = layout.atlas_height();
   std::vector<float> atlas(static_cast<std::size_t>(width) * static_cast<std::size_t>(height), kShadowEmpty);

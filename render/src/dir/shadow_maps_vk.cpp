@@ -32,7 +32,7 @@ ShadowMapsVk::ShadowMapsVk(vk::VulkanContext& context)
 
 void ShadowMapsVk::set_scene(const MrScene& scene) {
   // The real layer's occluders: the scene's stand-ins when it has them (mr_scene.h).
-  upload_scene_positions(context_, scene.real_shadow_casters.empty() ? scene.meshes : scene.real_shadow_casters,
+  upload_scene_positions(context_, scene.coarse_real_meshes.empty() ? scene.meshes : scene.coarse_real_meshes,
                          MeshLayers::Real, real_positions_);
   upload_scene_positions(context_, scene.meshes, MeshLayers::Virtual, virtual_positions_);
 }

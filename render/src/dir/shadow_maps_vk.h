@@ -19,7 +19,7 @@ class ShadowMapsVk {
   explicit ShadowMapsVk(vk::VulkanContext& context);
 
   /// `scene` must be valid (MrScene::validate()); its real layer casts through its
-  /// real_shadow_casters when it has them.
+  /// coarse_real_meshes when it has them.
   void set_scene(const MrScene& scene);
   /// Records the draws of every view of `layout` and the copy of the atlas into atlas(); the
   /// atlas images are (re)made when the layout's size changes.

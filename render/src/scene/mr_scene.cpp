@@ -91,9 +91,9 @@ void validate_mesh(const TriangleMesh& mesh, std::size_t material_count) {
 
 void MrScene::validate() const {
   for (const TriangleMesh& mesh : meshes) validate_mesh(mesh, materials.size());
-  for (const TriangleMesh& caster : real_shadow_casters) {
-    validate_mesh(caster, materials.size());
-    if (!caster.real) throw Error("shadow caster '" + caster.name + "' is virtual: only real meshes have stand-ins");
+  for (const TriangleMesh& coarse : coarse_real_meshes) {
+    validate_mesh(coarse, materials.size());
+    if (!coarse.real) throw Error("coarse mesh '" + coarse.name + "' is virtual: only real meshes have coarse copies");
   }
   for (const PhongMaterial& material : materials)
     if (!material.kd.allFinite() || !std::isfinite(material.ks) || !std::isfinite(material.n) || material.n < 0.f ||
@@ -102,6 +102,14 @@ void MrScene::validate() const {
   for (const MrLight& light : lights)
     if (light.through_vpl && light.kind != LightKind::Directional)
       throw Error("only directional (environment) lights can reach the scene through VPLs");
+}
+
+MrScene coarse_scene(const MrScene& scene) {
+  MrScene out{scene.materials, {}, scene.lights, scene.environment, {}};
+  for (const TriangleMesh& mesh : scene.meshes)
+    if (!mesh.real || scene.coarse_real_meshes.empty()) out.meshes.push_back(mesh);
+  out.meshes.insert(out.meshes.end(), scene.coarse_real_meshes.begin(), scene.coarse_real_meshes.end());
+  return out;
 }
 
 BoundingSphere bounding_sphere(const MrScene& scene, SceneMeshes meshes) {

@@ -8,8 +8,8 @@
 //                                   ObjectPlacements when `placements_buffer` is set,
 //                                   lights::LightSet when `real_lights_buffer` is set
 //                            writes MrScene "mr_scene": the reconstruction's position map as the
-//                                   real mesh (and on a wider grid as its stand-in in the shadow
-//                                   maps, MrScene::real_shadow_casters), that frame's real lights (when set) and the
+//                                   real mesh (and on a wider grid as MrScene::coarse_real_meshes),
+//                                   that frame's real lights (when set) and the
 //                                   configured real and virtual lights, the
 //                                   configured virtual objects (at the placements of that
 //                                   buffer when set, none while it is unresolved); with
@@ -17,7 +17,8 @@
 //                                   scene through its emitter VPL (MrLight::through_vpl)
 //   vpls                     reads  MrScene "mr_scene"; with VplBudget::ByPreviousFlux also the
 //                                   previous frame's VplSet "vpls" (its flux per light)
-//                            writes VplSet "vpls" (vpl.h)
+//                            writes VplSet "vpls" (vpl.h), traced onto MrScene::coarse_real_meshes
+//                                   in place of the real meshes when the scene has them
 //   dir                      reads  FrameInfo "frame", ColorImage "color" and PositionMap
 //                                   "positions" (the image size, which they must share),
 //                                   MrScene "mr_scene", VplSet "vpls"; when `albedo_buffers` is
@@ -104,16 +105,17 @@ struct DirStageOptions {
   DirRenderOptions renderer{};
   VplOptions vpls{.count = 64};
   DepthMeshOptions mesh{.stride = 2};
-  /// The grid stride of the reconstruction's stand-in in the shadow maps of the shadow-mapped
-  /// lights (MrScene::real_shadow_casters), in pixels of a 640-pixel-wide image (scaled with the
-  /// width: the same angular spacing at every resolution, 2 at 320); when that is at or below
-  /// mesh.stride, the rendered mesh casts.
-  /// A wider grid's triangles are still about as fine as a shadow map's texels over a room (4 px
-  /// at 525 px focal length: 7.6 mm at 1 m, 2.3 cm at 3 m; a 256-texel view, replay's, over a
-  /// 6 m room: 2.3 cm), and a quarter of them, which is what rasterising costs on a CPU device.
-  /// The stand-in's edge rule (depth_mesh.h) grows with its grid step, so it drops the slopes
-  /// the rendered mesh drops (depth discontinuities), no more and no fewer.
-  int shadow_caster_stride = 4;
+  /// The grid stride of the reconstruction's coarse copy (MrScene::coarse_real_meshes: the
+  /// occluders of the shadow-mapped lights' maps and the surfaces VPLs land on), in pixels of a
+  /// 640-pixel-wide image (scaled with the width: the same angular spacing at every resolution,
+  /// 2 at 320); when that is at or below mesh.stride, there is no coarse copy. Its triangles are
+  /// still about as fine as a shadow map's texels over a room (4 px at 525 px focal length:
+  /// 7.6 mm at 1 m, 2.3 cm at 3 m; a 256-texel view, replay's, over a 6 m room: 2.3 cm), and a
+  /// quarter as many, which is what rasterising them and building the VPLs' ray-tracing BVH
+  /// cost on a CPU: pipeline/replay_640x480's shadow maps 65-95 -> 30-57 ms and its vpls stage
+  /// 22-25 -> 6-7 ms per frame. Its edge rule (depth_mesh.h) grows with its grid step, so it
+  /// drops the slopes the rendered mesh drops (depth discontinuities), no more and no fewer.
+  int coarse_mesh_stride = 4;
   PhongMaterial reconstruction_material{{{0.5f, 0.5f, 0.5f}, 0.f, 1.f}, "reconstruction", {0.f, 0.f, 0.f}};
   colormap::ToneMapOptions tone_map{};  ///< the operator of the composites (and the colour mappings)
   EnvironmentLight environment = EnvironmentLight::Directional;
@@ -166,7 +168,7 @@ class MrSceneStage final : public Stage {
  private:
   DirSceneContent content_;
   DepthMeshOptions mesh_;
-  int shadow_caster_stride_;
+  int coarse_mesh_stride_;
   PhongMaterial reconstruction_material_;
   EnvironmentLight environment_;
   std::optional<BufferName<brdf::Materials>> materials_buffer_;

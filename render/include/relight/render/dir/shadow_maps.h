@@ -17,7 +17,7 @@
 // (light_depth()). Texels where nothing is seen hold kShadowEmpty.
 //
 // The real layer's occluders are the scene's real meshes, or their coarser stand-ins
-// MrScene::real_shadow_casters when it has them: a caster finer than a texel adds triangles to
+// MrScene::coarse_real_meshes when it has them: a caster finer than a texel adds triangles to
 // rasterise (the rasteriser's cost on a CPU device) but nothing to the map.
 //
 // The atlas is one float image: `columns` tiles of `tile` x `tile` texels per row, the real
@@ -75,13 +75,9 @@ struct ShadowLayout {
 [[nodiscard]] float light_depth(const ShadowView& view, const Eigen::Vector3f& point);
 
 /// The atlas by casting one ray per texel centre through each layer (row-major floats).
-/// `tracer` must hold the occluders the maps see: shadow_caster_scene()'s for a scene with
-/// MrScene::real_shadow_casters.
+/// `tracer` must hold the occluders the maps see: coarse_scene()'s for a scene with
+/// MrScene::coarse_real_meshes.
 [[nodiscard]] std::vector<float> shadow_atlas_cpu(const RayTracer& tracer, const ShadowLayout& layout, int threads = 0);
-
-/// The scene as the shadow maps see it: its real_shadow_casters in place of its real meshes
-/// (when it has any), its virtual meshes as they are.
-[[nodiscard]] MrScene shadow_caster_scene(const MrScene& scene);
 
 /// 1 when `point` (on a surface of unit normal `normal`, facing the light or not) is lit by light
 /// `light` through layer `layer` according to `atlas`, else 0. Points outside every view are lit.

@@ -133,22 +133,27 @@ struct MrScene {
   std::vector<TriangleMesh> meshes;
   std::vector<MrLight> lights;
   Environment environment;
-  /// Empty, or real meshes that stand in for the real meshes as occluders in the primary lights'
-  /// shadow maps (shadow_maps.h) only: a coarser tessellation of the same surfaces, e.g. the
-  /// reconstruction on a wider grid (depth_mesh.h), whose vertices are a subset of the full
-  /// mesh's. Every other consumer (G-buffer, ISMs, VPLs, the path tracer) sees `meshes`.
-  std::vector<TriangleMesh> real_shadow_casters;
+  /// Empty, or a coarser tessellation of the real meshes (e.g. the reconstruction on a wider
+  /// grid, depth_mesh.h, whose vertices are a subset of the full mesh's) that stands in for them
+  /// where light transport is sampled more coarsely than the camera's pixels: as the occluders of
+  /// the primary lights' shadow maps (shadow_maps.h) and as the surfaces the VPLs are traced onto
+  /// (vpl.h). The G-buffer, the ISMs and the path tracer see `meshes`.
+  std::vector<TriangleMesh> coarse_real_meshes;
 
   /// Adds a material and returns its index.
   std::uint32_t add_material(PhongMaterial material);
   [[nodiscard]] std::size_t triangle_count(bool real) const;
-  /// Throws relight::Error when a mesh (or shadow caster) refers to a missing material or vertex,
-  /// or has a non-finite position, or a normal array of the wrong size, or a shadow caster is
+  /// Throws relight::Error when a mesh (coarse or not) refers to a missing material or vertex,
+  /// or has a non-finite position, or a normal array of the wrong size, or a coarse mesh is
   /// virtual.
   void validate() const;
 
   static constexpr const char* type_name = "MrScene";
 };
+
+/// `scene` with its coarse_real_meshes in place of its real meshes (when it has any), its
+/// virtual meshes as they are.
+[[nodiscard]] MrScene coarse_scene(const MrScene& scene);
 
 /// The camera of one frame: pinhole intrinsics (with the image size) and camera-to-world pose
 /// (OpenCV camera convention: x right, y down, z forward).
