@@ -30,8 +30,13 @@ std::vector<IsmPoint> sample_layer(const MrScene& scene, bool real, const IsmOpt
     const TriangleMesh* mesh;
     std::size_t index;
   };
+  std::size_t triangle_count = 0;
+  for (const TriangleMesh& mesh : scene.meshes)
+    if (mesh.real == real) triangle_count += mesh.triangles.size();
   std::vector<Triangle> triangles;
   std::vector<double> cumulative_area;
+  triangles.reserve(triangle_count);
+  cumulative_area.reserve(triangle_count);
   double area = 0.0;
   for (const TriangleMesh& mesh : scene.meshes) {
     if (mesh.real != real) continue;
@@ -46,16 +51,35 @@ std::vector<IsmPoint> sample_layer(const MrScene& scene, bool real, const IsmOpt
   if (triangles.empty() || !(area > 0.0)) return points;
   const auto count = static_cast<std::size_t>(options.pool_factor) * static_cast<std::size_t>(options.points_per_vpl);
   const auto half_size = static_cast<float>(0.5 * std::sqrt(area / options.points_per_vpl));
+  // The random numbers in the order they were always drawn (a point's area target, then its
+  // barycentric pair); then the points are made in ascending order of their targets, each on the
+  // first triangle whose cumulative area reaches its target, in one sweep over the triangles,
+  // and stored at their own draw's place. A binary search and a triangle per point in draw
+  // order read the mesh at random and missed the cache at nearly every step (4 of 6 ms for a
+  // reconstruction of 100k triangles).
+  struct Draw {
+    double target;
+    float a, b;
+  };
   Pcg32 random(options.seed, stream);
-  points.reserve(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    const double target = random.uniform() * area;
-    const auto pick = std::min(static_cast<std::size_t>(std::lower_bound(cumulative_area.begin(), cumulative_area.end(), target) -
-                                                        cumulative_area.begin()),
-                               triangles.size() - 1);
+  std::vector<Draw> draws(count);
+  for (Draw& draw : draws) {
+    draw.target = random.uniform() * area;
+    draw.a = random.uniform();
+    draw.b = random.uniform();
+  }
+  std::vector<std::uint32_t> ascending(count);
+  for (std::size_t i = 0; i < count; ++i) ascending[i] = static_cast<std::uint32_t>(i);
+  std::ranges::sort(ascending, [&](std::uint32_t l, std::uint32_t r) { return draws[l].target < draws[r].target; });
+  points.resize(count);
+  std::size_t first_reaching = 0;
+  for (const std::uint32_t i : ascending) {
+    while (first_reaching < cumulative_area.size() && cumulative_area[first_reaching] < draws[i].target)
+      ++first_reaching;
+    const std::size_t pick = std::min(first_reaching, triangles.size() - 1);
     const TriangleMesh& mesh = *triangles[pick].mesh;
     const auto& tri = mesh.triangles[triangles[pick].index];
-    float a = random.uniform(), b = random.uniform();
+    float a = draws[i].a, b = draws[i].b;
     if (a + b > 1.f) {
       a = 1.f - a;
       b = 1.f - b;
@@ -68,8 +92,8 @@ std::vector<IsmPoint> sample_layer(const MrScene& scene, bool real, const IsmOpt
       const Vec3 n = ((1.f - a - b) * mesh.normals[tri[0]] + a * mesh.normals[tri[1]] + b * mesh.normals[tri[2]]);
       if (n.squaredNorm() > 0.f) normal = n.normalized();
     }
-    points.push_back({(1.f - a - b) * p0 + a * p1 + b * p2, normal, half_size,
-                      mesh.triangle_material[triangles[pick].index]});
+    points[i] = {(1.f - a - b) * p0 + a * p1 + b * p2, normal, half_size,
+                 mesh.triangle_material[triangles[pick].index]};
   }
   return points;  // already in random order: every contiguous run is a uniform subset
 }
