@@ -19,7 +19,11 @@ bool in_layers(const TriangleMesh& mesh, MeshLayers layers) {
 
 void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers, SceneVertices& out) {
   scene.validate();
+  std::size_t corners = 0;
+  for (const TriangleMesh& mesh : scene.meshes)
+    if (in_layers(mesh, layers)) corners += 3 * mesh.triangles.size();
   std::vector<RasterVertex> vertices;
+  vertices.reserve(corners);  // 300k corners of a reconstruction: no regrowth (and its copies) every frame
   for (const TriangleMesh& mesh : scene.meshes) {
     if (!in_layers(mesh, layers)) continue;
     const bool textured = !mesh.texcoords.empty();
