@@ -218,17 +218,13 @@ struct DirRendererVk::Impl {
         timers{vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context),
                vk::GpuTimer(context), vk::GpuTimer(context), vk::GpuTimer(context)} {}
 
-  /// `slot` holds at least `data` (grown with a quarter's headroom, never shrunk) with `data`
-  /// uploaded. The headroom: the VPLs and lights of a frame vary in number (rays that miss), and
-  /// a steady run should not allocate device memory every time a frame has one more.
+  /// `slot` holds at least `data` (grown with headroom, never shrunk) with `data` uploaded. The
+  /// headroom: the VPLs and lights of a frame vary in number (rays that miss), and a steady run
+  /// should not allocate device memory every time a frame has one more.
   template <class T>
-  void upload(std::unique_ptr<vk::VulkanBuffer>& slot, const std::vector<T>& data) {
+  void upload(std::optional<vk::VulkanBuffer>& slot, const std::vector<T>& data) {
     static_assert(sizeof(T) == sizeof(float));
-    const std::size_t bytes = std::max<std::size_t>(data.size(), 4) * sizeof(float);
-    if (!slot || slot->size_bytes() < bytes) {
-      slot.reset();  // free the old memory before the new allocation
-      slot = std::make_unique<vk::VulkanBuffer>(context, bytes + bytes / 4);
-    }
+    vk::reserve_with_headroom(slot, context, std::max<std::size_t>(data.size(), 4) * sizeof(float));
     if (!data.empty()) context.transfer().upload(std::as_bytes(std::span(data)), *slot);
   }
 
@@ -240,7 +236,7 @@ struct DirRendererVk::Impl {
   vk::ComputePipeline shade, merge;
   vk::VulkanBuffer gbuffer_buffer, shaded, output;
   vk::UniqueDescriptorSet merge_set;
-  std::unique_ptr<vk::VulkanBuffer> materials, lights, views, vpls, textures;
+  std::optional<vk::VulkanBuffer> materials, lights, views, vpls, textures;
   std::vector<std::shared_ptr<const Texture>> uploaded_textures;  // per material, of the packed `textures`
   std::vector<std::uint32_t> texture_headers;                     // kTexturesPerMaterial per material
   vk::UniqueDescriptorSet shade_set;
@@ -261,8 +257,8 @@ struct DirRendererVk::Impl {
     d.timers[2].stop(cmd);
     vk::compute_barrier(cmd);
     d.shade_set = {};
-    d.shade_set = d.shade.bind({&d.gbuffer_buffer, d.materials.get(), d.lights.get(), d.views.get(),
-                                &d.shadow_maps.atlas(), d.vpls.get(), &d.ism.atlas(), &d.shaded, d.textures.get()});
+    d.shade_set = d.shade.bind({&d.gbuffer_buffer, &*d.materials, &*d.lights, &*d.views, &d.shadow_maps.atlas(),
+                                &*d.vpls, &d.ism.atlas(), &d.shaded, &*d.textures});
     const auto n = static_cast<std::uint32_t>(options.interleave);
     d.timers[3].start(cmd);
     d.shade.dispatch(cmd, d.shade_set, params, vk::ComputePipeline::group_count((params.width + n - 1) / n * n, 8),

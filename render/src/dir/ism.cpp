@@ -30,13 +30,10 @@ std::vector<IsmPoint> sample_layer(const MrScene& scene, bool real, const IsmOpt
     const TriangleMesh* mesh;
     std::size_t index;
   };
-  std::size_t triangle_count = 0;
-  for (const TriangleMesh& mesh : scene.meshes)
-    if (mesh.real == real) triangle_count += mesh.triangles.size();
   std::vector<Triangle> triangles;
   std::vector<double> cumulative_area;
-  triangles.reserve(triangle_count);
-  cumulative_area.reserve(triangle_count);
+  triangles.reserve(scene.triangle_count(real));
+  cumulative_area.reserve(scene.triangle_count(real));
   double area = 0.0;
   for (const TriangleMesh& mesh : scene.meshes) {
     if (mesh.real != real) continue;

@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "relight/core/error.h"
@@ -139,9 +140,9 @@ struct RayTracer::Impl {
   [[nodiscard]] const LayerScene& layer(Layer which) const { return which == Layer::Real ? real : virtual_objects; }
 };
 
-RayTracer::RayTracer(const MrScene& scene, Build build) : impl_(std::make_unique<Impl>()) {
+RayTracer::RayTracer(MrScene scene, Build build) : impl_(std::make_unique<Impl>()) {
   scene.validate();
-  impl_->scene = scene;
+  impl_->scene = std::move(scene);
   impl_->device.reset(rtcNewDevice(nullptr));
   if (!impl_->device) throw Error("Embree: cannot create a device (unsupported CPU or out of memory)");
   RTCDevice device = impl_->device.get();

@@ -45,13 +45,14 @@ struct SurfaceHit {
 
 class RayTracer {
  public:
-  /// Builds both acceleration structures; copies what shading needs from `scene`.
+  /// Builds both acceleration structures over its own copy of `scene` (a temporary is moved in,
+  /// not copied).
   /// Throws relight::Error when the scene is invalid or Embree cannot start.
   /// High: the slowest build and the fastest rays (Embree's spatial splits), for renderers
   /// that trace millions of rays; Fast: a quick build for a scene that changes every frame and
   /// sees few rays (the DIR stage's VPL generation on the reconstruction).
   enum class Build { High, Fast };
-  explicit RayTracer(const MrScene& scene, Build build = Build::High);
+  explicit RayTracer(MrScene scene, Build build = Build::High);
   ~RayTracer();
   RayTracer(const RayTracer&) = delete;
   RayTracer& operator=(const RayTracer&) = delete;
