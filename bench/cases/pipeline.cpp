@@ -8,6 +8,15 @@
 // levels) and composite_pixels_over_2 counts the pixels that differ by more than 2 levels.
 // pipeline/replay_640x480_no_render: the same replay with nothing to render (`--no-object`: the
 // geometry, pose and frame outputs; goal >= 10 fps).
+// pipeline/replay_640x480_gpu and pipeline/replay_1024x768_gpu: the replay with 256 VPLs on the
+// Vulkan device the backend policy chooses (`--backend auto`: every stage on a real GPU; on a
+// CPU-type device such as lavapipe the per-pixel stages stay on the CPU), writing what a live
+// session at 60 fps writes: report.json only (no per-frame PNGs, no video; their disk cost is
+// pipeline/replay_640x480's). Goals >= 60 and >= 30 fps on a real GPU. The baseline is the same
+// replay on the CPU (`--backend cpu`: the CPU twins of every stage), alternately frame by frame;
+// composite_max_diff / mean_diff / pixels_over_2 compare the two pictures, so the case also says
+// whether the GPU path paints what the CPU path paints. stages_gpu_ms holds the median GPU time
+// of every stage that reports one, stages_on_device the stages whose buffers lived on the device.
 // The first frame (pipeline creation, shader compilation) is left out of the timings.
 #include <unistd.h>
 #include <algorithm>
@@ -52,13 +61,32 @@ void write_sequence(const std::filesystem::path& folder, int frames) {
   truth::write_sequence(synth, folder);
 }
 
+/// The median of `values` after the first (pipeline creation, shader compilation).
+double steady_median(const std::vector<double>& values) {
+  const std::vector<double> steady(values.begin() + (values.empty() ? 0 : 1), values.end());
+  return app::summarize(steady).median;
+}
+
 /// Per-stage medians of the frames after the first.
 bench::Json stage_medians(const FrameGraph& graph) {
   bench::Json stages = bench::Json::object();
-  for (const auto& timing : graph.timings()) {
-    std::vector<double> steady(timing.wall_ms.begin() + (timing.wall_ms.empty() ? 0 : 1), timing.wall_ms.end());
-    stages[timing.stage] = app::summarize(steady).median;
-  }
+  for (const auto& timing : graph.timings()) stages[timing.stage] = steady_median(timing.wall_ms);
+  return stages;
+}
+
+/// Per-stage median GPU milliseconds, for the stages that report device time.
+bench::Json stage_gpu_medians(const FrameGraph& graph) {
+  bench::Json stages = bench::Json::object();
+  for (const auto& timing : graph.timings())
+    if (!timing.device_ms.empty()) stages[timing.stage] = steady_median(timing.device_ms);
+  return stages;
+}
+
+/// The stages whose buffers lived on the device in their last run.
+bench::Json stages_on_device(const FrameGraph& graph) {
+  bench::Json stages = bench::Json::array();
+  for (const auto& timing : graph.timings())
+    if (timing.device_buffers || timing.backend == Backend::Vulkan) stages.push_back(timing.stage);
   return stages;
 }
 
@@ -83,6 +111,41 @@ struct CompositeDifference {
   }
 };
 
+/// Runs `ours` and `baseline` frame by frame alternately (`frames` timed frames each), finishes
+/// both and returns the fields both comparison cases share: times, fps, the composite difference
+/// and the per-stage medians.
+bench::Json compare_replays(app::ReplayPipeline& ours, app::ReplayPipeline& baseline, int frames,
+                            const std::string& case_name, const std::string& baseline_name) {
+  CompositeDifference difference;
+  const auto run = [&](app::ReplayPipeline& pipeline) {
+    if (!pipeline.graph->run_frame()) throw Error(case_name + ": the sequence ended early");
+  };
+  const bench::Comparison comparison =
+      bench::compare_interleaved([&] { run(ours); },
+                                 [&] {
+                                   run(baseline);
+                                   const ColorImage* a = ours.graph->find(ours.final_composite);
+                                   const ColorImage* b = baseline.graph->find(baseline.final_composite);
+                                   if (!a || !b) throw Error(case_name + ": no final composite");
+                                   difference.add(*a, *b);
+                                 },
+                                 frames);
+  ours.graph->finish();
+  baseline.graph->finish();
+
+  bench::Json result = bench::comparison_json(comparison, baseline_name);
+  result["fps"] = 1000.0 / comparison.ms;
+  result["baseline_fps"] = 1000.0 / comparison.baseline_ms;
+  result["frames"] = frames;
+  result["composite_max_diff"] = difference.max;
+  result["composite_mean_diff"] = difference.values ? difference.sum / static_cast<double>(difference.values) : 0.0;
+  result["composite_pixels_over_2"] = difference.pixels_over_2;
+  result["compute"] = ours.compute;
+  result["stages_ms"] = stage_medians(*ours.graph);
+  result["baseline_stages_ms"] = stage_medians(*baseline.graph);
+  return result;
+}
+
 bench::Json replay_640x480(const bench::Options& options) {
   TempFolder folder;
   const int frames = std::max(options.repetitions, 3);
@@ -98,34 +161,8 @@ bench::Json replay_640x480(const bench::Options& options) {
   };
   auto ours = build("ours", app::ReplayOptions{}.coarse_mesh_stride);
   auto exact = build("exact", 1);
-  CompositeDifference difference;
-  const auto run = [](app::ReplayPipeline& pipeline) {
-    if (!pipeline.graph->run_frame()) throw Error("pipeline/replay_640x480: the sequence ended early");
-  };
-  const bench::Comparison comparison =
-      bench::compare_interleaved([&] { run(ours); },
-                                 [&] {
-                                   run(exact);
-                                   const ColorImage* a = ours.graph->find(ours.final_composite);
-                                   const ColorImage* b = exact.graph->find(exact.final_composite);
-                                   if (!a || !b) throw Error("pipeline/replay_640x480: no final composite");
-                                   difference.add(*a, *b);
-                                 },
-                                 frames);
-  ours.graph->finish();
-  exact.graph->finish();
-
-  bench::Json result = bench::comparison_json(comparison, "exact_replay");
-  result["fps"] = 1000.0 / comparison.ms;
-  result["baseline_fps"] = 1000.0 / comparison.baseline_ms;
-  result["frames"] = frames;
+  bench::Json result = compare_replays(ours, exact, frames, "pipeline/replay_640x480", "exact_replay");
   result["goal_fps"] = 5;
-  result["composite_max_diff"] = difference.max;
-  result["composite_mean_diff"] = difference.values ? difference.sum / static_cast<double>(difference.values) : 0.0;
-  result["composite_pixels_over_2"] = difference.pixels_over_2;
-  result["compute"] = ours.compute;
-  result["stages_ms"] = stage_medians(*ours.graph);
-  result["baseline_stages_ms"] = stage_medians(*exact.graph);
   return result;
 }
 
@@ -155,7 +192,42 @@ bench::Json replay_640x480_no_render(const bench::Options& options) {
   return result;
 }
 
+/// The GPU cases at `width` x `height` (see the header).
+bench::Json replay_gpu(const bench::Options& options, int width, int height, double goal_fps) {
+  const std::string name = "pipeline/replay_" + std::to_string(width) + "x" + std::to_string(height) + "_gpu";
+  TempFolder folder;
+  const int frames = std::max(options.repetitions, 3);
+  synth::SynthOptions synth;
+  synth.frames = frames + 2;
+  synth.ground_truth = false;
+  synth.width = width;
+  synth.height = height;
+  truth::write_sequence(synth, folder.path / "sequence");
+  const auto build = [&](const std::string& side, vk::BackendPolicy backend) {
+    app::ReplayOptions replay = replay_options(folder.path / "sequence", folder.path / side);
+    replay.objects = {app::data_folder() / "models" / "glossy_pebble.gltf"};
+    replay.vpls = 256;
+    replay.backend = backend;
+    replay.write_frames = false;
+    replay.video = false;
+    auto pipeline = app::build_replay_pipeline(app::open_replay_source(replay), replay);
+    pipeline.graph->compile();
+    return pipeline;
+  };
+  auto gpu = build("gpu", vk::BackendPolicy::Auto);
+  auto cpu = build("cpu", vk::BackendPolicy::ForceCpu);
+  bench::Json result = compare_replays(gpu, cpu, frames, name, "cpu_replay");
+  result["goal_fps"] = goal_fps;
+  result["vpls"] = 256;
+  result["stages_gpu_ms"] = stage_gpu_medians(*gpu.graph);
+  result["stages_on_device"] = stages_on_device(*gpu.graph);
+  return result;
+}
+
 }  // namespace
 
 RELIGHT_BENCH_CASE("pipeline/replay_640x480", replay_640x480);
 RELIGHT_BENCH_CASE("pipeline/replay_640x480_no_render", replay_640x480_no_render);
+RELIGHT_BENCH_CASE("pipeline/replay_640x480_gpu", [](const bench::Options& o) { return replay_gpu(o, 640, 480, 60); });
+RELIGHT_BENCH_CASE("pipeline/replay_1024x768_gpu",
+                   [](const bench::Options& o) { return replay_gpu(o, 1024, 768, 30); });
