@@ -26,6 +26,7 @@
 #include "relight/capture/looping_source.h"
 #include "relight/capture/marker_pose.h"
 #include "relight/capture/openni_source.h"
+#include "relight/capture/prefetch_source.h"
 #include "relight/capture/range_source.h"
 #include "relight/capture/source_stage.h"
 #include "relight/capture/tum_sequence.h"
@@ -90,8 +91,14 @@ std::unique_ptr<capture::FrameSource> open_source_once(const ReplayOptions& opti
 
 std::unique_ptr<capture::FrameSource> open_replay_source(const ReplayOptions& options) {
   if (options.loops < 1) throw Error("--loop must be at least 1");
-  if (options.loops == 1) return open_source_once(options);
-  return std::make_unique<capture::LoopingSource>([options] { return open_source_once(options); }, options.loops);
+  std::unique_ptr<capture::FrameSource> source =
+      options.loops == 1
+          ? open_source_once(options)
+          : std::make_unique<capture::LoopingSource>([options] { return open_source_once(options); }, options.loops);
+  // A TUM folder's next frame is decoded on a worker thread while this one is processed
+  // (prefetch_source.h); an .oni recording plays through OpenNI's own reader thread.
+  if (options.sequence.extension() == ".oni") return source;
+  return std::make_unique<capture::PrefetchSource>(std::move(source));
 }
 
 ReplayPipeline::ReplayPipeline() = default;
@@ -188,7 +195,9 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   if (real_lights.lights_file.empty()) pipeline.extracted_lights = probe_input.lights;
   pipeline.light_estimation = light_stages.estimation;
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
-  graph.emplace<brdf::BrdfPreviewStage>();  // culled unless the frame writer shows it
+  // Culled unless the frame writer or report.html shows it; with the report alone only for its
+  // contact-sheet frames (build_replay_pipeline).
+  pipeline.brdf_preview = &graph.emplace<brdf::BrdfPreviewStage>();
   render::DirStageOptions dir;
   dir.vpls.count = options.vpls;
   dir.vpls.budget = options.vpl_budget;
@@ -409,6 +418,10 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<capture::FrameSource> sourc
     graph.add(std::move(writer));
   }
   add_report_collector(pipeline, total_frames, method2);
+  if (pipeline.brdf_preview && !options.write_frames) {
+    const ReportCollectorStage* shown = pipeline.report;
+    pipeline.brdf_preview->only_for([shown](std::int64_t frame) { return shown->shows(frame); });
+  }
   return pipeline;
 }
 

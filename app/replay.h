@@ -20,6 +20,10 @@
 #include "relight/render/vpl/vpl.h"
 #include "relight/vk/backend.h"
 
+namespace relight::brdf {
+class BrdfPreviewStage;
+}
+
 namespace relight::app {
 
 class CameraTrajectoryStage;
@@ -143,6 +147,7 @@ struct ReplayPipeline {
   /// The buffer with the final picture: "composite_mapped" with colour mapping, else "composite".
   BufferName<ColorImage> final_composite = kComposite;
   app::ReportCollectorStage* report = nullptr;    ///< gathers report.html's pictures, materials, lights
+  brdf::BrdfPreviewStage* brdf_preview = nullptr;  ///< set when there are virtual objects
   ReplayPipeline();
   ~ReplayPipeline();
   ReplayPipeline(ReplayPipeline&&) noexcept;

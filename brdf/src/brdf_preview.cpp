@@ -60,6 +60,10 @@ void BrdfPreviewStage::declare(StageBuilder& builder) {
 }
 
 void BrdfPreviewStage::run(StageContext& context) {
+  if (wanted_ && !wanted_(context.frame_index())) {
+    context.get(preview_) = ColorImage{};
+    return;
+  }
   const FrameInfo& frame = context.get(frame_);
   const ShadingLights lights =
       estimation_lights(context.get(lights_), frame.camera_to_world.value_or(Pose::Identity()));

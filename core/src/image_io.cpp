@@ -5,17 +5,20 @@
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <initializer_list>
+#include <iostream>
 #include <limits>
 #include <mutex>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <streambuf>
 #include <string_view>
 #include <vector>
 
@@ -48,6 +51,63 @@ class MutedStderr {
  private:
   int saved_ = -1;
 };
+
+// Muting fd 2 mutes the whole process: a warning another thread prints while a decoder runs
+// (the pipeline's stages beside the prefetching source, which decodes the next frame) was lost.
+// So std::cerr goes to a copy of the stderr descriptor taken before any thread or decoder
+// exists, which the muting leaves alone, and drops only what the decoding thread itself writes
+// there while it decodes (OpenCV's imread reports through std::cerr, libpng through fd 2).
+thread_local bool decoding_here = false;
+
+class DescriptorStreambuf final : public std::streambuf {
+ public:
+  explicit DescriptorStreambuf(int descriptor) : descriptor_(descriptor) {}
+  [[nodiscard]] int descriptor() const { return descriptor_; }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (traits_type::eq_int_type(c, traits_type::eof())) return traits_type::not_eof(c);
+    const char ch = traits_type::to_char_type(c);
+    return write_all(&ch, 1) ? c : traits_type::eof();
+  }
+  std::streamsize xsputn(const char* text, std::streamsize count) override {
+    return write_all(text, count) ? count : 0;
+  }
+
+ private:
+  bool write_all(const char* text, std::streamsize count) const {
+    if (decoding_here) return true;
+    while (count > 0) {
+      const ssize_t written = ::write(descriptor_, text, static_cast<std::size_t>(count));
+      if (written < 0 && errno == EINTR) continue;
+      if (written <= 0) return false;
+      text += written;
+      count -= written;
+    }
+    return true;
+  }
+  int descriptor_;
+};
+
+/// Rebinds std::cerr for the life of the program (this static's), and gives the original back
+/// before the standard streams' final flush.
+class CerrBesideMutedStderr {
+ public:
+  CerrBesideMutedStderr() : buffer_(::fcntl(STDERR_FILENO, F_DUPFD_CLOEXEC, 3)) {
+    if (copy_ok()) original_ = std::cerr.rdbuf(&buffer_);
+  }
+  ~CerrBesideMutedStderr() {
+    if (original_) std::cerr.rdbuf(original_);
+  }
+  CerrBesideMutedStderr(const CerrBesideMutedStderr&) = delete;
+  CerrBesideMutedStderr& operator=(const CerrBesideMutedStderr&) = delete;
+
+ private:
+  [[nodiscard]] bool copy_ok() const { return buffer_.descriptor() >= 0; }  // no stderr at all: leave it
+  DescriptorStreambuf buffer_;
+  std::streambuf* original_ = nullptr;
+};
+const CerrBesideMutedStderr cerr_beside_muted_stderr;
 
 std::mutex& decoder_mutex() {
   static std::mutex mutex;
@@ -148,6 +208,10 @@ cv::Mat run_decoder(const std::string& what, const Decode& decode) {
   try {
     const std::lock_guard lock(decoder_mutex());
     const MutedStderr muted;
+    decoding_here = true;
+    struct Done {
+      ~Done() { decoding_here = false; }
+    } done;
     return decode();
   } catch (const cv::Exception& e) {
     throw Error("cannot decode " + what + ": " + e.err);

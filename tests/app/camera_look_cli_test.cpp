@@ -169,6 +169,17 @@ TEST(CameraLookCli, BlurAndNoiseAreMeasuredOnAlternateFramesAfterTheFirstEight) 
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const auto look = nlohmann::json::parse(read_text_file(dir.path() / "look" / "report.json"))["camera_look"];
   EXPECT_EQ(look["frames"], 12);
+  // With no frame images the BRDF preview is made only for report.html's four contact-sheet
+  // frames, and each of those rows shows it as a picture.
+  const std::string html = read_text_file(dir.path() / "look" / "report.html");
+  std::size_t previews = 0;
+  for (std::size_t at = html.find("alt=\"brdf_preview frame "); at != std::string::npos;
+       at = html.find("alt=\"brdf_preview frame ", at + 1)) {
+    ++previews;
+    const std::size_t source = html.find("src=\"data:image/jpeg;base64,", at);
+    EXPECT_EQ(html.compare(source + 28, 4, "/9j/"), 0) << "a JPEG";
+  }
+  EXPECT_EQ(previews, 4u);
   EXPECT_EQ(look["blur_estimates"], 10) << "8 frames with both, then every second one";
   EXPECT_EQ(look["noise_estimates"], 10);
   EXPECT_NEAR(look["blur_sigma_px"].get<double>(), kBlur, 0.2 * kBlur) << look.dump();

@@ -8,8 +8,9 @@
 #include <map>
 
 #include "brdf_test_scene.h"
-#include "support/vulkan_test_env.h"
+#include "relight/brdf/brdf_preview.h"
 #include "relight/vk/transfer.h"
+#include "support/vulkan_test_env.h"
 
 namespace relight::brdf {
 namespace {
@@ -126,6 +127,29 @@ TEST_F(BrdfStagesVkTest, VulkanBackendGivesTheSameMaterials) {
       EXPECT_NEAR(b.ks, a.ks, 0.02f * a.ks) << k;
       EXPECT_NEAR(b.n, a.n, 0.05f * a.n) << k;
       std::printf("cluster %zu: CPU start ks %.4f n %.2f, GPU start ks %.4f n %.2f\n", k, a.ks, a.n, b.ks, b.n);
+    }
+  }
+}
+
+// A run that writes no frames makes the preview only for the frames its report shows: the other
+// frames get an empty picture, the wanted one the full five-panel mosaic.
+TEST(BrdfStages, ThePreviewIsMadeOnlyForTheWantedFrames) {
+  FrameGraph graph;
+  graph.emplace<SceneSource>(3);
+  add_brdf_stages(graph, scene_options(), Backend::Cpu, nullptr);
+  graph.emplace<BrdfPreviewStage>().only_for([](std::int64_t frame) { return frame == 1; });
+  graph.keep(kBrdfPreview);
+  graph.compile();
+  const ColorImage& color = test::brdf_scene().color;
+  for (std::int64_t frame = 0; frame < 3; ++frame) {
+    ASSERT_TRUE(graph.run_frame());
+    const ColorImage* preview = graph.find(kBrdfPreview);
+    ASSERT_NE(preview, nullptr);
+    if (frame == 1) {
+      EXPECT_EQ(preview->width(), 5 * color.width());
+      EXPECT_EQ(preview->height(), color.height());
+    } else {
+      EXPECT_TRUE(preview->pixels().empty()) << "frame " << frame;
     }
   }
 }

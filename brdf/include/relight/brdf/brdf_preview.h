@@ -6,6 +6,8 @@
 // BrdfPreviewStage reads ColorImage "color", Mask "highlight_mask", RadianceImage "kd",
 // Materials "materials", PositionMap "positions", NormalMap "normals", LightSet "lights" and
 // FrameInfo "frame" (names as BrdfBuffers); writes ColorImage "brdf_preview".
+#include <cstdint>
+#include <functional>
 #include <string>
 
 #include "relight/brdf/brdf_stages.h"
@@ -22,12 +24,17 @@ class BrdfPreviewStage final : public Stage {
   explicit BrdfPreviewStage(BrdfBuffers buffers = {}, BufferName<ColorImage> output = kBrdfPreview)
       : buffers_(buffers), output_name_(output) {}
   [[nodiscard]] std::string name() const override { return "brdf_preview"; }
+  /// Makes the mosaic only for the frames `wanted` accepts (an empty picture otherwise): a run
+  /// that writes no frames shows it only on report.html's few contact-sheet rows, and the
+  /// re-render behind it costs as much as the BRDF estimation's own stages.
+  void only_for(std::function<bool(std::int64_t)> wanted) { wanted_ = std::move(wanted); }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
  private:
   BrdfBuffers buffers_;
   BufferName<ColorImage> output_name_;
+  std::function<bool(std::int64_t)> wanted_;  ///< empty: every frame
   Read<ColorImage> color_;
   Read<Mask> highlights_;
   Read<RadianceImage> kd_;
