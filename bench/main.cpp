@@ -1,6 +1,7 @@
 // relight-bench [--list] [--repetitions N] [--report DIR] [FILTER]: runs the cases whose name
-// contains FILTER.
+// contains FILTER, or only the case named FILTER when one is.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <exception>
 #include <iostream>
 
@@ -24,8 +25,12 @@ int main(int argc, char** argv) {
 
   int matched = 0;
   std::vector<relight::bench::Json> results;
-  for (const auto& bench_case : relight::bench::cases()) {
-    if (!filter.empty() && bench_case.name.find(filter) == std::string::npos) continue;
+  // A filter that names a case exactly runs that case alone (pipeline/replay_640x480 is also the
+  // start of other cases' names).
+  const auto& cases = relight::bench::cases();
+  const bool exact = std::any_of(cases.begin(), cases.end(), [&](const auto& c) { return c.name == filter; });
+  for (const auto& bench_case : cases) {
+    if (exact ? bench_case.name != filter : bench_case.name.find(filter) == std::string::npos) continue;
     ++matched;
     if (list) {
       std::cout << bench_case.name << '\n';

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # scripts/bench-bundle.sh [-b BINARY] OUT.tar.xz
 #
-# Packs relight-bench, the shared libraries it loads and data/ into one archive that runs on
-# another x86-64 Linux machine without relight's Debian packages (a lent GPU machine, say):
+# Packs relight-bench and the relight CLI beside it (when built), the shared libraries they load
+# and data/ into one archive that runs on another x86-64 Linux machine without relight's Debian
+# packages (a lent GPU machine, say):
 #   tar xJf OUT.tar.xz && relight-bench-bundle/run.sh [relight-bench arguments]
+#   relight-bench-bundle/relight.sh replay ...   (e.g. under a profiler, with report.json)
 #
 # Why stubs: the Debian OpenCV the benchmark links pulls in GDAL, DICOM, FFmpeg, GStreamer and
 # SDL through imgcodecs, videoio and the live view (over 300 MB in 280 libraries), none of which a
@@ -15,7 +17,7 @@
 # checks), else the bundled ones.
 #
 # Default binary: build/release/bench/relight-bench if it exists, else build/debug's (stripped of
-# its debug information in the bundle either way).
+# its debug information in the bundle either way); the CLI is ../app/relight from the bench's folder.
 set -euo pipefail
 
 root="$(cd "$(dirname "$0")/.." && pwd)"
@@ -57,11 +59,15 @@ trap 'rm -rf "$work"' EXIT
 bundle="$work/relight-bench-bundle"
 mkdir -p "$bundle/bin" "$bundle/lib" "$bundle/fallback" "$work/stubs"
 
+binaries=("$binary")
+cli="$(dirname "$binary")/../app/relight"
+[[ -x "$cli" ]] && binaries+=("$cli")
+
 # soname -> path, as this machine's loader resolves the whole closure.
 declare -A path_of
 while read -r name _ path _; do
   [[ -n "$path" && "$path" == /* ]] && path_of["$name"]="$path"
-done < <(ldd "$binary" | awk '/=>/ {print $1, $2, $3}')
+done < <(for b in "${binaries[@]}"; do ldd "$b"; done | awk '/=>/ {print $1, $2, $3}')
 
 # One stub library: every exported symbol of the real one, functions abort, objects are zeros of
 # the real size, symbol versions kept.
@@ -100,7 +106,7 @@ make_stub() {
 }
 
 declare -A seen
-queue=("$binary")
+queue=("${binaries[@]}")
 stubs=0 libs=0
 while [[ ${#queue[@]} -gt 0 ]]; do
   current="${queue[0]}"
@@ -127,11 +133,15 @@ while [[ ${#queue[@]} -gt 0 ]]; do
   done < <(readelf -d "$current" | sed -n 's/.*(NEEDED).*\[\(.*\)\]/\1/p')
 done
 
-objcopy --strip-debug "$binary" "$bundle/bin/relight-bench"
+for b in "${binaries[@]}"; do objcopy --strip-debug "$b" "$bundle/bin/$(basename "$b")"; done
 cp -r "$root/data" "$bundle/data"
-cat >"$bundle/run.sh" <<'EOF'
+# run.sh runs relight-bench, relight.sh the CLI, each with the bundle's libraries and data.
+for wrapper in run:relight-bench relight:relight; do
+  program="${wrapper#*:}" script="$bundle/${wrapper%%:*}.sh"
+  [[ -x "$bundle/bin/$program" ]] || continue
+  sed "s/@PROGRAM@/$program/" >"$script" <<'EOF'
 #!/bin/sh
-# Runs the bundled relight-bench with its libraries and data (scripts/bench-bundle.sh).
+# Runs the bundled @PROGRAM@ with its libraries and data (scripts/bench-bundle.sh).
 here="$(cd "$(dirname "$0")" && pwd)"
 libs="$here/lib"
 # The target's libstdc++ when it is at least as new as the one the bundle was built with.
@@ -140,13 +150,14 @@ needed_cxx="$(cat "$here/fallback/GLIBCXX")"
 if [ -z "$system_cxx" ] || ! grep -q "$needed_cxx" "$system_cxx"; then libs="$libs:$here/fallback"; fi
 export LD_LIBRARY_PATH="$libs${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"
 export RELIGHT_DATA="${RELIGHT_DATA:-$here/data}"
-exec "$here/bin/relight-bench" "$@"
+exec "$here/bin/@PROGRAM@" "$@"
 EOF
-chmod +x "$bundle/run.sh"
+  chmod +x "$script"
+done
 # The newest libstdc++ symbol version the bundle's binaries ask for.
-strings "$bundle/bin/relight-bench" "$bundle"/lib/*.so* | grep -o '^GLIBCXX_3\.4\.[0-9]*$' | sort -t. -k3 -n | tail -1 \
+strings "$bundle"/bin/* "$bundle"/lib/*.so* | grep -o '^GLIBCXX_3\.4\.[0-9]*$' | sort -t. -k3 -n | tail -1 \
   >"$bundle/fallback/GLIBCXX"
 
 tar -C "$work" -cf - relight-bench-bundle | xz -T2 -6 >"$out.tmp"
 mv "$out.tmp" "$out"
-echo "bench-bundle: $out ($(du -h "$out" | cut -f1)): relight-bench, $libs libraries, $stubs stubs, data/"
+echo "bench-bundle: $out ($(du -h "$out" | cut -f1)): ${binaries[*]##*/}, $libs libraries, $stubs stubs, data/"
