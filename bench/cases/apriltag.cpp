@@ -1,5 +1,10 @@
 // apriltag/detect_640x480: AprilTag detection + pose on a synthetic 640x480 frame of the tag at
-// ~1.6 m, at decimation 1 and 2, with the pose error against the synthetic ground truth.
+// ~1.6 m, at decimation 1 and 2, with the pose error against the synthetic ground truth. The
+// detector runs on every hardware thread (the default); the baseline is the same detector on one
+// thread, interleaved, and same_detections says whether both found exactly the same corners.
+#include <algorithm>
+#include <thread>
+
 #include "bench.h"
 #include "relight/capture/marker_pose.h"
 #include "relight/synth/raycast.h"
@@ -23,9 +28,18 @@ Json detect_case(const relight::bench::Options& options, float decimate) {
   relight::capture::TagDetectorOptions detector_options;
   detector_options.decimate = decimate;
   relight::capture::TagDetector detector(detector_options);
-  std::vector<relight::capture::TagDetection> detections;
-  Json json;
-  json["ms"] = relight::bench::median_ms([&] { detections = detector.detect(color); }, options.repetitions);
+  detector_options.threads = 1;
+  relight::capture::TagDetector one_thread(detector_options);
+  std::vector<relight::capture::TagDetection> detections, baseline_detections;
+  const relight::bench::Comparison comparison =
+      relight::bench::compare_interleaved([&] { detections = detector.detect(color); },
+                                          [&] { baseline_detections = one_thread.detect(color); }, options.repetitions);
+  Json json = relight::bench::comparison_json(comparison, "apriltag_one_thread");
+  json["threads"] = std::max(1u, std::thread::hardware_concurrency());
+  json["same_detections"] =
+      detections.size() == baseline_detections.size() &&
+      std::equal(detections.begin(), detections.end(), baseline_detections.begin(),
+                 [](const auto& a, const auto& b) { return a.id == b.id && a.corners == b.corners; });
   json["decimate"] = decimate;
   json["tags_found"] = detections.size();
   auto pose = relight::capture::estimate_camera_pose(detections, layout, intrinsics);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 
 #include "relight/core/error.h"
 
@@ -35,7 +36,8 @@ TagDetector::TagDetector(const TagDetectorOptions& options)
   apriltag_detector_add_family_bits(library_->detector.get(), library_->family.get(),
                                     std::clamp(options.max_hamming, 0, 2));
   library_->detector->quad_decimate = options.decimate;
-  library_->detector->nthreads = std::max(1, options.threads);
+  library_->detector->nthreads =
+      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   library_->detector->refine_edges = options.refine_edges;
 }
 

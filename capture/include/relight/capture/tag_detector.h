@@ -24,7 +24,9 @@ struct TagDetection {
 
 struct TagDetectorOptions {
   float decimate = 1.0f;      ///< quad_decimate: 2 is faster and less precise on small tags
-  int threads = 1;
+  /// apriltag's worker threads; 0: one per hardware thread (the detections do not depend on it:
+  /// they are sorted by id and position).
+  int threads = 0;
   bool refine_edges = true;
   int max_hamming = 1;        ///< detections with more corrected bits are dropped
 };
