@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "fuzz_input.h"
+#include "image_size_limit.h"
 #include "relight/core/error.h"
 #include "relight/core/image_io.h"
 

@@ -5,13 +5,14 @@
 # Prints executions and crashes per target; a crashing input is kept under
 # build/fuzz/crashes/<target>/ and the script exits 1 (add the input to fuzz/corpus/<target>/ as a
 # regression once the product is fixed).
-# Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   (targets: tum_lists json_config depth_png obj gltf)
+# Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   (targets: tum_lists json_config depth_png obj gltf
+# tag_layout lights_json probe_image probe_list)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-60}"
 shift || true
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(tum_lists json_config depth_png obj gltf)
+[ ${#targets[@]} -gt 0 ] || targets=(tum_lists json_config depth_png obj gltf tag_layout lights_json probe_image probe_list)
 
 source "$root/scripts/common.sh"
 export CC=clang CXX=clang++

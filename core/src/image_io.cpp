@@ -18,6 +18,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <optional>
+#include <sstream>
 #include <streambuf>
 #include <string_view>
 #include <vector>
@@ -109,6 +110,11 @@ class CerrBesideMutedStderr {
 };
 const CerrBesideMutedStderr cerr_beside_muted_stderr;
 
+ImageSizeLimit& size_limit() {
+  static ImageSizeLimit limit;
+  return limit;
+}
+
 std::mutex& decoder_mutex() {
   static std::mutex mutex;
   return mutex;
@@ -162,8 +168,62 @@ void check_format(const std::filesystem::path& path, std::initializer_list<Image
   throw Error("cannot decode " + path.string() + ": not a " + expected + " file");
 }
 
-/// Width and height from a PNG's IHDR or a JPEG's frame header; nullopt when the header is
-/// missing or cut short.
+constexpr std::int64_t kLargestSide = std::int64_t{1} << 30;
+
+/// A Radiance HDR's resolution line ("-Y 512 +X 1024", after the header's blank line).
+std::optional<std::pair<int, int>> radiance_hdr_size(std::span<const std::uint8_t> b) {
+  const std::string_view text(reinterpret_cast<const char*>(b.data()), b.size());
+  const std::size_t blank = text.find("\n\n");
+  if (blank == std::string_view::npos) return std::nullopt;
+  const std::size_t end = text.find('\n', blank + 2);
+  if (end == std::string_view::npos) return std::nullopt;
+  std::istringstream line(std::string(text.substr(blank + 2, end - blank - 2)));
+  std::string first_axis, second_axis;
+  std::int64_t first = 0, second = 0;
+  if (!(line >> first_axis >> first >> second_axis >> second) || first_axis.size() != 2 || second_axis.size() != 2)
+    return std::nullopt;
+  first = std::clamp<std::int64_t>(first, 0, kLargestSide), second = std::clamp<std::int64_t>(second, 0, kLargestSide);
+  // The first axis counts the rows ("-Y H +X W"), unless the image is stored transposed.
+  if (first_axis[1] == 'Y') return std::pair{int(second), int(first)};
+  return std::pair{int(first), int(second)};
+}
+
+/// An OpenEXR header's dataWindow (box2i: xMin, yMin, xMax, yMax), after the magic number and
+/// the version: attributes as name, type, size and value until an empty name.
+std::optional<std::pair<int, int>> openexr_size(std::span<const std::uint8_t> b) {
+  const auto string_at = [&](std::size_t& i) -> std::optional<std::string_view> {
+    const auto* begin = reinterpret_cast<const char*>(b.data()) + i;
+    const auto* end = std::find(begin, reinterpret_cast<const char*>(b.data()) + b.size(), '\0');
+    if (end == reinterpret_cast<const char*>(b.data()) + b.size()) return std::nullopt;
+    i += static_cast<std::size_t>(end - begin) + 1;
+    return std::string_view(begin, static_cast<std::size_t>(end - begin));
+  };
+  const auto le32 = [&](std::size_t i) {
+    return static_cast<std::int32_t>(std::uint32_t(b[i]) | (std::uint32_t(b[i + 1]) << 8) |
+                                     (std::uint32_t(b[i + 2]) << 16) | (std::uint32_t(b[i + 3]) << 24));
+  };
+  std::size_t i = 8;
+  while (i < b.size()) {
+    const auto name = string_at(i);
+    if (!name || name->empty()) return std::nullopt;
+    const auto type = string_at(i);
+    if (!type || i + 4 > b.size()) return std::nullopt;
+    const std::int32_t size = le32(i);
+    i += 4;
+    if (size < 0 || i + static_cast<std::size_t>(size) > b.size()) return std::nullopt;
+    if (*name == "dataWindow" && *type == "box2i" && size == 16) {
+      const std::int64_t width = std::int64_t{le32(i + 8)} - le32(i) + 1,
+                         height = std::int64_t{le32(i + 12)} - le32(i + 4) + 1;
+      return std::pair{int(std::clamp<std::int64_t>(width, 0, kLargestSide)),
+                       int(std::clamp<std::int64_t>(height, 0, kLargestSide))};
+    }
+    i += static_cast<std::size_t>(size);
+  }
+  return std::nullopt;
+}
+
+/// Width and height from a PNG's IHDR, a JPEG's frame header, a Radiance HDR's resolution line
+/// or an OpenEXR's dataWindow; nullopt when the header is missing or cut short.
 std::optional<std::pair<int, int>> encoded_size(std::span<const std::uint8_t> b, ImageFormat format) {
   const auto be16 = [&](std::size_t i) { return (int(b[i]) << 8) | int(b[i + 1]); };
   if (format == ImageFormat::Png) {
@@ -176,6 +236,8 @@ std::optional<std::pair<int, int>> encoded_size(std::span<const std::uint8_t> b,
     constexpr std::uint32_t kLargest = 1u << 30;
     return std::pair{int(std::min(width, kLargest)), int(std::min(height, kLargest))};
   }
+  if (format == ImageFormat::RadianceHdr) return radiance_hdr_size(b);
+  if (format == ImageFormat::Exr) return openexr_size(b);
   // JPEG: walk the marker segments to the first start-of-frame (SOF0-SOF15 but DHT, JPG, DAC).
   std::size_t i = 2;
   while (i + 4 <= b.size()) {
@@ -199,6 +261,31 @@ std::optional<std::pair<int, int>> encoded_size(std::span<const std::uint8_t> b,
     i += 2 + length;
   }
   return std::nullopt;
+}
+
+/// Refuses an image whose header claims more than image_size_limit() before a decoder allocates
+/// for it (a 30 000 x 30 000 PNG of a few kilobytes asked for 2.7 GB). A header the file's first
+/// 256 KiB do not hold is left to the decoder, which fails on it.
+void check_size(const std::filesystem::path& path, std::initializer_list<ImageFormat> accepted) {
+  constexpr std::size_t kHeaderBytes = std::size_t{256} * 1024;
+  std::vector<std::uint8_t> head(kHeaderBytes);
+  std::ifstream in(path, std::ios::binary);
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  const std::string_view signature(reinterpret_cast<const char*>(head.data()), std::min<std::size_t>(head.size(), 16));
+  for (const ImageFormat format : accepted) {
+    if (!has_signature(signature, format)) continue;
+    const auto size = encoded_size(head, format);
+    if (!size) return;
+    const ImageSizeLimit limit = image_size_limit();
+    const auto [width, height] = *size;
+    if (width > limit.max_side || height > limit.max_side ||
+        std::int64_t{width} * std::int64_t{height} > limit.max_pixels)
+      throw Error(path.string() + ": a " + std::to_string(width) + "x" + std::to_string(height) + " " +
+                  describe(format) + " image, over the limit of " + std::to_string(limit.max_side) +
+                  " pixels on a side and " + std::to_string(limit.max_pixels) + " pixels in all");
+    return;
+  }
 }
 
 /// Runs an OpenCV decoder, one at a time and with its stderr muted; an OpenCV exception becomes
@@ -230,6 +317,7 @@ cv::Mat read_any(const std::filesystem::path& path, int flags, std::initializer_
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw Error("cannot read " + path.string() + ": no such file");
   check_format(path, accepted);
+  check_size(path, accepted);
   // OpenCV keeps EXR behind an opt-in switch since 4.5; relight reads only files it is asked to.
   ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
   const cv::Mat image = run_decoder(path.string(), [&] { return cv::imread(path.string(), flags); });
@@ -319,6 +407,9 @@ LabelImage read_label_png(const std::filesystem::path& path) {
 void write_label_png(const std::filesystem::path& path, const LabelImage& labels) {
   write_encoded(path, wrap(labels, CV_16UC1));
 }
+
+ImageSizeLimit image_size_limit() { return size_limit(); }
+void set_image_size_limit(const ImageSizeLimit& limit) { size_limit() = limit; }
 
 ColorImage read_color(const std::filesystem::path& path) {
   const cv::Mat raw = read_any(path, cv::IMREAD_ANYDEPTH | cv::IMREAD_COLOR, {ImageFormat::Png, ImageFormat::Jpeg});

@@ -93,6 +93,16 @@ Eigen::Vector3d read_vec3(const nlohmann::json& entry, const char* key, const st
   return v;
 }
 
+/// A direction: any finite, non-zero vector, scaled to unit length. The stable norm, because
+/// components near the largest double overflow the plain one (a direction of 1e300s became zero).
+Eigen::Vector3d read_unit_vec3(const nlohmann::json& entry, const char* key, const std::string& where,
+                               const std::string& what) {
+  Eigen::Vector3d v = read_vec3(entry, key, where);
+  if (!(v.stableNorm() >= 1e-9)) throw Error(where + ": " + what + " must not be zero");
+  v.stableNormalize();
+  return v;
+}
+
 }  // namespace
 
 LightSet lights_from_json(const std::string& text, const std::string& source) {
@@ -110,9 +120,7 @@ LightSet lights_from_json(const std::string& text, const std::string& source) {
     std::string type = entry["type"].get<std::string>();
     if (type == "directional") {
       light.kind = LightKind::Directional;
-      light.direction = read_vec3(entry, "direction", where);
-      if (light.direction.norm() < 1e-9) throw Error(where + ": the direction must not be zero");
-      light.direction.normalize();
+      light.direction = read_unit_vec3(entry, "direction", where, "the direction");
     } else if (type == "point" || type == "spot") {
       light.kind = type == "point" ? LightKind::Point : LightKind::Spot;
       light.position = read_vec3(entry, "position", where);
@@ -120,9 +128,7 @@ LightSet lights_from_json(const std::string& text, const std::string& source) {
       throw Error(where + ": unknown type '" + type.append("' (directional, point or spot)"));
     }
     if (light.kind == LightKind::Spot) {
-      light.axis = read_vec3(entry, "axis", where);
-      if (light.axis.norm() < 1e-9) throw Error(where + ": the spot's axis must not be zero");
-      light.axis.normalize();
+      light.axis = read_unit_vec3(entry, "axis", where, "the spot's axis");
       const auto degrees = [&](const char* key, double fallback) {
         if (!entry.contains(key)) return fallback;
         if (!entry[key].is_number()) throw Error(where + ": '" + key + "' must be a number of degrees");

@@ -121,6 +121,9 @@ ProbeFrame read_probe_image(const fs::path& path, const ProbeResponse& response)
   frame.name = path.string();
   if (is_hdr_image(path)) {
     frame.radiance = read_radiance(path);
+    // OpenEXR's floats can be negative (a colour transform's undershoot), which is no light
+    // (read_radiance refuses NaN and infinity).
+    for (Float3& p : frame.radiance.pixels()) p = {std::max(p.x, 0.f), std::max(p.y, 0.f), std::max(p.z, 0.f)};
   } else if (is_ldr_image(path)) {
     LdrProbe ldr = radiance_from_ldr(read_color(path), response);
     frame.radiance = std::move(ldr.radiance);

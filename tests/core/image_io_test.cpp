@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 
 #include "relight/core/atomic_file.h"
@@ -126,6 +127,49 @@ TEST(ImageIo, FilesOfAnotherFormatAreRefusedBeforeDecoding) {
   EXPECT_THROW((void)read_radiance(dir.path() / "c.png"), Error);
   EXPECT_THROW((void)read_color(dir.path() / "r.exr"), Error);
   EXPECT_THROW((void)read_depth_exr(dir.path() / "c.png"), Error);
+}
+
+/// Sets the readers' size limit for one test and restores the default after it.
+struct SizeLimitForTest {
+  explicit SizeLimitForTest(ImageSizeLimit limit) { set_image_size_limit(limit); }
+  ~SizeLimitForTest() { set_image_size_limit({}); }
+};
+
+// Issue "huge inputs": a header that claims more than the limit is refused, naming the file, its
+// size and the limit, before a decoder allocates (read from the header of PNG, JPEG-less here,
+// Radiance HDR and OpenEXR files alike).
+TEST(ImageIo, ImagesOverTheSizeLimitAreRefusedFromTheirHeader) {
+  test::TempDir dir;
+  write_color(dir.path() / "c.png", ColorImage(40, 30));
+  write_radiance(dir.path() / "r.hdr", RadianceImage(40, 30));
+  write_radiance(dir.path() / "r.exr", RadianceImage(40, 30));
+  write_depth_png(dir.path() / "d.png", DepthMap(40, 30), 5000.0);
+  const auto expect_refused = [](const std::function<void()>& read, const std::string& message) {
+    try {
+      read();
+      ADD_FAILURE() << "read past the limit: " << message;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  {
+    const SizeLimitForTest small({32, 1 << 20});
+    expect_refused([&] { (void)read_color(dir.path() / "c.png"); }, "c.png: a 40x30 PNG image, over the limit of 32");
+    expect_refused([&] { (void)read_radiance(dir.path() / "r.hdr"); }, "r.hdr: a 40x30 Radiance HDR image");
+    expect_refused([&] { (void)read_radiance(dir.path() / "r.exr"); }, "r.exr: a 40x30 OpenEXR image");
+    expect_refused([&] { (void)read_depth_png(dir.path() / "d.png", 5000.0); }, "d.png: a 40x30 PNG image");
+  }
+  {
+    const SizeLimitForTest few_pixels({64, 1000});  // 40 x 30 = 1200 pixels
+    expect_refused([&] { (void)read_radiance(dir.path() / "r.exr"); }, "and 1000 pixels in all");
+  }
+  EXPECT_EQ(read_color(dir.path() / "c.png").width(), 40);  // the default limit takes them
+  EXPECT_EQ(read_radiance(dir.path() / "r.hdr").height(), 30);
+  EXPECT_EQ(read_radiance(dir.path() / "r.exr").width(), 40);
+  // A few bytes that claim 100 000 x 100 000 pixels: refused, not allocated.
+  write_file_atomically(dir.path() / "huge.hdr",
+                        std::string_view("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 100000 +X 100000\n"));
+  expect_refused([&] { (void)read_radiance(dir.path() / "huge.hdr"); }, "huge.hdr: a 100000x100000 Radiance HDR image");
 }
 
 TEST(ImageIo, PreviewsMarkInvalidPixelsBlack) {

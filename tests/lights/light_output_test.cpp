@@ -27,6 +27,23 @@ TEST(LightOutput, JsonRoundTripKeepsEveryLight) {
   EXPECT_FALSE(back.lights[1].real);
 }
 
+// Found by lights_json_fuzzer: components near the largest double overflowed the plain norm, and
+// the direction came out as zeros. Any finite non-zero vector is a direction; zero is an error.
+TEST(LightOutput, HugeAndTinyDirectionsBecomeUnitVectorsAndZeroIsRefused) {
+  const LightSet set = lights_from_json(
+      R"({"lights": [{"type": "directional", "direction": [1e300, 1e300, 1e300], "power": [1, 1, 1]},
+                     {"type": "spot", "position": [0, 0, 2], "axis": [0, 3e-7, -4e-7], "cone_degrees": 30,
+                      "power": [1, 1, 1]}]})",
+      "huge.json");
+  ASSERT_EQ(set.lights.size(), 2u);
+  EXPECT_TRUE(set.lights[0].direction.isApprox(Eigen::Vector3d::Ones().normalized(), 1e-12));
+  EXPECT_TRUE(set.lights[1].axis.isApprox(Eigen::Vector3d(0, 0.6, -0.8), 1e-12));
+  EXPECT_THROW((void)lights_from_json(R"({"lights": [{"type": "directional", "direction": [0, 0, 1e-12],
+                                                      "power": [1, 1, 1]}]})",
+                                      "zero.json"),
+               Error);
+}
+
 TEST(LightOutput, SpotLightsKeepTheirConeAndFadeOutAtItsEdge) {
   const LightSet set = lights_from_json(R"({"lights": [{"type": "spot", "position": [0, 0, 2], "axis": [0, 0, -3],
                                                         "cone_degrees": 30, "power": [5, 5, 5]}]})",

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -137,6 +138,31 @@ TEST(ProbeStream, EightBitProbesAreDecodedAndClippingIsReported) {
   EXPECT_NEAR(probe(0, 0).x, ProbeResponse{}.clip_gain, 1e-4);
   EXPECT_NE(warnings.str().find("5 % of its pixels saturated"), std::string::npos) << warnings.str();
   EXPECT_DOUBLE_EQ(matcher.summary()["max_clipped_share"].get<double>(), 0.05);
+}
+
+// Found by probe_image_fuzzer: an OpenEXR probe may hold NaN, infinity or negative values, which
+// no light is. NaN and infinity refuse the probe with a line naming the pixel; negatives become
+// zero.
+TEST(ProbeStream, OpenExrProbesWithNonFiniteValuesAreRefusedAndNegativesAreNoLight) {
+  test::TempDir dir;
+  RadianceImage image = marker_probe(2.f);
+  image(1, 1) = {-0.5f, 3.f, -1e-3f};
+  write_radiance(dir.path() / "negative.exr", image);
+  const ProbeFrame frame = read_probe_image(dir.path() / "negative.exr", {});
+  EXPECT_EQ(frame.radiance(1, 1).x, 0.f);
+  EXPECT_EQ(frame.radiance(1, 1).y, 3.f);
+  EXPECT_EQ(frame.radiance(1, 1).z, 0.f);
+  EXPECT_EQ(frame.radiance(0, 0).x, 2.f);
+  for (const float bad : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    image(2, 3) = {1.f, bad, 1.f};
+    write_radiance(dir.path() / "bad.exr", image);
+    try {
+      (void)read_probe_image(dir.path() / "bad.exr", {});
+      ADD_FAILURE() << "a probe with " << bad << " was read";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.exr: pixel (3, 2) is not finite"), std::string::npos) << e.what();
+    }
+  }
 }
 
 TEST(ProbeStream, BadListsAreOneLineErrorsNamingTheLine) {

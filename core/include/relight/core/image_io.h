@@ -25,6 +25,17 @@ void write_depth_exr(const std::filesystem::path& path, const DepthMap& depth);
 LabelImage read_label_png(const std::filesystem::path& path);
 void write_label_png(const std::filesystem::path& path, const LabelImage& labels);
 
+/// The largest image the readers below decode: a file whose header claims more is refused with a
+/// line naming it and the limit before anything is allocated for it. 16384 on a side and 2^26
+/// pixels (a 16k x 4k probe, an 8k x 8k texture) by default.
+struct ImageSizeLimit {
+  int max_side = 16384;
+  std::int64_t max_pixels = std::int64_t{1} << 26;
+};
+[[nodiscard]] ImageSizeLimit image_size_limit();
+/// For programs that must stay smaller (the fuzz targets); set it before any reading starts.
+void set_image_size_limit(const ImageSizeLimit& limit);
+
 /// 8-bit colour, PNG or JPEG. Grey images are expanded to RGB; 16-bit images are rejected.
 ColorImage read_color(const std::filesystem::path& path);
 void write_color(const std::filesystem::path& path, const ColorImage& image);
