@@ -54,10 +54,12 @@ app::ReplayOptions replay_options(const std::filesystem::path& sequence, const s
   return replay;
 }
 
-void write_sequence(const std::filesystem::path& folder, int frames) {
+void write_sequence(const std::filesystem::path& folder, int frames, int width = 640, int height = 480) {
   synth::SynthOptions synth;
   synth.frames = frames;
   synth.ground_truth = false;
+  synth.width = width;
+  synth.height = height;
   truth::write_sequence(synth, folder);
 }
 
@@ -197,12 +199,7 @@ bench::Json replay_gpu(const bench::Options& options, int width, int height, dou
   const std::string name = "pipeline/replay_" + std::to_string(width) + "x" + std::to_string(height) + "_gpu";
   TempFolder folder;
   const int frames = std::max(options.repetitions, 3);
-  synth::SynthOptions synth;
-  synth.frames = frames + 2;
-  synth.ground_truth = false;
-  synth.width = width;
-  synth.height = height;
-  truth::write_sequence(synth, folder.path / "sequence");
+  write_sequence(folder.path / "sequence", frames + 2, width, height);
   const auto build = [&](const std::string& side, vk::BackendPolicy backend) {
     app::ReplayOptions replay = replay_options(folder.path / "sequence", folder.path / side);
     replay.objects = {app::data_folder() / "models" / "glossy_pebble.gltf"};

@@ -155,14 +155,25 @@ const char* describe(ImageFormat format) {
   return "?";
 }
 
-void check_format(const std::filesystem::path& path, std::initializer_list<ImageFormat> accepted) {
-  std::array<char, 16> bytes{};
+/// The file's first bytes: enough for every header the size check reads (a JPEG's frame header
+/// may follow tens of kilobytes of EXIF); a header they do not hold is left to the decoder,
+/// which fails on it.
+std::vector<std::uint8_t> read_head(const std::filesystem::path& path) {
+  constexpr std::size_t kHeaderBytes = std::size_t{256} * 1024;
+  std::vector<std::uint8_t> head(kHeaderBytes);
   std::ifstream in(path, std::ios::binary);
-  in.read(bytes.data(), bytes.size());
-  const std::string_view head(bytes.data(), static_cast<std::size_t>(in.gcount()));
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(in.gcount()));
+  return head;
+}
+
+/// Which of the accepted formats the file's first bytes say it is; relight::Error for none.
+ImageFormat check_format(const std::filesystem::path& path, std::span<const std::uint8_t> head,
+                         std::initializer_list<ImageFormat> accepted) {
+  const std::string_view signature(reinterpret_cast<const char*>(head.data()), std::min<std::size_t>(head.size(), 16));
   std::string expected;
   for (const ImageFormat format : accepted) {
-    if (has_signature(head, format)) return;
+    if (has_signature(signature, format)) return format;
     expected += std::string(expected.empty() ? "" : " or ") + describe(format);
   }
   throw Error("cannot decode " + path.string() + ": not a " + expected + " file");
@@ -264,28 +275,17 @@ std::optional<std::pair<int, int>> encoded_size(std::span<const std::uint8_t> b,
 }
 
 /// Refuses an image whose header claims more than image_size_limit() before a decoder allocates
-/// for it (a 30 000 x 30 000 PNG of a few kilobytes asked for 2.7 GB). A header the file's first
-/// 256 KiB do not hold is left to the decoder, which fails on it.
-void check_size(const std::filesystem::path& path, std::initializer_list<ImageFormat> accepted) {
-  constexpr std::size_t kHeaderBytes = std::size_t{256} * 1024;
-  std::vector<std::uint8_t> head(kHeaderBytes);
-  std::ifstream in(path, std::ios::binary);
-  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
-  head.resize(static_cast<std::size_t>(in.gcount()));
-  const std::string_view signature(reinterpret_cast<const char*>(head.data()), std::min<std::size_t>(head.size(), 16));
-  for (const ImageFormat format : accepted) {
-    if (!has_signature(signature, format)) continue;
-    const auto size = encoded_size(head, format);
-    if (!size) return;
-    const ImageSizeLimit limit = image_size_limit();
-    const auto [width, height] = *size;
-    if (width > limit.max_side || height > limit.max_side ||
-        std::int64_t{width} * std::int64_t{height} > limit.max_pixels)
-      throw Error(path.string() + ": a " + std::to_string(width) + "x" + std::to_string(height) + " " +
-                  describe(format) + " image, over the limit of " + std::to_string(limit.max_side) +
-                  " pixels on a side and " + std::to_string(limit.max_pixels) + " pixels in all");
-    return;
-  }
+/// for it (a 30 000 x 30 000 PNG of a few kilobytes asked for 2.7 GB).
+void check_size(const std::filesystem::path& path, std::span<const std::uint8_t> head, ImageFormat format) {
+  const auto size = encoded_size(head, format);
+  if (!size) return;
+  const ImageSizeLimit limit = image_size_limit();
+  const auto [width, height] = *size;
+  if (width > limit.max_side || height > limit.max_side ||
+      std::int64_t{width} * std::int64_t{height} > limit.max_pixels)
+    throw Error(path.string() + ": a " + std::to_string(width) + "x" + std::to_string(height) + " " + describe(format) +
+                " image, over the limit of " + std::to_string(limit.max_side) + " pixels on a side and " +
+                std::to_string(limit.max_pixels) + " pixels in all");
 }
 
 /// Runs an OpenCV decoder, one at a time and with its stderr muted; an OpenCV exception becomes
@@ -316,8 +316,8 @@ ColorImage rgb_image(const cv::Mat& bgr) {
 cv::Mat read_any(const std::filesystem::path& path, int flags, std::initializer_list<ImageFormat> accepted) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw Error("cannot read " + path.string() + ": no such file");
-  check_format(path, accepted);
-  check_size(path, accepted);
+  const std::vector<std::uint8_t> head = read_head(path);
+  check_size(path, head, check_format(path, head, accepted));
   // OpenCV keeps EXR behind an opt-in switch since 4.5; relight reads only files it is asked to.
   ::setenv("OPENCV_IO_ENABLE_OPENEXR", "1", 0);
   const cv::Mat image = run_decoder(path.string(), [&] { return cv::imread(path.string(), flags); });
