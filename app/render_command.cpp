@@ -46,6 +46,7 @@ struct RenderReferenceOptions {
   int spp = 256;
   double time_budget = 0.0;
   int max_bounces = 4;
+  double caustic_paths = 1.0;  ///< caustic light paths per pixel, light and sample (PathTracerOptions)
   std::uint64_t seed = 1;
   int downsample = 1;
   colormap::ToneMapOptions tone_map;  ///< Reinhard's key from this frame's L_rv (nothing to adapt from)
@@ -138,6 +139,7 @@ int run_render_reference(const RenderReferenceOptions& command) {
   options.max_bounces = command.max_bounces;
   options.seed = command.seed;
   options.threads = command.threads;
+  options.caustic_paths_per_pixel = command.caustic_paths;
   render::DifferentialPathTracer tracer(scene, options);
   tracer.reset(camera);
 
@@ -168,6 +170,7 @@ int run_render_reference(const RenderReferenceOptions& command) {
                                     {"seed", command.seed},
                                     {"seconds", seconds},
                                     {"rays", tracer.rays_traced()},
+                                    {"caustic_light_paths", tracer.light_paths_traced()},
                                     {"mrays_per_s", mrays},
                                     {"tone_map", tone_map_json(command.tone_map, tone_map)},
                                     {"outputs",
@@ -207,6 +210,12 @@ void register_render_reference(CLI::App& app, Runners& runners) {
       ->check(CLI::NonNegativeNumber);
   command->add_option("--max-bounces", options->max_bounces, "Indirect bounces")->check(CLI::Range(0, 1000))->capture_default_str();
   command->add_option("--seed", options->seed, "Random seed; same seed and spp, same image")->capture_default_str();
+  command
+      ->add_option("--caustic-paths", options->caustic_paths,
+                   "Light paths per pixel, light and sample that carry the light focused by mirrors and glass "
+                   "(caustics; traced only when the scene has such materials; 0 = none)")
+      ->check(CLI::Range(0.0, 1024.0))
+      ->capture_default_str();
   command->add_option("--downsample", options->downsample, "Render at 1/N of the camera resolution")
       ->check(CLI::IsMember({1, 2, 4, 8}))
       ->capture_default_str();
@@ -233,12 +242,15 @@ void register_models(CLI::App& app, Runners& runners) {
   command->add_option("--out", *out, "Output folder")->required();
   runners[command] = [out] {
     fs::create_directories(*out);
-    const render::VirtualModel pebble = render::make_glossy_pebble();
+    std::string written;
+    for (const render::VirtualModel& model :
+         {render::make_glossy_pebble(), render::make_glass_pebble(), render::make_metal_bottle()}) {
+      render::save_gltf(*out / (model.name + ".gltf"), model);
+      written += model.name + ".gltf, ";
+    }
     const render::VirtualModel box = render::make_matte_box();
-    render::save_gltf(*out / (pebble.name + ".gltf"), pebble);
     render::save_obj(*out / (box.name + ".obj"), box);
-    std::cerr << "relight models: wrote " << pebble.name << ".gltf and " << box.name << ".obj/.mtl to " << out->string()
-              << "\n";
+    std::cerr << "relight models: wrote " << written << box.name << ".obj/.mtl to " << out->string() << "\n";
     return 0;
   };
 }

@@ -41,6 +41,34 @@ TEST(RenderReferenceCli, WritesLrvLrCompositeAndSummary) {
   const auto summary = nlohmann::json::parse(read_text_file(dir.path() / "nested" / "ref.json"));
   EXPECT_EQ(summary["samples_per_pixel"], 2);
   EXPECT_GT(summary["mrays_per_s"].get<double>(), 0.0);
+  EXPECT_EQ(summary["caustic_light_paths"], 0);  // a Phong object: no light path is traced
+}
+
+// Glass focuses the room's lamps onto the table: with the same seed the camera paths are the same
+// with and without the caustic light paths, so what those add is exactly the light through glass.
+TEST(RenderReferenceCli, TheGlassPebbleFocusesTheLampsOntoTheTable) {
+  test::TempDir dir;
+  const std::string common = "render-reference --quiet --sequence " + synthetic_sequence().string() + " --object " +
+                             (kData / "models" / "glass_pebble.gltf").string() +
+                             " --spp 2 --downsample 8 --max-bounces 0";
+  ASSERT_EQ(relight(common + " --out " + (dir.path() / "with.exr").string()).exit_code, 0);
+  const auto without = relight(common + " --caustic-paths 0 --out " + (dir.path() / "without.exr").string());
+  ASSERT_EQ(without.exit_code, 0) << without.err;
+  EXPECT_GT(nlohmann::json::parse(read_text_file(dir.path() / "with.json"))["caustic_light_paths"].get<double>(), 0.0);
+  EXPECT_EQ(nlohmann::json::parse(read_text_file(dir.path() / "without.json"))["caustic_light_paths"], 0);
+  const RadianceImage with_rv = read_radiance(dir.path() / "with.exr"),
+                      without_rv = read_radiance(dir.path() / "without.exr");
+  const RadianceImage with_r = read_radiance(dir.path() / "with.Lr.exr"),
+                      without_r = read_radiance(dir.path() / "without.Lr.exr");
+  int brighter = 0;
+  for (std::size_t i = 0; i < with_rv.size(); ++i) {
+    ASSERT_EQ(with_r.pixels()[i], without_r.pixels()[i]);  // the glass is virtual: no caustic in L_r
+    const float added = luminance(with_rv.pixels()[i]) - luminance(without_rv.pixels()[i]);
+    ASSERT_GE(added, 0.f);
+    brighter += added > 0.f;
+  }
+  EXPECT_GT(brighter, 5);
+  EXPECT_LT(brighter, static_cast<int>(with_rv.size()) / 4);
 }
 
 // The path tracer's composite takes the same operators as replay's: Reinhard's key from the
@@ -110,7 +138,8 @@ TEST(RenderReferenceCli, BadInputGivesOneLineErrors) {
 TEST(ModelsCli, RegeneratesTheShippedModelsByteForByte) {
   test::TempDir dir;
   ASSERT_EQ(relight("models --out " + dir.path().string()).exit_code, 0);
-  for (const char* file : {"glossy_pebble.gltf", "matte_box.obj", "matte_box.mtl"})
+  for (const char* file :
+       {"glossy_pebble.gltf", "glass_pebble.gltf", "metal_bottle.gltf", "matte_box.obj", "matte_box.mtl"})
     EXPECT_EQ(read_text_file(dir.path() / file), read_text_file(kData / "models" / file)) << file;
 }
 

@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "glb_file.h"
 #include "relight/core/error.h"
@@ -76,11 +79,107 @@ TEST(ModelIo, EmissiveMaterialSurvivesGltf) {
   EXPECT_TRUE(load_model(dir.path() / "lamp.gltf").materials[0].emission.isApprox(Eigen::Vector3f(4, 3, 2), 1e-5f));
 }
 
+TEST(ModelIo, GlassAndMirrorMaterialsSurviveGltf) {
+  const test::TempDir dir;
+  VirtualModel model = make_matte_box();
+  model.materials[0].specular = dielectric(1.33f, {0.6f, 0.9f, 1.f}, 0.05f);
+  model.materials.push_back(model.materials[0]);
+  model.materials[1].name = "mirror";
+  model.materials[1].specular = conductor({0.95f, 0.64f, 0.54f});
+  model.meshes[0].triangle_material[0] = 1;
+  save_gltf(dir.path() / "specular.gltf", model);
+  const VirtualModel back = load_model(dir.path() / "specular.gltf");
+  ASSERT_EQ(back.materials.size(), 3u);  // + the default material
+  const SpecularMaterial& glass = back.materials[0].specular;
+  EXPECT_EQ(glass.kind, SpecularKind::Dielectric);
+  EXPECT_FLOAT_EQ(glass.ior, 1.33f);
+  EXPECT_TRUE(glass.attenuation_color.isApprox(Eigen::Vector3f(0.6f, 0.9f, 1.f)));
+  EXPECT_FLOAT_EQ(glass.attenuation_distance, 0.05f);
+  EXPECT_EQ(back.materials[1].specular.kind, SpecularKind::Conductor);
+  EXPECT_TRUE(back.materials[1].specular.reflectance.isApprox(Eigen::Vector3f(0.95f, 0.64f, 0.54f)));
+  expect_same_material(model.materials[0], back.materials[0]);  // the Phong fallback too
+  EXPECT_FALSE(back.materials[2].specular.specular());
+}
+
+TEST(ModelIo, GltfTransmissionMakesGlassAndASmoothMetalAMirror) {
+  const test::TempDir dir;
+  save_gltf(dir.path() / "box.gltf", make_matte_box());
+  nlohmann::json gltf = nlohmann::json::parse(std::ifstream(dir.path() / "box.gltf"));
+  const auto write_with = [&](const nlohmann::json& material) {
+    gltf["materials"] = nlohmann::json::array({material});
+    std::ofstream(dir.path() / "variant.gltf") << gltf.dump();
+    return load_model(dir.path() / "variant.gltf").materials[0];
+  };
+  // Glass without an index (1.5) and with a volume's attenuation; its Phong fallback is clear.
+  const PhongMaterial glass = write_with(nlohmann::json::parse(R"({"name": "glass",
+      "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 1], "metallicFactor": 0, "roughnessFactor": 0},
+      "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                     "KHR_materials_volume": {"attenuationColor": [0.5, 0.5, 1], "attenuationDistance": 0.2}}})"));
+  EXPECT_EQ(glass.specular.kind, SpecularKind::Dielectric);
+  EXPECT_FLOAT_EQ(glass.specular.ior, 1.5f);
+  EXPECT_TRUE(glass.specular.attenuation_color.isApprox(Eigen::Vector3f(0.5f, 0.5f, 1.f)));
+  EXPECT_FLOAT_EQ(glass.specular.attenuation_distance, 0.2f);
+  EXPECT_LT(glass.kd.maxCoeff(), 1e-6f);
+  const PhongMaterial water = write_with(nlohmann::json::parse(R"({"name": "water",
+      "extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.9}, "KHR_materials_ior": {"ior": 1.33}}})"));
+  EXPECT_FLOAT_EQ(water.specular.ior, 1.33f);
+  EXPECT_FALSE(std::isfinite(water.specular.attenuation_distance));
+  const PhongMaterial copper = write_with(nlohmann::json::parse(R"({"name": "copper",
+      "pbrMetallicRoughness": {"baseColorFactor": [0.95, 0.64, 0.54, 1], "metallicFactor": 1, "roughnessFactor": 0.02}})"));
+  EXPECT_EQ(copper.specular.kind, SpecularKind::Conductor);
+  EXPECT_TRUE(copper.specular.reflectance.isApprox(Eigen::Vector3f(0.95f, 0.64f, 0.54f)));
+  // Rough metal and a little transmission stay Phong.
+  EXPECT_FALSE(
+      write_with(nlohmann::json::parse(R"({"pbrMetallicRoughness": {"metallicFactor": 1, "roughnessFactor": 0.4}})"))
+          .specular.specular());
+  EXPECT_FALSE(write_with(nlohmann::json::parse(
+                              R"({"extensions": {"KHR_materials_transmission": {"transmissionFactor": 0.2}}})"))
+                   .specular.specular());
+}
+
+TEST(ProceduralModels, TheGlassPebbleAndTheMetalBottleAreClosedAndWoundOutwards) {
+  // Glass needs both: the winding says whether a ray enters or leaves (specular_material.h).
+  const std::vector<VirtualModel> models{make_glass_pebble(), make_metal_bottle()};
+  for (const VirtualModel& model : models) {
+    const TriangleMesh& mesh = model.meshes.at(0);
+    std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed_edges;
+    double volume = 0.0;  // divergence theorem: positive for outward windings
+    for (const auto& t : mesh.triangles) {
+      for (int e = 0; e < 3; ++e)
+        ++directed_edges[{t[static_cast<std::size_t>(e)], t[static_cast<std::size_t>((e + 1) % 3)]}];
+      volume += mesh.positions[t[0]].cast<double>().dot(
+                    mesh.positions[t[1]].cast<double>().cross(mesh.positions[t[2]].cast<double>())) /
+                6.0;
+    }
+    for (const auto& [edge, count] : directed_edges) {
+      EXPECT_EQ(count, 1) << model.name;  // each directed edge once, and its reverse once: closed
+      EXPECT_EQ(directed_edges.count({edge.second, edge.first}), 1u) << model.name;
+    }
+    EXPECT_GT(volume, 0.0) << model.name;
+    EXPECT_TRUE(model.materials.at(0).specular.specular()) << model.name;
+  }
+  // The bottle's volume is about that of its profile turned (a 7 cm cylinder 0.11 m high plus neck).
+  const TriangleMesh& bottle = models[1].meshes.at(0);
+  double volume = 0.0;
+  for (const auto& t : bottle.triangles)
+    volume += bottle.positions[t[0]].cast<double>().dot(
+                  bottle.positions[t[1]].cast<double>().cross(bottle.positions[t[2]].cast<double>())) /
+              6.0;
+  EXPECT_GT(volume, std::numbers::pi * 0.035 * 0.035 * 0.11);
+  EXPECT_LT(volume, std::numbers::pi * 0.035 * 0.035 * 0.21);
+}
+
 TEST(ModelIo, ShippedModelsAreTheProceduralOnes) {
   const std::filesystem::path models = std::filesystem::path(RELIGHT_TEST_DATA) / "models";
   const VirtualModel pebble = load_model(models / "glossy_pebble.gltf");
   expect_same_geometry(make_glossy_pebble(), pebble, 1e-6f);
   expect_same_material(make_glossy_pebble().materials[0], pebble.materials[0]);
+  const std::vector<VirtualModel> specular_models{make_glass_pebble(), make_metal_bottle()};
+  for (const VirtualModel& model : specular_models) {
+    const VirtualModel shipped = load_model(models / (model.name + ".gltf"));
+    expect_same_geometry(model, shipped, 1e-6f);
+    EXPECT_EQ(shipped.materials[0].specular.kind, model.materials[0].specular.kind) << model.name;
+  }
   const VirtualModel box = load_model(models / "matte_box.obj");
   expect_same_geometry(make_matte_box(), box, 1e-6f);
   expect_same_material(make_matte_box().materials[0], box.materials[0]);

@@ -4,16 +4,27 @@
 #include <atomic>
 #include <cmath>
 
+#include "reference/caustic_light_tracer.h"
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
 #include "relight/render/scene/phong_brdf.h"
 #include "relight/render/scene/sampler.h"
+#include "relight/render/scene/specular_bsdf.h"
 #include "scene/surface_shading.h"
 
 namespace relight::render {
 namespace {
 
 using namespace detail;
+
+/// Where a camera path stands: its non-specular bounces (the bounce limit and Russian roulette
+/// count these), its specular ones (capped separately, so that light crossing a glass object or
+/// bouncing inside it is not cut by the diffuse bounce limit) and the dielectric it is inside.
+struct PathState {
+  int bounces = 0;
+  int specular_bounces = 0;
+  const SpecularMaterial* medium = nullptr;
+};
 
 class PathIntegrator {
  public:
@@ -27,48 +38,51 @@ class PathIntegrator {
   /// Adds the radiance along one ray in one version of the scene (with or without the virtual
   /// objects), weighted by `throughput`, to `radiance`. It repeats the joint path's arithmetic
   /// exactly, so L_r does not change by a bit when virtual objects are added to a scene.
-  void trace_layer(Vec3 origin, Vec3 direction, int bounce, bool with_virtual, Vec3 throughput, Vec3& radiance,
+  void trace_layer(Vec3 origin, Vec3 direction, PathState state, bool with_virtual, Vec3 throughput, Vec3& radiance,
                    Pcg32& rng, std::uint32_t& rays) const;
-  std::optional<SurfaceHit> nearest(const Vec3& origin, const Vec3& direction, bool with_virtual,
-                                    std::uint32_t& rays) const;
   /// Next-event estimation at v, shared by both versions of the scene: for every light (the
   /// virtual ones only when `virtual_lights`) whose sample is lit and not blocked by real
   /// geometry, add(light, f cos E, virtual_visible), where virtual_visible says whether no
-  /// virtual geometry blocks it either (tested only when `test_virtual`, else true).
+  /// virtual geometry blocks it either (tested only when `test_virtual`, else true). Nothing at
+  /// a specular vertex: its delta directions never point at a light (caustic_light_tracer.h
+  /// brings the light that reaches surfaces through them).
   template <class Add>
   void direct_lights(const Vertex& v, bool virtual_lights, bool test_virtual, std::uint32_t& rays, Add&& add) const;
   /// Samples the continuation; false when the path ends (bounce limit, absorption, roulette).
-  bool continue_path(const Vertex& v, int bounce, Vec3& throughput, Vec3& origin, Vec3& direction, Pcg32& rng) const;
+  bool continue_path(const Vertex& v, PathState& state, Vec3& throughput, Vec3& origin, Vec3& direction,
+                     Pcg32& rng) const;
 
   const MrScene& scene_;
   const RayTracer& tracer_;
   const PathTracerOptions& options_;
 };
 
-std::optional<SurfaceHit> PathIntegrator::nearest(const Vec3& origin, const Vec3& direction, bool with_virtual,
-                                                  std::uint32_t& rays) const {
-  ++rays;
-  std::optional<SurfaceHit> hit = tracer_.intersect(Layer::Real, origin, direction);
-  if (!with_virtual || !tracer_.has_virtual_geometry()) return hit;
-  ++rays;
-  std::optional<SurfaceHit> virtual_hit = tracer_.intersect(
-      Layer::Virtual, origin, direction, hit ? hit->t : std::numeric_limits<float>::infinity());
-  return virtual_hit ? virtual_hit : hit;
-}
-
-bool PathIntegrator::continue_path(const Vertex& v, int bounce, Vec3& throughput, Vec3& origin, Vec3& direction,
+bool PathIntegrator::continue_path(const Vertex& v, PathState& state, Vec3& throughput, Vec3& origin, Vec3& direction,
                                    Pcg32& rng) const {
-  if (bounce >= options_.max_bounces) return false;
+  if (v.specular) {
+    if (state.specular_bounces >= options_.max_specular_bounces) return false;
+    const std::optional<SpecularSample> sample =
+        sample_specular(*v.specular, v.outward, v.wo, rng.uniform(), Transport::Radiance);
+    if (!sample) return false;
+    throughput = throughput.cwiseProduct(sample->weight);
+    if (sample->transmitted) state.medium = v.outward.dot(v.wo) >= 0.f ? v.specular : nullptr;
+    ++state.specular_bounces;
+    origin = offset_origin(v, sample->wi);
+    direction = sample->wi;
+    return true;
+  }
+  if (state.bounces >= options_.max_bounces) return false;
   const float u1 = rng.uniform();
   const float u2 = rng.uniform();
   const std::optional<BrdfSample> sample = sample_phong(v.brdf, v.shading_normal, v.wo, u1, u2);
   if (!sample || sample->wi.dot(v.geometric_normal) <= 0.f) return false;
   throughput = throughput.cwiseProduct(sample->weight);
-  if (bounce + 1 >= options_.roulette_from) {
+  if (state.bounces + 1 >= options_.roulette_from) {
     const float survive = std::min(0.95f, throughput.maxCoeff());
     if (!(rng.uniform() < survive)) return false;
     throughput /= survive;
   }
+  ++state.bounces;
   origin = offset_origin(v, sample->wi);
   direction = sample->wi;
   return true;
@@ -77,6 +91,7 @@ bool PathIntegrator::continue_path(const Vertex& v, int bounce, Vec3& throughput
 template <class Add>
 void PathIntegrator::direct_lights(const Vertex& v, bool virtual_lights, bool test_virtual, std::uint32_t& rays,
                                    Add&& add) const {
+  if (v.specular) return;
   for (const MrLight& light : scene_.lights) {
     if (!virtual_lights && !light.real) continue;
     const std::optional<LightSample> sample = sample_light(light, v.point);
@@ -96,21 +111,22 @@ void PathIntegrator::direct_lights(const Vertex& v, bool virtual_lights, bool te
   }
 }
 
-void PathIntegrator::trace_layer(Vec3 origin, Vec3 direction, int bounce, bool with_virtual, Vec3 throughput,
+void PathIntegrator::trace_layer(Vec3 origin, Vec3 direction, PathState state, bool with_virtual, Vec3 throughput,
                                  Vec3& radiance, Pcg32& rng, std::uint32_t& rays) const {
-  for (int k = bounce;; ++k) {
-    const std::optional<SurfaceHit> hit = nearest(origin, direction, with_virtual, rays);
+  for (;;) {
+    const std::optional<SurfaceHit> hit = nearest_hit(tracer_, origin, direction, with_virtual, rays);
     if (!hit) {
       radiance += throughput.cwiseProduct(scene_.environment.radiance);
       break;
     }
+    if (state.medium) throughput = throughput.cwiseProduct(beer_lambert(*state.medium, hit->t));
     const Vertex v = make_vertex(*hit, direction, scene_);
     radiance += throughput.cwiseProduct(v.emission);
     direct_lights(v, with_virtual, with_virtual && tracer_.has_virtual_geometry(), rays,
                   [&](const MrLight&, const Vec3& contribution, bool virtual_visible) {
                     if (virtual_visible) radiance += throughput.cwiseProduct(contribution);
                   });
-    if (!continue_path(v, k, throughput, origin, direction, rng)) break;
+    if (!continue_path(v, state, throughput, origin, direction, rng)) break;
   }
 }
 
@@ -118,7 +134,8 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
   DifferentialPathTracer::Sample out;
   const bool has_virtual = tracer_.has_virtual_geometry();
   Vec3 throughput = Vec3::Ones();
-  for (int k = 0;; ++k) {
+  PathState state;
+  for (bool first = true;; first = false) {
     ++out.rays;
     const std::optional<SurfaceHit> hit = tracer_.intersect(Layer::Real, origin, direction);
     bool virtual_in_front = false;
@@ -130,10 +147,10 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
     if (virtual_in_front) {
       // The two versions of the scene differ from here on: finish each path on its own, both
       // continuing the same random stream.
-      out.virtual_first_hit = k == 0;
+      out.virtual_first_hit = first;
       Pcg32 rng_real = rng;
-      trace_layer(origin, direction, k, true, throughput, out.real_virtual, rng, out.rays);
-      trace_layer(origin, direction, k, false, throughput, out.real, rng_real, out.rays);
+      trace_layer(origin, direction, state, true, throughput, out.real_virtual, rng, out.rays);
+      trace_layer(origin, direction, state, false, throughput, out.real, rng_real, out.rays);
       break;
     }
     if (!hit) {
@@ -142,6 +159,7 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
       out.real += sky;
       break;
     }
+    if (state.medium) throughput = throughput.cwiseProduct(beer_lambert(*state.medium, hit->t));
     const Vertex v = make_vertex(*hit, direction, scene_);
     const Vec3 emitted = throughput.cwiseProduct(v.emission);
     out.real_virtual += emitted;
@@ -152,7 +170,7 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
                     if (light.real) out.real += weighted;
                     if (virtual_visible) out.real_virtual += weighted;
                   });
-    if (!continue_path(v, k, throughput, origin, direction, rng)) break;
+    if (!continue_path(v, state, throughput, origin, direction, rng)) break;
   }
   return out;
 }
@@ -162,8 +180,14 @@ DifferentialPathTracer::Sample PathIntegrator::trace(Vec3 origin, Vec3 direction
 DifferentialPathTracer::DifferentialPathTracer(const MrScene& scene, PathTracerOptions options)
     : options_(options), tracer_(scene) {
   if (options_.max_bounces < 0) throw Error("max bounces must not be negative");
+  if (options_.max_specular_bounces < 0) throw Error("max specular bounces must not be negative");
   if (options_.roulette_from < 1) throw Error("Russian roulette must start at bounce 1 or later");
+  if (!(options_.caustic_paths_per_pixel >= 0.0) || !std::isfinite(options_.caustic_paths_per_pixel))
+    throw Error("caustic paths per pixel must be a number of at least 0");
+  caustics_ = std::make_unique<detail::CausticLightTracer>(tracer_, options_);
 }
+
+DifferentialPathTracer::~DifferentialPathTracer() = default;
 
 void DifferentialPathTracer::reset(const MrCamera& camera) {
   if (camera.intrinsics.width <= 0 || camera.intrinsics.height <= 0) throw Error("the render size must be positive");
@@ -174,6 +198,7 @@ void DifferentialPathTracer::reset(const MrCamera& camera) {
   virtual_hits_.assign(pixels, 0);
   samples_done_ = 0;
   rays_ = 0;
+  light_paths_ = 0;
 }
 
 DifferentialPathTracer::Sample DifferentialPathTracer::trace_pixel(double u, double v, std::uint64_t pixel,
@@ -217,6 +242,13 @@ void DifferentialPathTracer::add_samples(int samples) {
       }
     rays += local_rays;
   }, 1);
+  if (caustics_->active() && options_.caustic_paths_per_pixel > 0.0) {
+    const auto paths = static_cast<std::uint64_t>(std::max(
+        1.0, std::round(options_.caustic_paths_per_pixel * camera_.intrinsics.width * camera_.intrinsics.height)));
+    for (int s = 0; s < samples; ++s)
+      rays += caustics_->trace(camera_, paths, first + static_cast<std::uint64_t>(s), sum_rv_, sum_r_);
+    light_paths_ += paths * tracer_.scene().lights.size() * static_cast<std::uint64_t>(samples);
+  }
   samples_done_ += samples;
   rays_ += rays.load();
 }

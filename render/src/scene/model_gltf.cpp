@@ -72,6 +72,39 @@ std::optional<PhongMaterial> phong_extras(const tinygltf::Material& m) {
   return out;
 }
 
+const Value* extension_of(const tinygltf::Material& m, const char* name) {
+  const auto found = m.extensions.find(name);
+  return found != m.extensions.end() && found->second.IsObject() ? &found->second : nullptr;
+}
+
+/// An RGB array member of a glTF object, or `fallback`.
+Eigen::Vector3f colour(const Value& object, const char* key, const Eigen::Vector3f& fallback) {
+  if (!object.Has(key) || !object.Get(key).IsArray() || object.Get(key).ArrayLen() != 3) return fallback;
+  Eigen::Vector3f out;
+  for (int c = 0; c < 3; ++c) out[c] = static_cast<float>(object.Get(key).Get(c).GetNumberAsDouble());
+  return out;
+}
+
+/// The specular part of a glTF material (model_io.h): glass from KHR_materials_transmission
+/// (with _ior and _volume), a mirror from a smooth untextured metal.
+SpecularMaterial specular_of(const tinygltf::Material& m, const Eigen::Vector3f& base) {
+  const auto& pbr = m.pbrMetallicRoughness;
+  if (const Value* transmission = extension_of(m, "KHR_materials_transmission");
+      transmission && number(*transmission, "transmissionFactor", 0.f) >= kGltfTransmissionThreshold) {
+    SpecularMaterial glass = dielectric(1.5f);
+    if (const Value* ior = extension_of(m, "KHR_materials_ior")) glass.ior = number(*ior, "ior", 1.5f);
+    if (const Value* volume = extension_of(m, "KHR_materials_volume")) {
+      glass.attenuation_color = colour(*volume, "attenuationColor", Eigen::Vector3f::Ones());
+      glass.attenuation_distance = number(*volume, "attenuationDistance", std::numeric_limits<float>::infinity());
+    }
+    return glass;
+  }
+  if (pbr.metallicFactor >= kGltfMirrorMinMetallic && pbr.roughnessFactor <= kGltfMirrorMaxRoughness &&
+      pbr.metallicRoughnessTexture.index < 0)
+    return conductor(base);
+  return {};
+}
+
 PhongMaterial from_gltf(const tinygltf::Material& m) {
   PhongMaterial out;
   const auto& pbr = m.pbrMetallicRoughness;
@@ -89,6 +122,12 @@ PhongMaterial from_gltf(const tinygltf::Material& m) {
     strength = number(found->second, "emissiveStrength", 1.f);
   if (m.emissiveFactor.size() == 3)
     for (int c = 0; c < 3; ++c) out.emission[c] = static_cast<float>(m.emissiveFactor[static_cast<std::size_t>(c)]) * strength;
+  out.specular = specular_of(m, base);
+  if (out.specular.kind == SpecularKind::Dielectric && !phong_extras(m)) {
+    // The Phong fallback of renderers without specular materials: a clear, glossy surface (the
+    // metallic-roughness mapping would make clear glass of base colour white a white plaster).
+    out.kd = base * (1.f - number(*extension_of(m, "KHR_materials_transmission"), "transmissionFactor", 0.f));
+  }
   return out;
 }
 
@@ -541,6 +580,27 @@ tinygltf::Material to_gltf(const PhongMaterial& m) {
                                 {"ks", tinygltf::Value(static_cast<double>(m.ks))},
                                 {"n", tinygltf::Value(static_cast<double>(m.n))}};
   out.extras = tinygltf::Value(tinygltf::Value::Object{{"relight_phong", tinygltf::Value(phong)}});
+  const auto rgb = [](const Eigen::Vector3f& c) {
+    return tinygltf::Value(tinygltf::Value::Array{tinygltf::Value(static_cast<double>(c.x())),
+                                                  tinygltf::Value(static_cast<double>(c.y())),
+                                                  tinygltf::Value(static_cast<double>(c.z()))});
+  };
+  const SpecularMaterial& s = m.specular;
+  if (s.kind == SpecularKind::Conductor) {
+    out.pbrMetallicRoughness.baseColorFactor = {s.reflectance.x(), s.reflectance.y(), s.reflectance.z(), 1.0};
+    out.pbrMetallicRoughness.metallicFactor = 1.0;
+    out.pbrMetallicRoughness.roughnessFactor = 0.0;
+  } else if (s.kind == SpecularKind::Dielectric) {
+    out.pbrMetallicRoughness.roughnessFactor = 0.0;
+    out.extensions["KHR_materials_transmission"] =
+        tinygltf::Value(tinygltf::Value::Object{{"transmissionFactor", tinygltf::Value(1.0)}});
+    out.extensions["KHR_materials_ior"] =
+        tinygltf::Value(tinygltf::Value::Object{{"ior", tinygltf::Value(static_cast<double>(s.ior))}});
+    tinygltf::Value::Object volume{{"attenuationColor", rgb(s.attenuation_color)}};
+    if (std::isfinite(s.attenuation_distance))
+      volume["attenuationDistance"] = tinygltf::Value(static_cast<double>(s.attenuation_distance));
+    out.extensions["KHR_materials_volume"] = tinygltf::Value(volume);
+  }
   return out;
 }
 
@@ -554,6 +614,10 @@ void save_gltf(const std::filesystem::path& path, const VirtualModel& model) {
   for (const PhongMaterial& m : model.materials) gltf.materials.push_back(to_gltf(m));
   if (std::any_of(model.materials.begin(), model.materials.end(), [](const PhongMaterial& m) { return m.emission.maxCoeff() > 1.f; }))
     gltf.extensionsUsed.push_back("KHR_materials_emissive_strength");
+  if (std::any_of(model.materials.begin(), model.materials.end(),
+                  [](const PhongMaterial& m) { return m.specular.kind == SpecularKind::Dielectric; }))
+    for (const char* name : {"KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"})
+      gltf.extensionsUsed.emplace_back(name);
   tinygltf::Scene scene;
   for (const TriangleMesh& source : model.meshes) {
     tinygltf::Mesh mesh;

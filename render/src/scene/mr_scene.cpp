@@ -99,6 +99,20 @@ void MrScene::validate() const {
     if (!material.kd.allFinite() || !std::isfinite(material.ks) || !std::isfinite(material.n) || material.n < 0.f ||
         !material.emission.allFinite())
       throw Error("material '" + material.name + "' has invalid Phong parameters");
+  for (const PhongMaterial& material : materials) {
+    const SpecularMaterial& s = material.specular;
+    const auto unit = [](const Eigen::Vector3f& c) {
+      return c.allFinite() && c.minCoeff() >= 0.f && c.maxCoeff() <= 1.f;
+    };
+    if (s.kind == SpecularKind::Conductor && !unit(s.reflectance))
+      throw Error("material '" + material.name + "': a mirror's reflectance must lie in [0, 1]");
+    if (s.kind == SpecularKind::Dielectric &&
+        (!(s.ior >= 1.f && s.ior <= 4.f) || !unit(s.attenuation_color) || !(s.attenuation_color.minCoeff() > 0.f) ||
+         !(s.attenuation_distance > 0.f)))
+      throw Error("material '" + material.name +
+                  "': glass needs an index of refraction in [1, 4], an attenuation colour in (0, 1] and an attenuation "
+                  "distance above 0");
+  }
   for (const MrLight& light : lights)
     if (light.through_vpl && light.kind != LightKind::Directional)
       throw Error("only directional (environment) lights can reach the scene through VPLs");
@@ -116,6 +130,12 @@ BoundingSphere bounding_sphere(const MrScene& scene, SceneMeshes meshes) {
   Eigen::AlignedBox3f box;
   for (const TriangleMesh& mesh : scene.meshes) {
     if (meshes == SceneMeshes::Virtual && mesh.real) continue;
+    if (meshes == SceneMeshes::Specular) {
+      for (std::size_t t = 0; t < mesh.triangles.size(); ++t)
+        if (scene.materials[mesh.triangle_material[t]].specular.specular())
+          for (const std::uint32_t v : mesh.triangles[t]) box.extend(mesh.positions[v]);
+      continue;
+    }
     for (const Eigen::Vector3f& p : mesh.positions) box.extend(p);
   }
   BoundingSphere sphere;

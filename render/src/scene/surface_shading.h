@@ -22,6 +22,11 @@ struct Vertex {
   Vec3 wo;
   Phong brdf;     ///< the material's, textured at the point
   Vec3 emission;  ///< the material's, textured at the point
+  /// The material's specular part (specular_material.h), null when it is not specular; then
+  /// `outward` is the interpolated normal on the side the triangle's winding points to (out of a
+  /// closed object), whichever side the ray came from.
+  const SpecularMaterial* specular = nullptr;
+  Vec3 outward = Vec3::Zero();
 };
 
 inline Vertex make_vertex(const SurfaceHit& hit, const Vec3& direction, const MrScene& scene) {
@@ -34,7 +39,26 @@ inline Vertex make_vertex(const SurfaceHit& hit, const Vec3& direction, const Mr
   if (v.shading_normal.dot(v.wo) <= 0.f) v.shading_normal = v.geometric_normal;
   v.brdf = phong_at(scene, hit);
   v.emission = emission_at(scene, hit);
+  const SpecularMaterial& specular = scene.materials[hit.material].specular;
+  if (specular.specular()) {
+    v.specular = &specular;
+    v.outward = hit.interpolated_normal.dot(hit.geometric_normal) < 0.f ? Vec3(-hit.interpolated_normal)
+                                                                        : hit.interpolated_normal;
+  }
   return v;
+}
+
+/// The nearest hit along a ray in the real scene (with_virtual false) or in the whole scene,
+/// counting the layer queries in `rays`.
+inline std::optional<SurfaceHit> nearest_hit(const RayTracer& tracer, const Vec3& origin, const Vec3& direction,
+                                             bool with_virtual, std::uint32_t& rays) {
+  ++rays;
+  std::optional<SurfaceHit> hit = tracer.intersect(Layer::Real, origin, direction);
+  if (!with_virtual || !tracer.has_virtual_geometry()) return hit;
+  ++rays;
+  std::optional<SurfaceHit> virtual_hit =
+      tracer.intersect(Layer::Virtual, origin, direction, hit ? hit->t : std::numeric_limits<float>::infinity());
+  return virtual_hit ? virtual_hit : hit;
 }
 
 /// Ray origin just off the surface on the side `direction` leaves towards (avoids self-hits).

@@ -21,6 +21,15 @@
 // Surface emission is only found by BRDF sampling (no area-light sampling), which keeps the
 // estimator simple and unbiased; it is efficient for the point-like lights of our scenes.
 //
+// Mirrors, metals and glass (specular_material.h) are delta scatterers: a camera path follows
+// them by sampling reflection or refraction in proportion to Fresnel (specular_bsdf.h; these
+// vertices count against max_specular_bounces, not max_bounces) and attenuates by Beer-Lambert
+// inside glass; they get no next-event estimate. The light those surfaces focus onto others
+// (caustics) comes from light paths splatted to the camera (caustic_paths_per_pixel per pixel
+// and pass, src/reference/caustic_light_tracer.h), which take exactly the paths camera paths
+// cannot, so the sum counts nothing twice. A scene without specular materials traces no light
+// path and renders as before.
+//
 // Deterministic: every sample of every pixel has its own random stream (sampler.h), so the
 // result depends on the seed and the sample count only, not on threads or pass sizes.
 #include <chrono>
@@ -36,9 +45,17 @@
 
 namespace relight::render {
 
+namespace detail {
+class CausticLightTracer;
+}
+
 struct PathTracerOptions {
   int max_bounces = 4;    ///< indirect bounces after the camera hit (0 = direct light only)
   int roulette_from = 3;  ///< first bounce at which Russian roulette may end a path
+  int max_specular_bounces = 16;  ///< reflections and refractions at specular surfaces per path
+  /// Caustic light paths per light, per pixel of the image and per pass (0 = none: the light
+  /// focused by mirrors and glass is then missing).
+  double caustic_paths_per_pixel = 1.0;
   std::uint64_t seed = 1;
   int threads = 0;  ///< 0 = all hardware threads
 };
@@ -49,6 +66,9 @@ using RenderProgress = std::function<void(int, int)>;
 class DifferentialPathTracer {
  public:
   DifferentialPathTracer(const MrScene& scene, PathTracerOptions options = {});
+  ~DifferentialPathTracer();
+  DifferentialPathTracer(const DifferentialPathTracer&) = delete;
+  DifferentialPathTracer& operator=(const DifferentialPathTracer&) = delete;
 
   /// Starts a new image for `camera` (drops the accumulated samples).
   void reset(const MrCamera& camera);
@@ -61,10 +81,13 @@ class DifferentialPathTracer {
   [[nodiscard]] int samples_done() const { return samples_done_; }
   /// Rays traced since reset: camera, continuation and shadow rays, each layer query counted.
   [[nodiscard]] std::uint64_t rays_traced() const { return rays_; }
+  /// Caustic light paths traced since reset (zero in a scene without specular materials).
+  [[nodiscard]] std::uint64_t light_paths_traced() const { return light_paths_; }
   /// The current averages.
   [[nodiscard]] DifferentialImages images() const;
 
-  /// One camera sample through the continuous image position (u, v) - exposed for tests.
+  /// One camera sample through the continuous image position (u, v) - exposed for tests (the
+  /// camera paths alone, without the caustic light paths).
   struct Sample {
     Eigen::Vector3f real_virtual = Eigen::Vector3f::Zero();
     Eigen::Vector3f real = Eigen::Vector3f::Zero();
@@ -76,11 +99,13 @@ class DifferentialPathTracer {
  private:
   PathTracerOptions options_;
   RayTracer tracer_;  // holds the scene
+  std::unique_ptr<detail::CausticLightTracer> caustics_;  // refers to tracer_ and options_
   MrCamera camera_;
   std::vector<double> sum_rv_, sum_r_;
   std::vector<std::uint32_t> virtual_hits_;
   int samples_done_ = 0;
   std::uint64_t rays_ = 0;
+  std::uint64_t light_paths_ = 0;
 };
 
 /// Renders `samples_per_pixel` samples of `camera` in one call.

@@ -24,6 +24,14 @@
 // texture (with its scale) bends the shading normal in the triangle's tangent frame
 // (normal_map.h; TANGENT attributes are not read). Each texture reference's
 // KHR_texture_transform (and its texCoord override) is applied (UvTransform, texture.h).
+// Specular materials (specular_material.h): a material with KHR_materials_transmission's
+// transmissionFactor >= kGltfTransmissionThreshold is glass (a dielectric; partial transmission
+// is not modelled) of KHR_materials_ior's index (1.5 without it) and KHR_materials_volume's
+// attenuationColor / attenuationDistance (clear without it; the base colour's tint and
+// thicknessFactor are not read), its Phong fallback k_d = base (1 - transmission); a material
+// with metallic >= kGltfMirrorMinMetallic, roughness <= kGltfMirrorMaxRoughness and no
+// metallic-roughness texture is a mirror of reflectance F0 = base colour. save_gltf writes both
+// back the same way.
 // Occlusion textures, MTL texture maps and the base colour's alpha are ignored. Meshes keep the file's axes
 // (y-up, see virtual_model.h); glTF node transforms are applied. save_gltf writes no textures.
 #include <filesystem>
@@ -31,6 +39,10 @@
 #include "relight/render/scene/virtual_model.h"
 
 namespace relight::render {
+
+inline constexpr float kGltfTransmissionThreshold = 0.5f;
+inline constexpr float kGltfMirrorMinMetallic = 0.99f;
+inline constexpr float kGltfMirrorMaxRoughness = 0.05f;
 
 /// Loads by extension (.obj, .gltf, .glb). Throws relight::Error with one line naming the file
 /// when it is missing, unreadable, malformed or holds no triangles.

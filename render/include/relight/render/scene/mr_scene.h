@@ -17,6 +17,7 @@
 #include "relight/core/camera.h"
 #include "relight/core/phong.h"
 #include "relight/core/pose.h"
+#include "relight/render/scene/specular_material.h"
 #include "relight/render/scene/texture.h"
 
 namespace relight::render {
@@ -40,7 +41,9 @@ struct MetallicRoughness {
 /// `metallic_roughness`'s factors and give k_d (before the base colour), k_s and n through the
 /// mapping above, and a normal texture (glTF's, linear; normal_map.h) that bends the shading
 /// normal, its x and y times `normal_scale`. Textures are shared: scenes are copied every frame,
-/// texels are not.
+/// texels are not. A `specular` material (a mirror, a metal, glass: specular_material.h) is
+/// perfectly specular for the renderers that model it (the path tracer); the others shade its
+/// Phong fallback.
 struct PhongMaterial : Phong {
   std::string name;
   Eigen::Vector3f emission{0.f, 0.f, 0.f};
@@ -50,6 +53,7 @@ struct PhongMaterial : Phong {
   MetallicRoughness metallic_roughness{};  ///< the factors; read only with metallic_roughness_texture
   std::shared_ptr<const Texture> normal_texture{};
   float normal_scale = 1.f;
+  SpecularMaterial specular{};
 };
 
 /// `material`'s Phong parameters at a point where its metallic-roughness texture reads
@@ -123,9 +127,9 @@ struct BoundingSphere {
 
 struct MrScene;
 
-enum class SceneMeshes { All, Virtual };
-/// A sphere around every vertex of `scene`'s meshes (or of its virtual ones): the bounding box's
-/// half diagonal, 1 % + 1 mm larger.
+enum class SceneMeshes { All, Virtual, Specular };
+/// A sphere around every vertex of `scene`'s meshes (or of its virtual ones, or of its triangles
+/// with a specular material): the bounding box's half diagonal, 1 % + 1 mm larger.
 [[nodiscard]] BoundingSphere bounding_sphere(const MrScene& scene, SceneMeshes meshes = SceneMeshes::All);
 
 struct MrScene {
@@ -145,7 +149,8 @@ struct MrScene {
   [[nodiscard]] std::size_t triangle_count(bool real) const;
   /// Throws relight::Error when a mesh (coarse or not) refers to a missing material or vertex,
   /// or has a non-finite position, or a normal array of the wrong size, or a coarse mesh is
-  /// virtual.
+  /// virtual, or a specular material is out of range (reflectance and attenuation colour in
+  /// [0, 1], the attenuation colour above 0, ior in [1, 4], attenuation distance > 0).
   void validate() const;
 
   static constexpr const char* type_name = "MrScene";
