@@ -12,6 +12,7 @@ void AsRenderedCompositeStage::declare(StageBuilder& builder) {
   real_ = builder.read(kRealRadiance);
   coverage_ = builder.read(render::kVirtualCoverage);
   gbuffer_ = builder.read(render::kDirGBuffer);
+  back_projection_ = builder.read(render::kSpecularBackProjection);
   tone_map_ = builder.read(colormap::kToneMap);
   composite_ = builder.write(kCompositeAsRendered);
 }
@@ -22,9 +23,9 @@ void AsRenderedCompositeStage::run(StageContext& context) {
     out = ColorImage{};
     return;
   }
-  out = render::differential_composite(context.get(color_), context.get(real_virtual_), context.get(real_),
-                                       context.get(coverage_), context.get(tone_map_),
-                                       {rule_, nullptr, &context.get(gbuffer_).virtual_surface});
+  out = render::differential_composite(
+      context.get(color_), context.get(real_virtual_), context.get(real_), context.get(coverage_),
+      context.get(tone_map_), {rule_, nullptr, &context.get(gbuffer_).virtual_surface, &context.get(back_projection_)});
 }
 
 }  // namespace relight::app

@@ -4,7 +4,8 @@
 // composite's "after" on report.html's contact sheet. It is computed only for the frames the
 // report shows (`wanted`); on the others it writes an empty image.
 // Reads:  ColorImage "color", RadianceImage "L_rv", "L_r", CoverageImage "virtual_coverage",
-//         GBuffer "dir_gbuffer", colormap::ToneMap "tone_map".
+//         GBuffer "dir_gbuffer", render::SpecularBackProjection "specular_back_projection",
+//         colormap::ToneMap "tone_map".
 // Writes: ColorImage "composite_as_rendered".
 #include <cstdint>
 #include <functional>
@@ -34,6 +35,7 @@ class AsRenderedCompositeStage final : public Stage {
   Read<RadianceImage> real_virtual_, real_;
   Read<render::CoverageImage> coverage_;
   Read<render::GBuffer> gbuffer_;
+  Read<render::SpecularBackProjection> back_projection_;
   Read<colormap::ToneMap> tone_map_;
   Write<ColorImage> composite_;
 };

@@ -178,9 +178,9 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
     render::VirtualModel model = render::load_model(options.objects[i]);
     if (std::any_of(model.materials.begin(), model.materials.end(),
                     [](const render::PhongMaterial& m) { return m.specular.specular(); }))
-      std::cerr << "relight: warning: " << options.objects[i].string()
-                << " has mirror or glass materials: DIR shades their glossy Phong stand-in (relight render-reference "
-                   "renders them exactly, caustics included)\n";
+      std::cerr << "relight: note: " << options.objects[i].string()
+                << " has mirror or glass materials: DIR renders their reflections and refractions but not yet the "
+                   "light they focus (caustics; relight render-reference renders those)\n";
     const Eigen::AlignedBox3f box = render::bounds(model);  // y-up: the footprint is x by z
     requests[i].footprint_radius_m =
         requests[i].placement.scale * 0.5 * std::hypot(box.sizes().x(), box.sizes().z());

@@ -34,6 +34,7 @@
 #include <utility>
 
 #include "bench.h"
+#include "differential_errors.h"
 #include "relight/lights/light_stages.h"
 #include "relight/render/dir/dir_vk.h"
 #include "relight/render/dir/edge_coverage.h"
@@ -52,6 +53,8 @@
 namespace {
 
 using namespace relight;
+using bench::compare;
+using bench::Errors;
 using Clock = std::chrono::steady_clock;
 
 render::MrScene bench_scene() {
@@ -64,38 +67,6 @@ render::MrScene bench_scene() {
 render::MrCamera bench_camera() {
   const Pose pose = synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75});
   return {PinholeIntrinsics{262.5, 262.5, 79.5, 59.5, 160, 120}, pose};
-}
-
-float tm(float x) { return std::clamp(x, 0.f, 1.f); }
-
-Float3 tm(const Float3& c) { return {tm(c.x), tm(c.y), tm(c.z)}; }
-
-/// Composite in camera-linear space, the camera image being `camera_real` (TM of a real image).
-Float3 composite(const render::DifferentialImages& images, const RadianceImage& camera_real, std::size_t i) {
-  const float c = images.virtual_coverage.pixels()[i];
-  const Float3 with = tm(images.real_virtual.pixels()[i]);
-  const Float3 delta = with - tm(images.real.pixels()[i]);
-  return c * with + (1.f - c) * (tm(camera_real.pixels()[i]) + delta);
-}
-
-struct Errors {
-  double delta_rel = 0.0;
-  double composite_rmse = 0.0;
-};
-
-Errors compare(const render::DifferentialImages& ours, const render::DifferentialImages& reference) {
-  double diff = 0.0, norm = 0.0, squared = 0.0;
-  for (std::size_t i = 0; i < ours.real.size(); ++i) {
-    const Float3 c = composite(ours, reference.real, i) - composite(reference, reference.real, i);
-    squared += dot(c, c);
-    if (ours.virtual_coverage.pixels()[i] > 0.f || reference.virtual_coverage.pixels()[i] > 0.f) continue;
-    const Float3 d_ref = tm(reference.real_virtual.pixels()[i]) - tm(reference.real.pixels()[i]);
-    if (length(d_ref) <= 0.01f) continue;
-    const Float3 d_ours = tm(ours.real_virtual.pixels()[i]) - tm(ours.real.pixels()[i]);
-    diff += length(d_ours - d_ref);
-    norm += length(d_ref);
-  }
-  return {norm > 0.0 ? diff / norm : 0.0, std::sqrt(squared / (3.0 * static_cast<double>(ours.real.size())))};
 }
 
 struct CurvePoint {

@@ -11,45 +11,20 @@
 #include "relight/render/reference/path_tracer.h"
 #include "relight/render/scene/specular_bsdf.h"
 #include "relight/render/scene/tessellation.h"
+#include "specular_scenes.h"
 #include "test_scenes.h"
 
 namespace relight::render {
 namespace {
 
 using Eigen::Vector3f;
+using test::at;
 using test::camera_at;
+using test::emitter;
+using test::pixel_hit;
+using test::specular_material;
+using test::with_layer;
 constexpr float kPi = std::numbers::pi_v<float>;
-
-PhongMaterial specular_material(const SpecularMaterial& specular, const char* name) {
-  PhongMaterial m;
-  m.name = name;
-  m.kd = Vector3f::Zero();
-  m.specular = specular;
-  return m;
-}
-
-PhongMaterial emitter(float radiance) {
-  PhongMaterial m = test::diffuse(Vector3f::Zero(), "emitter");
-  m.emission = Vector3f::Constant(radiance);
-  return m;
-}
-
-TriangleMesh with_layer(TriangleMesh mesh, const char* name, bool real) {
-  mesh.name = name;
-  mesh.real = real;
-  return mesh;
-}
-
-Vector3f at(const RadianceImage& image, int row, int col) {
-  const Float3 p = image(row, col);
-  return {p.x, p.y, p.z};
-}
-
-/// The first hit of a pixel centre's ray in `layer`.
-std::optional<SurfaceHit> pixel_hit(const RayTracer& tracer, const MrCamera& camera, int row, int col, Layer layer) {
-  const Eigen::Vector3d d = camera.camera_to_world.linear() * camera.intrinsics.ray(col, row).normalized();
-  return tracer.intersect(layer, camera.camera_to_world.translation().cast<float>(), d.cast<float>());
-}
 
 /// Transmittance of a clear-walled slab at normal incidence with internal reflections: light
 /// crosses two interfaces of reflectance R and the absorbing inside (a per pass) any odd number

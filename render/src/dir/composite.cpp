@@ -118,20 +118,59 @@ std::optional<Float3> clipped_difference(const Rgb8& camera, const Float3& with,
   return changed - linear;
 }
 
+/// The camera image decoded to linear sRGB, bilinear at (x, y) inside it.
+Float3 camera_linear_at(const ColorImage& camera, float x, float y) {
+  const int x0 = std::clamp(static_cast<int>(x), 0, camera.width() - 1),
+            y0 = std::clamp(static_cast<int>(y), 0, camera.height() - 1);
+  const int x1 = std::min(x0 + 1, camera.width() - 1), y1 = std::min(y0 + 1, camera.height() - 1);
+  const float fx = std::clamp(x - static_cast<float>(x0), 0.f, 1.f),
+              fy = std::clamp(y - static_cast<float>(y0), 0.f, 1.f);
+  const auto at = [&](int row, int col) { return colormap::decode_srgb8(camera(row, col)); };
+  return (1.f - fy) * ((1.f - fx) * at(y0, x0) + fx * at(y0, x1)) + fy * ((1.f - fx) * at(y1, x0) + fx * at(y1, x1));
+}
+
+/// The back-projection of options, where it applies to `camera`'s pixels; none otherwise.
+const SpecularBackProjection* back_projection_of(const CompositeOptions& options, const ColorImage& camera) {
+  const SpecularBackProjection* view = options.back_projection;
+  if (!view || view->empty()) return nullptr;
+  if (!view->specular.same_shape(camera))
+    throw Error("differential composite: the camera image and the specular back-projection differ in size");
+  return view;
+}
+
+/// The virtual colour of a mirror or glass pixel (composite.h): CI_bp with the virtual objects'
+/// change `with` - `without` (both in the composite's space) added or, multiplicatively, scaled in.
+Float3 seen_through(CompositeRule rule, const Float3& camera_bp, const Float3& with, const Float3& without) {
+  if (rule == CompositeRule::Additive) return camera_bp + (with - without);
+  const auto channel = [](float camera, float w, float wo) {
+    return wo < 1e-3f ? camera + (w - wo) : camera * std::min(w / wo, kMaxCompositeRatio);
+  };
+  return {channel(camera_bp.x, with.x, without.x), channel(camera_bp.y, with.y, without.y),
+          channel(camera_bp.z, with.z, without.z)};
+}
+
 }  // namespace
 
 ColorImage differential_composite(const ColorImage& camera, const RadianceImage& real_virtual,
                                   const RadianceImage& real, const CoverageImage& virtual_coverage,
                                   const colormap::ToneMap& tone_map, const CompositeOptions& options) {
   require_camera_size(camera, {&real_virtual, &real}, virtual_coverage);
-  const auto with = [&](std::size_t i) { return colormap::tone_map(real_virtual.pixels()[i], tone_map); };
+  const auto to_camera = [&](const Float3& radiance) { return colormap::tone_map(radiance, tone_map); };
+  const auto with = [&](std::size_t i) { return to_camera(real_virtual.pixels()[i]); };
   const auto difference = [&](std::size_t i) {
     const Float3 &lrv = real_virtual.pixels()[i], &lr = real.pixels()[i];
     if (const auto clipped = clipped_difference(camera.pixels()[i], lrv, lr, tone_map.exposure)) return *clipped;
-    return real_difference(options.rule, camera.pixels()[i], with(i), colormap::tone_map(lr, tone_map));
+    return real_difference(options.rule, camera.pixels()[i], with(i), to_camera(lr));
   };
-  return colormap::composite_layer(camera, separated_layer(virtual_coverage, options.virtual_centre, with, difference),
-                                   options.look);
+  const SpecularBackProjection* view = back_projection_of(options, camera);
+  const auto camera_at = [&](float x, float y) { return camera_linear_at(camera, x, y); };
+  const auto virtual_colour = [&](std::size_t i) {
+    if (!view || !view->specular.pixels()[i]) return with(i);
+    return seen_through(options.rule, back_projected_camera(*view, i, camera_at, to_camera), with(i),
+                        to_camera(real.pixels()[i]));
+  };
+  return colormap::composite_layer(
+      camera, separated_layer(virtual_coverage, options.virtual_centre, virtual_colour, difference), options.look);
 }
 
 ColorImage mapped_differential_composite(const ColorImage& camera, const RadianceImage& delta,
@@ -140,6 +179,15 @@ ColorImage mapped_differential_composite(const ColorImage& camera, const Radianc
                                          const CompositeOptions& options) {
   require_camera_size(camera, {&delta, &real_virtual, &real}, virtual_coverage);
   const auto mapped = [&](std::size_t i) { return mapping(real_virtual.pixels()[i]); };
+  const SpecularBackProjection* view = back_projection_of(options, camera);
+  const auto camera_at = [&](float x, float y) { return camera_linear_at(camera, x, y); };
+  const auto to_camera = [&](const Float3& radiance) { return mapping(radiance); };
+  const auto virtual_colour = [&](std::size_t i) {
+    if (!view || !view->specular.pixels()[i]) return mapped(i);
+    const Float3 with = mapped(i);
+    return seen_through(options.rule, back_projected_camera(*view, i, camera_at, to_camera), with,
+                        with - delta.pixels()[i]);
+  };
   // delta_L = tau(TM(L_rv)) - tau(TM(L_r)) (colormap_stages.h), so tau(TM(L_r)) = mapped - delta.
   const auto difference = [&](std::size_t i) {
     if (const auto clipped = clipped_difference(camera.pixels()[i], real_virtual.pixels()[i], real.pixels()[i],
@@ -150,7 +198,7 @@ ColorImage mapped_differential_composite(const ColorImage& camera, const Radianc
     return real_difference(options.rule, camera.pixels()[i], with, with - delta.pixels()[i]);
   };
   return colormap::composite_layer(
-      camera, separated_layer(virtual_coverage, options.virtual_centre, mapped, difference), options.look);
+      camera, separated_layer(virtual_coverage, options.virtual_centre, virtual_colour, difference), options.look);
 }
 
 }  // namespace relight::render

@@ -4,6 +4,7 @@
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
 #include "relight/render/dir/dir.h"
+#include "relight/render/dir/specular_shading.h"
 #include "relight/render/scene/phong_brdf.h"
 #include "scene/surface_shading.h"
 
@@ -200,10 +201,13 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
 
 }  // namespace
 
-DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene, const Vec3& camera_centre,
-                                       const ShadowLayout& layout, std::span<const float> shadow_atlas,
-                                       std::span<const Vpl> vpls, std::span<const float> ism_atlas,
-                                       const IsmPointPools& ism_points, const DirRenderOptions& options) {
+namespace detail {
+
+DifferentialImages shade_from_maps(const GBuffer& gbuffer, const MrScene& scene, const Vec3& camera_centre,
+                                   const PositionMap* eyes, const ShadowLayout& layout,
+                                   std::span<const float> shadow_atlas, std::span<const Vpl> vpls,
+                                   std::span<const float> ism_atlas, const IsmPointPools& ism_points,
+                                   const DirRenderOptions& options) {
   const int width = gbuffer.position.width(), height = gbuffer.position.height();
   if (shadow_atlas.size() < static_cast<std::size_t>(layout.atlas_width()) * static_cast<std::size_t>(layout.atlas_height()))
     throw Error("shade_dir_from_maps: the shadow atlas is smaller than its layout");
@@ -239,7 +243,8 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
           return Vec3(f.x, f.y, f.z);
         };
         const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
-        shaded(y, x) = shader.shade(point, normal, (camera_centre - point).normalized(),
+        const Vec3 eye = eyes ? Vec3((*eyes)(y, x).x, (*eyes)(y, x).y, (*eyes)(y, x).z) : camera_centre;
+        shaded(y, x) = shader.shade(point, normal, (eye - point).normalized(),
                                     surface_phong(material, factor(metallic_roughness)), factor(kd_texture),
                                     material.emission.cwiseProduct(factor(emission_texture)), real_pixel, subset);
       }
@@ -260,8 +265,19 @@ DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& sc
   return out;
 }
 
+}  // namespace detail
+
+DifferentialImages shade_dir_from_maps(const GBuffer& gbuffer, const MrScene& scene, const Vec3& camera_centre,
+                                       const ShadowLayout& layout, std::span<const float> shadow_atlas,
+                                       std::span<const Vpl> vpls, std::span<const float> ism_atlas,
+                                       const IsmPointPools& ism_points, const DirRenderOptions& options) {
+  return detail::shade_from_maps(gbuffer, scene, camera_centre, nullptr, layout, shadow_atlas, vpls, ism_atlas,
+                                 ism_points, options);
+}
+
 DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
-                                  const DirRenderOptions& options, GBuffer* gbuffer_out) {
+                                  const DirRenderOptions& options, GBuffer* gbuffer_out,
+                                  SpecularBackProjection* back_projection_out) {
   const RayTracer tracer(scene);
   GBuffer local;
   GBuffer& gbuffer = gbuffer_out ? *gbuffer_out : local;
@@ -273,8 +289,14 @@ DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, 
           : shadow_atlas_cpu(RayTracer(coarse_scene(scene)), layout, options.shading.threads);
   const IsmPointPools points = sample_ism_points(scene, options.ism);
   const std::vector<float> ism_atlas = ism_atlas_cpu(points, vpls, options.ism);
-  return shade_dir_from_maps(gbuffer, scene, camera.camera_to_world.translation().cast<float>(), layout, shadow_atlas,
-                             vpls, ism_atlas, points, options);
+  DifferentialImages images = shade_dir_from_maps(gbuffer, scene, camera.camera_to_world.translation().cast<float>(),
+                                                  layout, shadow_atlas, vpls, ism_atlas, points, options);
+  SpecularBackProjection back_projection;
+  if (has_specular_surfaces(scene))
+    back_projection =
+        add_specular_light(images, tracer, camera, gbuffer, layout, shadow_atlas, vpls, ism_atlas, points, options);
+  if (back_projection_out) *back_projection_out = std::move(back_projection);
+  return images;
 }
 
 }  // namespace relight::render

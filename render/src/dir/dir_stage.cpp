@@ -187,6 +187,7 @@ void DirRenderStage::declare(StageBuilder& builder) {
   }
   images_ = builder.write(kDirImages);
   gbuffer_ = builder.write(kDirGBuffer);
+  back_projection_ = builder.write(kSpecularBackProjection);
 }
 
 void DirRenderStage::run(StageContext& context) {
@@ -202,8 +203,9 @@ void DirRenderStage::run(StageContext& context) {
   const std::vector<Vpl>& vpls = context.get(vpls_).vpls;
   DifferentialImages& images = context.get(images_);
   GBuffer& gbuffer = context.get(gbuffer_);
+  SpecularBackProjection& back_projection = context.get(back_projection_);
   if (!context_) {
-    images = render_dir_cpu(scene, camera, vpls, options_, &gbuffer);
+    images = render_dir_cpu(scene, camera, vpls, options_, &gbuffer, &back_projection);
   } else {
     if (!renderer_ || renderer_size_ != std::pair{width, height}) {
       renderer_ = std::make_unique<DirRendererVk>(*context_, width, height);
@@ -212,6 +214,7 @@ void DirRenderStage::run(StageContext& context) {
     renderer_->set_scene(scene, options_);
     images = renderer_->render(camera, vpls, options_);
     gbuffer = renderer_->last_gbuffer();
+    back_projection = renderer_->last_back_projection();
     // The GPU time of the steps that ran on the device (timestamps; none on devices without them).
     const DirVkTimings& t = renderer_->last_timings();
     const double gpu_ms =
@@ -265,6 +268,7 @@ void DifferentialCompositeStage::declare(StageBuilder& builder) {
   real_ = builder.read(kRealRadiance);
   coverage_ = builder.read(kVirtualCoverage);
   gbuffer_ = builder.read(kDirGBuffer);
+  back_projection_ = builder.read(kSpecularBackProjection);
   tone_map_ = builder.read(colormap::kToneMap);
   if (camera_look_) look_ = builder.read(colormap::kCameraLook);
   composite_ = builder.write(kComposite);
@@ -277,9 +281,10 @@ void DifferentialCompositeStage::run(StageContext& context) {
     throw Error("differential_composite: the colour image (" + std::to_string(color.width()) + "x" +
                 std::to_string(color.height()) + ") and the rendered image (" + std::to_string(real_virtual.width()) +
                 "x" + std::to_string(real_virtual.height()) + ") differ in size");
-  context.get(composite_) = differential_composite(
-      color, real_virtual, context.get(real_), context.get(coverage_), context.get(tone_map_),
-      {rule_, camera_look_ ? &context.get(look_) : nullptr, &context.get(gbuffer_).virtual_surface});
+  context.get(composite_) =
+      differential_composite(color, real_virtual, context.get(real_), context.get(coverage_), context.get(tone_map_),
+                             {rule_, camera_look_ ? &context.get(look_) : nullptr,
+                              &context.get(gbuffer_).virtual_surface, &context.get(back_projection_)});
 }
 
 }  // namespace relight::render

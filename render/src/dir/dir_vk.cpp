@@ -8,8 +8,10 @@
 #include <optional>
 
 #include "dir/ism_vk.h"
+#include "dir/shadow_maps_vk.h"
 #include "relight/core/error.h"
 #include "relight/render/dir/gbuffer_vk.h"
+#include "relight/render/dir/specular_shading.h"
 #include "relight/shaders/dir_merge_comp.h"
 #include "relight/shaders/dir_shade_comp.h"
 #include "relight/vk/barrier.h"
@@ -18,7 +20,6 @@
 #include "relight/vk/context.h"
 #include "relight/vk/timer.h"
 #include "relight/vk/transfer.h"
-#include "dir/shadow_maps_vk.h"
 
 namespace relight::render {
 namespace detail {
@@ -242,6 +243,8 @@ struct DirRendererVk::Impl {
   vk::UniqueDescriptorSet shade_set;
   std::array<vk::GpuTimer, 6> timers;
   std::optional<MrScene> scene;  ///< the last set_scene's materials, lights and environment (no meshes)
+  std::unique_ptr<RayTracer> specular_tracer;  ///< the whole scene, where it has specular surfaces
+  SpecularBackProjection back_projection;      ///< the last render's
   ShadowLayout layout;
   IsmPointPools points;
   DirVkTimings timings;
@@ -297,6 +300,8 @@ void DirRendererVk::set_scene(const MrScene& scene, const DirRenderOptions& opti
   d.upload(d.materials, pack_materials(scene, d.texture_headers));
   d.upload(d.lights, pack_lights(scene, d.layout));
   d.upload(d.views, pack_views(d.layout));
+  // The secondary rays of specular surfaces need the whole scene on the CPU (specular_gbuffer.h).
+  d.specular_tracer = has_specular_surfaces(scene) ? std::make_unique<RayTracer>(scene) : nullptr;
   // Kept for the shading, which reads the materials, lights and environment; the meshes are on
   // the device already (copying them would copy the whole reconstruction every frame).
   d.scene = MrScene{scene.materials, {}, scene.lights, scene.environment, {}};
@@ -311,6 +316,7 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
   d.upload(d.vpls, pack_vpls(vpls));
   d.vpl_count = static_cast<std::uint32_t>(vpls.size());
   d.last_gbuffer.reset();
+  d.back_projection = {};
 
   const Eigen::Vector3f centre = camera.camera_to_world.translation().cast<float>();
   const Eigen::Vector3f environment = d.scene->environment.radiance;
@@ -347,8 +353,21 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
   });
   const auto ms = [&](std::size_t k) { return d.timers[k].elapsed_ms().value_or(0.0); };
   d.timings = {ms(0), ms(1), ms(2), ms(3), ms(4), ms(5), cpu_shading};
-  if (cpu_shading) return shade_on_cpu(camera, vpls, options);
+  DifferentialImages out = cpu_shading ? shade_on_cpu(camera, vpls, options) : download_images();
+  if (d.specular_tracer) {
+    // Reflective and refractive surfaces: their secondary G-buffers traced and shaded on the CPU
+    // from this frame's maps (specular_shading.h).
+    const auto start = std::chrono::steady_clock::now();
+    d.back_projection = add_specular_light(out, *d.specular_tracer, camera, last_gbuffer(), d.layout,
+                                           last_shadow_atlas(), vpls, last_ism_atlas(), d.points, options);
+    d.timings.specular_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    d.timings.total_ms += d.timings.specular_ms;
+  }
+  return out;
+}
 
+DifferentialImages DirRendererVk::download_images() const {
+  Impl& d = *impl_;
   std::vector<float> radiance(static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height) * 16);
   d.context.transfer().download(d.output, std::as_writable_bytes(std::span(radiance)));
   DifferentialImages out{RadianceImage(d.width, d.height), RadianceImage(d.width, d.height), CoverageImage(d.width, d.height), 1,
@@ -383,6 +402,7 @@ DifferentialImages DirRendererVk::shade_on_cpu(const MrCamera& camera, std::span
 
 const DirVkTimings& DirRendererVk::last_timings() const { return impl_->timings; }
 const ShadowLayout& DirRendererVk::shadow_layout() const { return impl_->layout; }
+const SpecularBackProjection& DirRendererVk::last_back_projection() const { return impl_->back_projection; }
 const IsmPointPools& DirRendererVk::ism_points() const { return impl_->points; }
 
 const GBuffer& DirRendererVk::last_gbuffer() const {

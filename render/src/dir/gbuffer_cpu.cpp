@@ -76,15 +76,37 @@ NormalMap shading_normals(const GBuffer& gbuffer, const MrScene& scene) {
   return out;
 }
 
+GBuffer empty_gbuffer(int width, int height, bool textured) {
+  GBuffer out{PositionMap(width, height), NormalMap(width, height), LabelImage(width, height), Mask(width, height),
+              DepthMap(width, height)};
+  if (textured) {
+    out.texcoord = Image<Float3>(width, height);
+    out.tangent = Image<float>(width, height);
+  }
+  return out;
+}
+
+void store_hit(GBuffer& g, int row, int col, const SurfaceHit& hit, const Eigen::Vector3f& direction,
+               float texcoord_footprint) {
+  const bool back = hit.interpolated_normal.dot(direction) > 0.f;
+  const Eigen::Vector3f n = back ? Eigen::Vector3f(-hit.interpolated_normal) : hit.interpolated_normal;
+  g.position(row, col) = {hit.point.x(), hit.point.y(), hit.point.z()};
+  g.normal(row, col) = {n.x(), n.y(), n.z()};
+  g.material(row, col) = static_cast<std::uint16_t>(hit.material + 1);
+  g.virtual_surface(row, col) = hit.real ? 0 : 1;
+  g.distance(row, col) = hit.t;
+  if (g.texcoord.empty() || !hit.has_texcoord) return;
+  // At least a little above zero: zero marks "no coordinates" (texture_factors).
+  g.texcoord(row, col) = {hit.texcoord.x(), hit.texcoord.y(), std::max(texcoord_footprint, 1e-12f)};
+  std::optional<TangentFrame> frame = tangent_frame(hit.texcoord_gradient, hit.interpolated_normal);
+  if (frame && back) frame = flipped(*frame);
+  g.tangent(row, col) = encode_tangent(frame, n);
+}
+
 GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads) {
   const PinholeIntrinsics& k = camera.intrinsics;
-  GBuffer out{PositionMap(k.width, k.height), NormalMap(k.width, k.height), LabelImage(k.width, k.height),
-              Mask(k.width, k.height), DepthMap(k.width, k.height)};
   const bool textured = has_textures(tracer.scene());
-  if (textured) {
-    out.texcoord = Image<Float3>(k.width, k.height);
-    out.tangent = Image<float>(k.width, k.height);
-  }
+  GBuffer out = empty_gbuffer(k.width, k.height, textured);
   const Eigen::Vector3f origin = camera.camera_to_world.translation().cast<float>();
   const auto ray = [&](int col, int row) {
     return (camera.camera_to_world.linear() * k.ray(col, row).normalized()).cast<float>().eval();
@@ -98,22 +120,10 @@ GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads
             tracer.intersect(Layer::Virtual, origin, d, real ? real->t : std::numeric_limits<float>::infinity());
         const auto& hit = virtual_hit ? virtual_hit : real;
         if (!hit) continue;
-        const bool back = hit->interpolated_normal.dot(d) > 0.f;
-        const Eigen::Vector3f n = back ? Eigen::Vector3f(-hit->interpolated_normal) : hit->interpolated_normal;
-        out.position(row, col) = {hit->point.x(), hit->point.y(), hit->point.z()};
-        out.normal(row, col) = {n.x(), n.y(), n.z()};
-        out.material(row, col) = static_cast<std::uint16_t>(hit->material + 1);
-        out.virtual_surface(row, col) = hit->real ? 0 : 1;
-        out.distance(row, col) = hit->t;
-        if (textured && hit->has_texcoord) {
-          const float footprint =
-              std::max(texcoord_step(*hit, origin, ray(col + 1, row)), texcoord_step(*hit, origin, ray(col, row + 1)));
-          // At least a little above zero: zero marks "no coordinates" (texture_factors).
-          out.texcoord(row, col) = {hit->texcoord.x(), hit->texcoord.y(), std::max(footprint, 1e-12f)};
-          std::optional<TangentFrame> frame = tangent_frame(hit->texcoord_gradient, hit->interpolated_normal);
-          if (frame && back) frame = flipped(*frame);
-          out.tangent(row, col) = encode_tangent(frame, n);
-        }
+        const float footprint = textured && hit->has_texcoord ? std::max(texcoord_step(*hit, origin, ray(col + 1, row)),
+                                                                         texcoord_step(*hit, origin, ray(col, row + 1)))
+                                                              : 0.f;
+        store_hit(out, row, col, *hit, d, footprint);
       }
   }, 4);
   return out;

@@ -35,6 +35,11 @@
 // the camera, not clipped, would see the change. Pixels the virtual objects leave unchanged keep
 // the camera's value bit for bit.
 //
+// At the pixels of virtual mirrors and glass, both composites take the camera's own colours of
+// what they reflect and refract where the camera sees it (back-projection, Knecht et al. 2013
+// eqs. 6-11; specular_back_projection.h, CompositeOptions::back_projection), plus the change the
+// virtual objects make to it.
+//
 // With a CameraLook both composites put the camera's blur, motion blur and noise on the rendered
 // layer (colormap/camera_look.h, composite_layer): the virtual objects and the differential
 // effects they cause, not the camera image, which has them already.
@@ -46,6 +51,7 @@
 #include "relight/core/image.h"
 #include "relight/core/named_values.h"
 #include "relight/render/differential_images.h"
+#include "relight/render/dir/specular_back_projection.h"
 
 namespace relight::render {
 
@@ -58,6 +64,10 @@ struct CompositeOptions {
   CompositeRule rule = CompositeRule::Additive;
   const colormap::CameraLook* look = nullptr;  ///< the camera's artefacts for the rendered layer
   const Mask* virtual_centre = nullptr;        ///< pixels whose centre sample saw a virtual object
+  /// What mirrors and glass show (specular_back_projection.h): at their pixels the virtual
+  /// colour is CI_bp + TM(L'_rv) - TM(L'_r) (the multiplicative rule: CI_bp TM(L'_rv) /
+  /// TM(L'_r)) instead of TM(L_rv), L' being what L_rv and L_r hold there. None or empty: TM(L_rv).
+  const SpecularBackProjection* back_projection = nullptr;
 };
 
 /// Throws relight::Error when the images differ in size.

@@ -9,7 +9,8 @@
 // hold the GPU to it. Reads an MrScene, an MrCamera and the VPLs (vpl/vpl.h); writes
 // DifferentialImages (L_rv, L_r, coverage, their indirect parts). Emitter VPLs (the last of the
 // list, vpl.h) are direct light: every pixel sums all of them, outside the interleaving, the
-// merge and the indirect parts that temporal smoothing blends.
+// merge and the indirect parts that temporal smoothing blends. Pixels on mirrors and glass
+// take the light of what they reflect and refract (specular_shading.h, both renderers).
 #include <span>
 
 #include "relight/render/differential_images.h"
@@ -17,6 +18,7 @@
 #include "relight/render/dir/gbuffer.h"
 #include "relight/render/dir/ism.h"
 #include "relight/render/dir/shadow_maps.h"
+#include "relight/render/dir/specular_back_projection.h"
 
 namespace relight::render {
 
@@ -39,9 +41,11 @@ struct DirRenderOptions {
 
 /// The whole method without a GPU, step for step the same algorithm (ray-cast G-buffer and
 /// shadow maps, CPU ISMs, shade_dir_from_maps): the fallback where no Vulkan device exists.
-/// `vpls` as for DirRendererVk::render.
+/// `vpls` as for DirRendererVk::render. `back_projection_out`: what mirrors and glass show, for
+/// the composite (specular_back_projection.h; empty without them).
 [[nodiscard]] DifferentialImages render_dir_cpu(const MrScene& scene, const MrCamera& camera, std::span<const Vpl> vpls,
-                                                const DirRenderOptions& options = {}, GBuffer* gbuffer_out = nullptr);
+                                                const DirRenderOptions& options = {}, GBuffer* gbuffer_out = nullptr,
+                                                SpecularBackProjection* back_projection_out = nullptr);
 
 /// The shading pass on the CPU, from the same inputs as the GPU's (`ism_points`: the pools the
 /// ISM atlas was splatted from, for their bounds).

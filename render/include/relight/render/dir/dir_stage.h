@@ -26,8 +26,10 @@
 //                                   ("kd_valid", camera_albedo.h)
 //                            writes DifferentialImages "dir_images" (L_rv, L_r, coverage and
 //                                   their indirect parts, one shading pass; the coverage
-//                                   fractional at outlines, edge_coverage.h) and GBuffer
-//                                   "dir_gbuffer"
+//                                   fractional at outlines, edge_coverage.h; at mirrors and
+//                                   glass what they reflect and refract, specular_shading.h),
+//                                   SpecularBackProjection "specular_back_projection" (empty
+//                                   without mirrors and glass) and GBuffer "dir_gbuffer"
 //   indirect_smoothing       reads  DifferentialImages "dir_images", GBuffer "dir_gbuffer",
 //                                   FrameInfo "frame"
 //                            writes RadianceImage "L_rv", "L_r", "L_rv_indirect" (the VPL part
@@ -40,7 +42,8 @@
 //                            writes colormap::ToneMap "tone_map" (colormap/tone_map_stage.h)
 //   differential_composite   reads  ColorImage "color", RadianceImage "L_rv", "L_r",
 //                                   CoverageImage "virtual_coverage", GBuffer "dir_gbuffer"
-//                                   (which pixel centres are virtual), colormap::ToneMap
+//                                   (which pixel centres are virtual), SpecularBackProjection
+//                                   "specular_back_projection", colormap::ToneMap
 //                                   "tone_map"; with `camera_look` also
 //                                   colormap::CameraLook "camera_look" (camera_look_stage.h)
 //                            writes ColorImage "composite" (composite.h, eq. 5.1)
@@ -238,6 +241,7 @@ class DirRenderStage final : public Stage {
   Read<Mask> albedo_valid_;
   Write<DifferentialImages> images_;
   Write<GBuffer> gbuffer_;
+  Write<SpecularBackProjection> back_projection_;
 };
 
 /// Step 6 (temporal smoothing of the indirect light).
@@ -281,6 +285,7 @@ class DifferentialCompositeStage final : public Stage {
   Read<RadianceImage> real_;
   Read<CoverageImage> coverage_;
   Read<GBuffer> gbuffer_;
+  Read<SpecularBackProjection> back_projection_;
   Read<colormap::CameraLook> look_;
   Write<ColorImage> composite_;
 };

@@ -33,6 +33,7 @@ namespace relight::render {
 struct DirVkTimings {
   double gbuffer_ms = 0, shadow_maps_ms = 0, ism_ms = 0, shading_ms = 0, merge_ms = 0, total_ms = 0;
   bool cpu_shading = false;
+  double specular_ms = 0;  ///< CPU wall time of the reflective/refractive step (specular_shading.h); 0 without
 };
 
 class DirRendererVk {
@@ -55,9 +56,12 @@ class DirRendererVk {
   [[nodiscard]] std::vector<float> last_shadow_atlas() const;
   [[nodiscard]] std::vector<float> last_ism_atlas() const;
   [[nodiscard]] const ShadowLayout& shadow_layout() const;
+  /// What the last render's mirrors and glass show, for the composite (empty without them).
+  [[nodiscard]] const SpecularBackProjection& last_back_projection() const;
   [[nodiscard]] const IsmPointPools& ism_points() const;
 
  private:
+  [[nodiscard]] DifferentialImages download_images() const;
   [[nodiscard]] DifferentialImages shade_on_cpu(const MrCamera& camera, std::span<const Vpl> vpls,
                                                 const DirRenderOptions& options);
 

@@ -46,6 +46,16 @@ enum class MaterialTexture { BaseColor, Emission, MetallicRoughness, Normal };
 /// texture or `gbuffer` no texture coordinates.
 [[nodiscard]] NormalMap shading_normals(const GBuffer& gbuffer, const MrScene& scene);
 
+/// A G-buffer of `width` x `height` that sees nothing, with texture coordinates and tangents when
+/// `textured`.
+[[nodiscard]] GBuffer empty_gbuffer(int width, int height, bool textured);
+
+/// Stores at (row, col) the surface `hit` seen along `direction` (unit): its normal turned to
+/// face the ray, and where it has texture coordinates (and `g` has room for them) those and its
+/// frame with the footprint `texcoord_footprint`.
+void store_hit(GBuffer& g, int row, int col, const SurfaceHit& hit, const Eigen::Vector3f& direction,
+               float texcoord_footprint);
+
 [[nodiscard]] GBuffer gbuffer_cpu(const RayTracer& tracer, const MrCamera& camera, int threads = 0);
 
 }  // namespace relight::render

@@ -3,7 +3,8 @@
 // mapped_differential_composite): the picture of `relight replay --colormap sample|stats`.
 // Reads:  ColorImage "color" (camera), RadianceImage "delta_L" and ColorMapping "color_mapping"
 //         (a colour-mapping stage, colormap_stages.h), RadianceImage "L_rv", "L_r" and CoverageImage
-//         "virtual_coverage" and GBuffer "dir_gbuffer" (the DIR stage, dir_stage.h); with `camera_look`, CameraLook
+//         "virtual_coverage", GBuffer "dir_gbuffer" and SpecularBackProjection "specular_back_projection"
+//         (the DIR stage, dir_stage.h); with `camera_look`, CameraLook
 //         "camera_look" (camera_look_stage.h), whose artefacts go on the virtual layer.
 // Writes: ColorImage "composite_mapped".
 #include <string>
@@ -30,6 +31,7 @@ class MappedCompositeStage final : public Stage {
   Read<RadianceImage> delta_, real_virtual_, real_;
   Read<CoverageImage> coverage_;
   Read<GBuffer> gbuffer_;
+  Read<SpecularBackProjection> back_projection_;
   Read<colormap::ColorMapping> mapping_;
   bool camera_look_;
   CompositeRule rule_;

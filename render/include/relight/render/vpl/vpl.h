@@ -29,6 +29,12 @@
 // so sparse points lose energy: the pool must hold enough points that a cone's footprint at the
 // scene's distances covers several.
 //
+// Mirrors and glass (specular_material.h) hold no VPL: a path that meets one goes on in the
+// mirrored or refracted direction (chosen in proportion to Fresnel; Beer-Lambert inside) to the
+// diffuse surface it reaches, where the VPL is left - the caustic VPLs of Knecht et al., TVCG 2013
+// §4.2.2, which light the surroundings with the light the object focuses (vpl_tracer.h,
+// follow_specular). Ray-traced bounces only; the rasterised RSMs do not yet.
+//
 // Virtual focus: the differential image lives where virtual objects reflect or block light, and
 // they are small, so uniformly spread light samples put few VPLs on them. A share of each light's
 // samples (`virtual_share`) is therefore drawn uniformly inside the cone that the virtual objects'

@@ -1,0 +1,79 @@
+#include "relight/render/dir/specular_shading.h"
+
+#include "relight/core/error.h"
+
+namespace relight::render {
+
+namespace detail {
+// dir_cpu.cpp: shade_dir_from_maps with a view point per pixel (`eyes`) instead of the camera's.
+DifferentialImages shade_from_maps(const GBuffer& gbuffer, const MrScene& scene, const Eigen::Vector3f& camera_centre,
+                                   const PositionMap* eyes, const ShadowLayout& layout,
+                                   std::span<const float> shadow_atlas, std::span<const Vpl> vpls,
+                                   std::span<const float> ism_atlas, const IsmPointPools& ism_points,
+                                   const DirRenderOptions& options);
+}  // namespace detail
+
+namespace {
+
+/// Per channel: a branch's weight times its light.
+Float3 times(const Float3& a, const Float3& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+
+}  // namespace
+
+SpecularLight shade_specular_from_maps(const SpecularGBuffers& specular, const MrScene& scene,
+                                       const ShadowLayout& layout, std::span<const float> shadow_atlas,
+                                       std::span<const Vpl> vpls, std::span<const float> ism_atlas,
+                                       const IsmPointPools& ism_points, const DirRenderOptions& options) {
+  const int width = specular.specular.width(), height = specular.specular.height();
+  SpecularLight out{{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,
+                     RadianceImage(width, height), RadianceImage(width, height)},
+                    {},
+                    {}};
+  DifferentialImages& sum = out.light;
+  for (const SpecularBranch* branch : {&specular.reflected, &specular.refracted}) {
+    DifferentialImages light = detail::shade_from_maps(branch->gbuffer, scene, Eigen::Vector3f::Zero(), &branch->eye,
+                                                       layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
+    for (std::size_t i = 0; i < sum.real_virtual.size(); ++i) {
+      if (!specular.specular.pixels()[i]) continue;
+      const Float3& w = branch->weight.pixels()[i];
+      sum.real_virtual.pixels()[i] += times(w, light.real_virtual.pixels()[i]);
+      sum.real.pixels()[i] += times(w, light.real.pixels()[i]);
+      sum.indirect_real_virtual.pixels()[i] += times(w, light.indirect_real_virtual.pixels()[i]);
+      sum.indirect_real.pixels()[i] += times(w, light.indirect_real.pixels()[i]);
+    }
+    (branch == &specular.reflected ? out.reflected_real : out.refracted_real) = std::move(light.real);
+  }
+  return out;
+}
+
+void put_specular_light(DifferentialImages& images, const DifferentialImages& specular_light,
+                        const SpecularGBuffers& specular) {
+  if (images.real_virtual.width() != specular.specular.width() ||
+      images.real_virtual.height() != specular.specular.height())
+    throw Error("put_specular_light: the images and the specular G-buffers differ in size");
+  const bool indirect = !images.indirect_real_virtual.empty();
+  for (std::size_t i = 0; i < images.real_virtual.size(); ++i) {
+    if (!specular.specular.pixels()[i]) continue;
+    images.real_virtual.pixels()[i] = specular_light.real_virtual.pixels()[i];
+    images.real.pixels()[i] = specular_light.real.pixels()[i];
+    if (!indirect) continue;
+    images.indirect_real_virtual.pixels()[i] = specular_light.indirect_real_virtual.pixels()[i];
+    images.indirect_real.pixels()[i] = specular_light.indirect_real.pixels()[i];
+  }
+}
+
+SpecularBackProjection add_specular_light(DifferentialImages& images, const RayTracer& tracer, const MrCamera& camera,
+                                          const GBuffer& gbuffer, const ShadowLayout& layout,
+                                          std::span<const float> shadow_atlas, std::span<const Vpl> vpls,
+                                          std::span<const float> ism_atlas, const IsmPointPools& ism_points,
+                                          const DirRenderOptions& options) {
+  const SpecularGBuffers specular =
+      specular_gbuffers_cpu(tracer, camera, gbuffer, {.threads = options.shading.threads});
+  if (specular.pixels == 0) return {};
+  const SpecularLight light =
+      shade_specular_from_maps(specular, tracer.scene(), layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
+  put_specular_light(images, light.light, specular);
+  return back_project(specular, light.reflected_real, light.refracted_real, gbuffer, camera);
+}
+
+}  // namespace relight::render
