@@ -129,7 +129,10 @@ int run_render_reference(const RenderReferenceOptions& command) {
       if (!synthetic) throw Error("--place x,y,z[,yaw[,scale]] is needed to put the object into a recorded scene");
       placement_text = kDefaultSynthPlacement;
     }
-    render::add_virtual_model(scene, render::load_model(command.object), render::Placement::parse(placement_text));
+    const render::VirtualModel model = render::load_model(command.object);
+    for (const std::string& warning : model.warnings)
+      std::cerr << "relight: warning: " << command.object.string() << ": " << warning << "\n";
+    render::add_virtual_model(scene, model, render::Placement::parse(placement_text));
   }
   for (const std::string& light : command.virtual_lights) scene.lights.push_back(parse_virtual_light(light));
   for (const std::string& spot : command.real_spots) scene.lights.push_back(parse_spot("--real-spot", spot, true));

@@ -176,11 +176,8 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   std::vector<std::string> names;
   for (std::size_t i = 0; i < options.objects.size(); ++i) {
     render::VirtualModel model = render::load_model(options.objects[i]);
-    if (std::any_of(model.materials.begin(), model.materials.end(),
-                    [](const render::PhongMaterial& m) { return m.specular.specular(); }))
-      std::cerr << "relight: note: " << options.objects[i].string()
-                << " has mirror or glass materials: DIR renders their reflections and refractions but not yet the "
-                   "light they focus (caustics; relight render-reference renders those)\n";
+    for (const std::string& warning : model.warnings)
+      std::cerr << "relight: warning: " << options.objects[i].string() << ": " << warning << "\n";
     const Eigen::AlignedBox3f box = render::bounds(model);  // y-up: the footprint is x by z
     requests[i].footprint_radius_m =
         requests[i].placement.scale * 0.5 * std::hypot(box.sizes().x(), box.sizes().z());

@@ -6,7 +6,8 @@
 # results in out/replay (or RELIGHT_OUT): frames/*_composite.png before and *_composite_mapped.png
 # after colour mapping, composite.mp4, report.html. Then the same on a short synthetic sequence
 # (`relight synth`, with its own light probe and exact geometry), results in
-# out/replay-mixed-reality.
+# out/replay-mixed-reality, and on that sequence the glass pebble beside the aluminium bottle
+# (reflections, refractions and caustics), results in out/replay-glass.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/install-deps.sh"
@@ -18,4 +19,7 @@ relight="$root/build/release/app/relight"
 mixed="$out-mixed-reality"
 "$relight" synth --quiet --frames 8 --out "$mixed/sequence"
 "$relight" replay "$mixed/sequence" --object "$root/data/models/glossy_pebble.gltf" --out "$mixed"
-echo "Results (open report.html in each): $out, $mixed"
+glass="$out-glass"
+"$relight" replay "$mixed/sequence" --object "$root/data/models/glass_pebble.gltf" --place 0.35,-0.2,0.75,30 \
+  --object "$root/data/models/metal_bottle.gltf" --place 0.1,-0.3,0.75 --out "$glass"
+echo "Results (open report.html in each): $out, $mixed, $glass"

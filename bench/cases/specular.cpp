@@ -4,11 +4,13 @@
 //
 // dir/specular_640x480: `ms` per frame (VPLs included) of the Vulkan renderer with both objects,
 // the baseline the same frame without them ("dir_without_specular_objects"), interleaved;
-// stages_ms per step (specular: the secondary G-buffers traced and shaded, on the CPU).
+// stages_ms per step (specular: the caustic photons traced and gathered, the secondary
+// G-buffers traced and shaded, on the CPU); by_photon_count: the caustic error for 1k to 64k
+// photons per light.
 // Errors against the path tracer (1 bounce, caustics on, kReferenceSpp samples per pixel):
 //   specular_delta_rel_error: sum |TM(L_rv) - TM(L_rv_ref)| / sum |TM(L_rv_ref)| over the
-//     pixels inside the mirror and glass (what those pixels show: the composite takes TM(L_rv)
-//     there until back-projection lands);
+//     pixels inside the mirror and glass (what they show where the camera image cannot be
+//     back-projected; elsewhere the composite takes the camera's own colours);
 //   caustic_delta_rel_error: the mean relative error of DeltaL = TM(L_rv) - TM(L_r) where the
 //     path tracer's caustics change DeltaL by more than 0.02 (its images with and without caustic
 //     light paths);
@@ -141,7 +143,18 @@ bench::Json specular_640x480(const bench::Options& options) {
   json["caustic_delta_rel_error"] = caustic;
   json["caustic_pixels"] = caustic_pixels;
   json["composite_rmse"] = bench::compare(ours.images, reference).composite_rmse;
-  json["dir_caustics"] = false;  // not yet: the caustic error is the caustics' whole share
+  json["caustic_photons_per_light"] = dir_options.caustics.photons_per_light;
+  // The caustic error against the photon count (the VPL count stays at 256).
+  bench::Json by_photons = bench::Json::array();
+  for (const int photons : {1024, 4096, 16384, 65536}) {
+    render::DirRenderOptions more = dir_options;
+    more.caustics.photons_per_light = photons;
+    ours.draw(view, more);
+    by_photons.push_back({{"photons_per_light", photons},
+                          {"caustic_delta_rel_error", caustic_error(ours.images, reference, without_caustics).first},
+                          {"specular_ms", ours.renderer.last_timings().specular_ms}});
+  }
+  json["by_photon_count"] = by_photons;
   json["width"] = width;
   json["height"] = height;
   json["light_samples"] = 256;

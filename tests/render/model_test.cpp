@@ -137,6 +137,47 @@ TEST(ModelIo, GltfTransmissionMakesGlassAndASmoothMetalAMirror) {
                    .specular.specular());
 }
 
+// Bad glass is one line naming the file; what the loader cannot honour is a warning.
+TEST(ModelIo, BadGlassIsAnErrorAndOpenGlassOrAnUnknownExtensionAWarning) {
+  const test::TempDir dir;
+  save_gltf(dir.path() / "box.gltf", make_matte_box());
+  nlohmann::json gltf = nlohmann::json::parse(std::ifstream(dir.path() / "box.gltf"));
+  const auto glass = [](double ior) {
+    return nlohmann::json{
+        {"name", "glass"},
+        {"extensions",
+         {{"KHR_materials_transmission", {{"transmissionFactor", 1}}}, {"KHR_materials_ior", {{"ior", ior}}}}}};
+  };
+  gltf["materials"] = nlohmann::json::array({glass(0.5)});
+  std::ofstream(dir.path() / "thin_air.gltf") << gltf.dump();
+  try {
+    (void)load_model(dir.path() / "thin_air.gltf");
+    ADD_FAILURE() << "an index of refraction of 0.5 was accepted";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("thin_air.gltf"), std::string::npos) << message;
+    EXPECT_NE(message.find("index of refraction"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+  // The closed box in glass: no warning. Without its top face: open.
+  gltf["materials"] = nlohmann::json::array({glass(1.5)});
+  std::ofstream(dir.path() / "glass_box.gltf") << gltf.dump();
+  EXPECT_TRUE(load_model(dir.path() / "glass_box.gltf").warnings.empty());
+  VirtualModel open_box = make_matte_box();
+  open_box.materials[0].specular = dielectric(1.5f);
+  open_box.meshes[0].triangles.resize(open_box.meshes[0].triangles.size() - 2);
+  open_box.meshes[0].triangle_material.resize(open_box.meshes[0].triangles.size());
+  save_gltf(dir.path() / "open.gltf", open_box);
+  const VirtualModel open = load_model(dir.path() / "open.gltf");
+  ASSERT_EQ(open.warnings.size(), 1u);
+  EXPECT_NE(open.warnings[0].find("not a closed surface"), std::string::npos) << open.warnings[0];
+  gltf["extensionsUsed"] = nlohmann::json::array({"KHR_materials_sheen"});
+  std::ofstream(dir.path() / "sheen.gltf") << gltf.dump();
+  const VirtualModel sheen = load_model(dir.path() / "sheen.gltf");
+  ASSERT_EQ(sheen.warnings.size(), 1u);
+  EXPECT_NE(sheen.warnings[0].find("KHR_materials_sheen"), std::string::npos) << sheen.warnings[0];
+}
+
 TEST(ProceduralModels, TheGlassPebbleAndTheMetalBottleAreClosedAndWoundOutwards) {
   // Glass needs both: the winding says whether a ray enters or leaves (specular_material.h).
   const std::vector<VirtualModel> models{make_glass_pebble(), make_metal_bottle()};

@@ -22,17 +22,10 @@ using test::at;
 using test::camera_at;
 using test::emitter;
 using test::pixel_hit;
+using test::slab_transmittance;
 using test::specular_material;
 using test::with_layer;
 constexpr float kPi = std::numbers::pi_v<float>;
-
-/// Transmittance of a clear-walled slab at normal incidence with internal reflections: light
-/// crosses two interfaces of reflectance R and the absorbing inside (a per pass) any odd number
-/// of times, (1 - R)^2 a / (1 - R^2 a^2).
-float slab_transmittance(float ior, float a) {
-  const float r = (ior - 1.f) * (ior - 1.f) / ((ior + 1.f) * (ior + 1.f));
-  return (1.f - r) * (1.f - r) * a / (1.f - r * r * a * a);
-}
 
 TEST(SpecularBsdf, DielectricFresnelHasItsKnownValues) {
   EXPECT_NEAR(dielectric_fresnel(1.f, 1.f, 1.5f), 0.04f, 1e-6f);  // ((n - 1) / (n + 1))^2
@@ -159,15 +152,8 @@ TEST(SpecularPathTracer, AGlassSlabSeenThroughDimsByFresnelAndBeerLambert) {
 
 TEST(SpecularPathTracer, AGlassSlabCastsTheSunsLightThroughItWithFresnelAndAbsorption) {
   const float sun = 3.f, albedo = 0.5f;
-  MrScene scene = test::floor_scene(Vector3f::Constant(albedo), {0, 0, 1}, 0.f);
-  scene.lights[0].kind = LightKind::Directional;
-  scene.lights[0].direction = Vector3f::UnitZ();
-  scene.lights[0].intensity = Vector3f::Constant(sun);
   const Vector3f colour(0.5f, 0.8f, 1.f);
-  scene.meshes.push_back(
-      with_layer(tessellate_box({-0.5f, -0.5f, 0.5f}, {0.5f, 0.5f, 0.6f},
-                                scene.add_material(specular_material(dielectric(1.5f, colour, 0.1f), "glass"))),
-                 "slab", false));
+  const MrScene scene = test::sunlit_glass_slab(sun, albedo, colour);
   const MrCamera camera = camera_at({0, -1.6, 0.35}, {0, 0, 0}, 64, 48);
   PathTracerOptions options;
   options.max_bounces = 0;
@@ -178,13 +164,8 @@ TEST(SpecularPathTracer, AGlassSlabCastsTheSunsLightThroughItWithFresnelAndAbsor
   ASSERT_GT(under.size(), 60u);
   ASSERT_GT(beside.size(), 30u);
   const double lit = albedo / std::numbers::pi * sun;
-  const Eigen::Vector3d through = test::mean_over(images.real_virtual, under);
-  for (int c = 0; c < 3; ++c) {
-    const double expected = lit * slab_transmittance(1.5f, colour[c]);
-    EXPECT_NEAR(through[c], expected, 0.03 * expected) << "channel " << c;
-    EXPECT_NEAR(test::mean_over(images.real, under)[c], lit, 1e-4 * lit);  // the glass is virtual
-    EXPECT_NEAR(test::mean_over(images.real_virtual, beside)[c], lit, 1e-4 * lit);
-  }
+  test::expect_sun_through_slab(images, under, lit, colour, 0.03, 1e-4);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(test::mean_over(images.real_virtual, beside)[c], lit, 1e-4 * lit);
   for (const auto& [row, col] : under)
     EXPECT_NEAR(images.real_virtual(row, col).z, lit * slab_transmittance(1.5f, 1.f), 0.25 * lit) << row << "," << col;
 }

@@ -23,7 +23,8 @@ Float3 times(const Float3& a, const Float3& b) { return {a.x * b.x, a.y * b.y, a
 SpecularLight shade_specular_from_maps(const SpecularGBuffers& specular, const MrScene& scene,
                                        const ShadowLayout& layout, std::span<const float> shadow_atlas,
                                        std::span<const Vpl> vpls, std::span<const float> ism_atlas,
-                                       const IsmPointPools& ism_points, const DirRenderOptions& options) {
+                                       const IsmPointPools& ism_points, const DirRenderOptions& options,
+                                       const CausticPhotons* photons) {
   const int width = specular.specular.width(), height = specular.specular.height();
   SpecularLight out{{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,
                      RadianceImage(width, height), RadianceImage(width, height)},
@@ -33,6 +34,9 @@ SpecularLight shade_specular_from_maps(const SpecularGBuffers& specular, const M
   for (const SpecularBranch* branch : {&specular.reflected, &specular.refracted}) {
     DifferentialImages light = detail::shade_from_maps(branch->gbuffer, scene, Eigen::Vector3f::Zero(), &branch->eye,
                                                        layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
+    if (photons)
+      add_caustic_light(light, branch->gbuffer, scene, *photons, Eigen::Vector3f::Zero(), &branch->eye, nullptr,
+                        options.shading.threads);
     for (std::size_t i = 0; i < sum.real_virtual.size(); ++i) {
       if (!specular.specular.pixels()[i]) continue;
       const Float3& w = branch->weight.pixels()[i];
@@ -67,11 +71,14 @@ SpecularBackProjection add_specular_light(DifferentialImages& images, const RayT
                                           std::span<const float> shadow_atlas, std::span<const Vpl> vpls,
                                           std::span<const float> ism_atlas, const IsmPointPools& ism_points,
                                           const DirRenderOptions& options) {
-  const SpecularGBuffers specular =
-      specular_gbuffers_cpu(tracer, camera, gbuffer, {.threads = options.shading.threads});
+  const int threads = options.shading.threads;
+  const CausticPhotons photons = trace_caustic_photons(tracer, options.caustics, threads);
+  add_caustic_light(images, gbuffer, tracer.scene(), photons, camera.camera_to_world.translation().cast<float>(),
+                    nullptr, nullptr, threads);
+  const SpecularGBuffers specular = specular_gbuffers_cpu(tracer, camera, gbuffer, {.threads = threads});
   if (specular.pixels == 0) return {};
-  const SpecularLight light =
-      shade_specular_from_maps(specular, tracer.scene(), layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
+  const SpecularLight light = shade_specular_from_maps(specular, tracer.scene(), layout, shadow_atlas, vpls, ism_atlas,
+                                                       ism_points, options, &photons);
   put_specular_light(images, light.light, specular);
   return back_project(specular, light.reflected_real, light.refracted_real, gbuffer, camera);
 }

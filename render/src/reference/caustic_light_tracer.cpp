@@ -2,19 +2,18 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <optional>
 
 #include "relight/core/parallel.h"
 #include "relight/render/scene/phong_brdf.h"
 #include "relight/render/scene/sampler.h"
 #include "relight/render/scene/specular_bsdf.h"
+#include "scene/caustic_emission.h"
 #include "scene/surface_shading.h"
 
 namespace relight::render::detail {
 namespace {
 
-constexpr float kPi = std::numbers::pi_v<float>;
 /// Light paths per parallel work item: their splats are merged in this order, so the sums do not
 /// depend on the threads.
 constexpr std::uint64_t kPathsPerChunk = 2048;
@@ -26,52 +25,6 @@ struct Splat {
   bool real_virtual = true;  ///< L_rv, else L_r
   Vec3 value;
 };
-
-/// A light path's first ray and its flux weight.
-struct Emission {
-  Vec3 origin;
-  Vec3 direction;
-  Vec3 beta;
-};
-
-/// Samples the first ray of a path from `light` towards the sphere `target` (see the header).
-std::optional<Emission> emit(const MrLight& light, const BoundingSphere& target, const BoundingSphere& scene, float u1,
-                             float u2) {
-  const float phi = 2.f * kPi * u2;
-  Vec3 t, b;
-  if (light.kind == LightKind::Directional) {
-    const Vec3 to_light = light.direction.normalized();
-    orthonormal_basis(to_light, t, b);
-    const float r = target.radius * std::sqrt(u1);
-    const Vec3 on_disc = target.centre + r * (std::cos(phi) * t + std::sin(phi) * b);
-    const float far = (scene.centre - target.centre).norm() + scene.radius + target.radius + 1.f;
-    return Emission{on_disc + far * to_light, -to_light, light.intensity * (kPi * target.radius * target.radius)};
-  }
-  const Vec3 to_target = target.centre - light.position;
-  const float distance = to_target.norm();
-  Vec3 direction;
-  float pdf = 0.f;
-  if (distance <= target.radius) {
-    const float z = 1.f - 2.f * u1;
-    const float r = std::sqrt(std::max(0.f, 1.f - z * z));
-    direction = Vec3(r * std::cos(phi), r * std::sin(phi), z);
-    pdf = 1.f / (4.f * kPi);
-  } else {
-    const float sin2_max = (target.radius / distance) * (target.radius / distance);
-    const float cos_max = std::sqrt(std::max(0.f, 1.f - sin2_max));
-    const float one_minus_cos_max = sin2_max / (1.f + cos_max);  // without cancellation
-    const float one_minus_cos = u1 * one_minus_cos_max;
-    const float cos_theta = 1.f - one_minus_cos;
-    const float sin_theta = std::sqrt(std::max(0.f, one_minus_cos * (2.f - one_minus_cos)));
-    const Vec3 axis = to_target / distance;
-    orthonormal_basis(axis, t, b);
-    direction = (cos_theta * axis + sin_theta * (std::cos(phi) * t + std::sin(phi) * b)).normalized();
-    pdf = 1.f / (2.f * kPi * one_minus_cos_max);
-  }
-  const float falloff = light.kind == LightKind::Spot ? spot_falloff(light, direction) : 1.f;
-  if (!(falloff > 0.f) || !(pdf > 0.f) || !std::isfinite(pdf)) return std::nullopt;
-  return Emission{light.position, direction, light.intensity * (falloff / pdf)};
-}
 
 /// One light path in one version of the scene (see the header).
 class LightPathWalker {
@@ -198,7 +151,7 @@ std::uint64_t CausticLightTracer::trace(const MrCamera& camera, std::uint64_t pa
             Pcg32 rng = Pcg32::for_sample(options_.seed ^ kLightPathSeed, i, pass);
             const float u1 = rng.uniform();
             const float u2 = rng.uniform();
-            const std::optional<Emission> emission = emit(light, specular_bounds_, scene_bounds_, u1, u2);
+            const std::optional<Emission> emission = emit_towards(light, specular_bounds_, scene_bounds_, u1, u2);
             if (!emission) continue;
             walker.walk(*emission, true, rng, splats[c], rays[c]);
             if (light.real) walker.walk(*emission, false, rng, splats[c], rays[c]);

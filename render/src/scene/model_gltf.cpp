@@ -507,6 +507,10 @@ VirtualModel load_gltf(const std::filesystem::path& path) {
   std::erase_if(model.meshes, [](const TriangleMesh& m) { return m.triangles.empty(); });
   if (model.meshes.empty()) throw Error(path.string() + ": the glTF file holds no triangles");
   check_model(model, path);
+  for (const std::string& name : gltf.extensionsUsed)
+    if (std::find(kSupportedGltfExtensions.begin(), kSupportedGltfExtensions.end(), name) ==
+        kSupportedGltfExtensions.end())
+      model.warnings.push_back("glTF extension " + name + " is not supported: ignored");
   return model;
 }
 

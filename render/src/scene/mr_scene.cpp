@@ -46,6 +46,22 @@ Phong phong_from_metallic_roughness(const MetallicRoughness& parameters) {
   return out;
 }
 
+std::optional<std::string> specular_problem(const PhongMaterial& material) {
+  const SpecularMaterial& s = material.specular;
+  const auto unit = [](const Eigen::Vector3f& c) {
+    return c.allFinite() && c.minCoeff() >= 0.f && c.maxCoeff() <= 1.f;
+  };
+  if (s.kind == SpecularKind::Conductor && !unit(s.reflectance))
+    return "material '" + material.name + "': a mirror's reflectance must lie in [0, 1]";
+  if (s.kind == SpecularKind::Dielectric &&
+      (!(s.ior >= 1.f && s.ior <= 4.f) || !unit(s.attenuation_color) || !(s.attenuation_color.minCoeff() > 0.f) ||
+       !(s.attenuation_distance > 0.f)))
+    return "material '" + material.name +
+           "': glass needs an index of refraction in [1, 4] (this one: " + std::to_string(s.ior) +
+           "), an attenuation colour in (0, 1] and an attenuation distance above 0";
+  return std::nullopt;
+}
+
 Phong surface_phong(const PhongMaterial& material, const Eigen::Vector3f& metallic_roughness_texel) {
   if (!material.metallic_roughness_texture) return material;
   MetallicRoughness at = material.metallic_roughness;
@@ -99,20 +115,8 @@ void MrScene::validate() const {
     if (!material.kd.allFinite() || !std::isfinite(material.ks) || !std::isfinite(material.n) || material.n < 0.f ||
         !material.emission.allFinite())
       throw Error("material '" + material.name + "' has invalid Phong parameters");
-  for (const PhongMaterial& material : materials) {
-    const SpecularMaterial& s = material.specular;
-    const auto unit = [](const Eigen::Vector3f& c) {
-      return c.allFinite() && c.minCoeff() >= 0.f && c.maxCoeff() <= 1.f;
-    };
-    if (s.kind == SpecularKind::Conductor && !unit(s.reflectance))
-      throw Error("material '" + material.name + "': a mirror's reflectance must lie in [0, 1]");
-    if (s.kind == SpecularKind::Dielectric &&
-        (!(s.ior >= 1.f && s.ior <= 4.f) || !unit(s.attenuation_color) || !(s.attenuation_color.minCoeff() > 0.f) ||
-         !(s.attenuation_distance > 0.f)))
-      throw Error("material '" + material.name +
-                  "': glass needs an index of refraction in [1, 4], an attenuation colour in (0, 1] and an attenuation "
-                  "distance above 0");
-  }
+  for (const PhongMaterial& material : materials)
+    if (const std::optional<std::string> problem = specular_problem(material)) throw Error(*problem);
   for (const MrLight& light : lights)
     if (light.through_vpl && light.kind != LightKind::Directional)
       throw Error("only directional (environment) lights can reach the scene through VPLs");

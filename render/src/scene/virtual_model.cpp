@@ -1,7 +1,11 @@
 #include "relight/render/scene/virtual_model.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include "relight/core/error.h"
@@ -45,10 +49,38 @@ Eigen::Affine3d Placement::transform() const {
   return t;
 }
 
-void check_model(const VirtualModel& model, const std::filesystem::path& file) {
+namespace {
+
+/// Whether every edge of the mesh's triangles that use a glass material is shared by exactly two
+/// of them, vertices welded by position (glTF splits vertices at texture seams).
+bool glass_is_closed(const TriangleMesh& mesh, const std::vector<PhongMaterial>& materials) {
+  std::map<std::array<float, 3>, std::uint32_t> welded;
+  const auto id = [&](std::uint32_t v) {
+    const Eigen::Vector3f& p = mesh.positions[v];
+    return welded.try_emplace({p.x(), p.y(), p.z()}, static_cast<std::uint32_t>(welded.size())).first->second;
+  };
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> edges;
+  bool any = false;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (materials[mesh.triangle_material[t]].specular.kind != SpecularKind::Dielectric) continue;
+    any = true;
+    for (std::size_t e = 0; e < 3; ++e) {
+      const std::uint32_t a = id(mesh.triangles[t][e]), b = id(mesh.triangles[t][(e + 1) % 3]);
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  }
+  return !any || std::all_of(edges.begin(), edges.end(), [](const auto& edge) { return edge.second == 2; });
+}
+
+}  // namespace
+
+void check_model(VirtualModel& model, const std::filesystem::path& file) {
   const auto fail = [&file](const TriangleMesh& mesh, const std::string& why) {
     throw Error(file.string() + ": " + (mesh.name.empty() ? "" : "mesh '" + mesh.name + "': ") + why);
   };
+  for (const PhongMaterial& material : model.materials)
+    if (const std::optional<std::string> problem = specular_problem(material))
+      throw Error(file.string() + ": " + *problem);
   for (const TriangleMesh& mesh : model.meshes) {
     for (std::size_t v = 0; v < mesh.positions.size(); ++v)
       if (!mesh.positions[v].allFinite()) fail(mesh, "vertex " + std::to_string(v + 1) + " is not finite");
@@ -69,6 +101,9 @@ void check_model(const VirtualModel& model, const std::filesystem::path& file) {
         fail(mesh, "triangle " + std::to_string(t + 1) + " uses material " + std::to_string(mesh.triangle_material[t]) +
                        ", but the model has " + std::to_string(model.materials.size()));
     }
+    if (!glass_is_closed(mesh, model.materials))
+      model.warnings.push_back((mesh.name.empty() ? "a glass mesh" : "glass mesh '" + mesh.name + "'") +
+                               " is not a closed surface: rays that enter it may not leave (rendered as a thin sheet)");
   }
 }
 

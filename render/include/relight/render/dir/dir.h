@@ -14,6 +14,7 @@
 #include <span>
 
 #include "relight/render/differential_images.h"
+#include "relight/render/dir/caustic_photons.h"
 #include "relight/render/dir/dir_options.h"
 #include "relight/render/dir/gbuffer.h"
 #include "relight/render/dir/ism.h"
@@ -37,6 +38,7 @@ struct DirRenderOptions {
   int interleave = 4;        ///< n: n x n VPL subsets; 1 = every pixel sees every VPL
   DirOutput output = DirOutput::Both;
   DirBackend backend = DirBackend::Auto;
+  CausticOptions caustics{};  ///< the light mirrors and glass focus (caustic_photons.h)
 };
 
 /// The whole method without a GPU, step for step the same algorithm (ray-cast G-buffer and

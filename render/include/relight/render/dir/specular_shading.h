@@ -19,6 +19,7 @@
 #include <span>
 
 #include "relight/render/differential_images.h"
+#include "relight/render/dir/caustic_photons.h"
 #include "relight/render/dir/dir.h"
 #include "relight/render/dir/specular_back_projection.h"
 #include "relight/render/dir/specular_gbuffer.h"
@@ -31,15 +32,20 @@ struct SpecularLight {
   RadianceImage reflected_real, refracted_real;
 };
 
+/// `photons`: the frame's caustics, which the surfaces seen in mirrors and glass show too (none:
+/// no caustics).
 [[nodiscard]] SpecularLight shade_specular_from_maps(const SpecularGBuffers& specular, const MrScene& scene,
                                                      const ShadowLayout& layout, std::span<const float> shadow_atlas,
                                                      std::span<const Vpl> vpls, std::span<const float> ism_atlas,
-                                                     const IsmPointPools& ism_points, const DirRenderOptions& options);
+                                                     const IsmPointPools& ism_points, const DirRenderOptions& options,
+                                                     const CausticPhotons* photons = nullptr);
 
-/// The whole step on the CPU, where both DIR renderers call it: the secondary G-buffers of
-/// `gbuffer` (specular_gbuffers_cpu over `tracer`), shaded (shade_specular_from_maps), put into
-/// `images` (put_specular_light). Returns their back-projection into the camera image
-/// (specular_back_projection.h; empty where no pixel is specular), for the composite.
+/// The whole step on the CPU, where both DIR renderers call it: the caustics of the frame
+/// (caustic_photons.h, options.caustics) gathered at `gbuffer`; the secondary G-buffers of
+/// `gbuffer` (specular_gbuffers_cpu over `tracer`), shaded with their caustics
+/// (shade_specular_from_maps), put into `images` (put_specular_light). Returns their
+/// back-projection into the camera image (specular_back_projection.h; empty where no pixel is
+/// specular), for the composite.
 SpecularBackProjection add_specular_light(DifferentialImages& images, const RayTracer& tracer, const MrCamera& camera,
                                           const GBuffer& gbuffer, const ShadowLayout& layout,
                                           std::span<const float> shadow_atlas, std::span<const Vpl> vpls,

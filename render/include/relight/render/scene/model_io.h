@@ -34,13 +34,20 @@
 // back the same way.
 // Occlusion textures, MTL texture maps and the base colour's alpha are ignored. Meshes keep the file's axes
 // (y-up, see virtual_model.h); glTF node transforms are applied. save_gltf writes no textures.
+#include <array>
 #include <filesystem>
+#include <string_view>
 
 #include "relight/render/scene/virtual_model.h"
 
 namespace relight::render {
 
 inline constexpr float kGltfTransmissionThreshold = 0.5f;
+/// The glTF extensions load_gltf reads; a file using another gets a warning naming it
+/// (VirtualModel::warnings).
+inline constexpr std::array<std::string_view, 5> kSupportedGltfExtensions{
+    "KHR_texture_transform", "KHR_materials_emissive_strength", "KHR_materials_transmission", "KHR_materials_ior",
+    "KHR_materials_volume"};
 inline constexpr float kGltfMirrorMinMetallic = 0.99f;
 inline constexpr float kGltfMirrorMaxRoughness = 0.05f;
 

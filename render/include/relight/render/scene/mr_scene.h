@@ -11,6 +11,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,11 @@ struct PhongMaterial : Phong {
 /// `metallic_roughness_texel` (texture_at()), before the base-colour texture; the material's
 /// own without that texture.
 [[nodiscard]] Phong surface_phong(const PhongMaterial& material, const Eigen::Vector3f& metallic_roughness_texel);
+
+/// What is wrong with a material's specular part (a mirror's reflectance outside [0, 1]; glass
+/// with an index of refraction outside [1, 4] or NaN, an attenuation colour outside (0, 1], an
+/// attenuation distance not above 0), as one line naming the material; none when it is valid.
+[[nodiscard]] std::optional<std::string> specular_problem(const PhongMaterial& material);
 
 /// A texture's colour at a point with coordinates `uv` (mip level `lod`), or its mean where the
 /// point has none; 1 without a texture.

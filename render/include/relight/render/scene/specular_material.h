@@ -19,11 +19,11 @@
 //
 // Which renderers see it: the differential path tracer (reference/path_tracer.h) renders these
 // materials exactly, caustics included. DIR shades what they reflect and refract
-// (dir/specular_gbuffer.h, dir/specular_shading.h); the ray-traced VPL tracer follows light
-// through them to the surface it reaches (caustic VPLs, vpl/vpl.h). Not yet: sharp caustics in
-// DIR, light through glass in DIR's shadow maps (glass casts an opaque shadow there), and the
-// rasterised RSM VPL source, which lights VPLs on them by their Phong fallback (PhongMaterial's
-// k_d, k_s, n: for glTF the metallic-roughness mapping).
+// (dir/specular_gbuffer.h, dir/specular_shading.h) and their caustics (dir/caustic_photons.h:
+// its shadow maps see glass as opaque, the photons bring the light through it back); the
+// ray-traced VPL tracer follows light through them to the surface it reaches (caustic VPLs,
+// vpl/vpl.h). Not yet: the rasterised RSM VPL source, which lights VPLs on them by their Phong
+// fallback (PhongMaterial's k_d, k_s, n: for glTF the metallic-roughness mapping).
 
 namespace relight::render {
 

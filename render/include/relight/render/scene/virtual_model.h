@@ -21,6 +21,9 @@ struct VirtualModel {
   std::string name;
   std::vector<PhongMaterial> materials;
   std::vector<TriangleMesh> meshes;
+  /// What the loader read but cannot render as the file means it, one line each (an unsupported
+  /// glTF extension, glass that is not a closed surface): the model is usable, the user is told.
+  std::vector<std::string> warnings{};
 };
 
 /// Where a model goes: translation in the world (metres), the world direction its up axis
@@ -54,9 +57,11 @@ void add_virtual_model(MrScene& scene, const VirtualModel& model, const Placemen
 [[nodiscard]] Eigen::AlignedBox3f bounds(const VirtualModel& model);
 
 /// Throws relight::Error naming `file` when a mesh has a non-finite position or normal, a triangle
-/// index past its vertices or a material index past the model's materials: what a loader checks
-/// before the model reaches the renderer (which indexes without checking).
-void check_model(const VirtualModel& model, const std::filesystem::path& file);
+/// index past its vertices or a material index past the model's materials, or a material an
+/// invalid specular part (specular_problem): what a loader checks before the model reaches the
+/// renderer (which indexes without checking). Adds a warning for each glass mesh that is not a
+/// closed surface: its rays enter and never leave, so it renders as a thin sheet at best.
+void check_model(VirtualModel& model, const std::filesystem::path& file);
 
 /// Area-weighted vertex normals from the triangles (for meshes that come without normals).
 void compute_vertex_normals(TriangleMesh& mesh);

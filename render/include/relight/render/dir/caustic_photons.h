@@ -1,0 +1,99 @@
+#pragma once
+// Caustics in DIR (Knecht et al., TVCG 2013 §4.2.1 and §5.2, eqs. 12-14): the light a spot,
+// point or directional light sends through mirrors and glass onto diffuse surfaces (LS+DE).
+//
+// Photons: from every light, rays aimed at the specular objects (the sampler of the path
+// tracer's light tracing), followed through their specular vertices (Fresnel-proportional choice,
+// Beer-Lambert inside glass, up to `max_vertices`) to the first diffuse surface, where the photon
+// is stored with its flux and incident direction; a ray whose first hit is not specular is direct
+// light, which the shadow maps already give. Each photon path is traced in both worlds with the
+// same random numbers: with the virtual objects (L_rv, every light) and without them (L_r, real
+// lights; virtual meshes invisible), so the paper's real(ls, p_hit, p) of eq. 14 - a caustic
+// reaches L_r only when the light, the specular object and the receiver are all real - follows
+// from the geometry instead of being a flag.
+//
+// Density estimation: a G-buffer pixel at p with normal n reflects
+//   L(p, wo) = sum over photons q within `radius` of p (on p's side of the surface)
+//              f(p; wi_q, wo) Phi_q 3 (1 - |q - p| / r) / (pi r^2)
+// (a cone filter, whose weights integrate to 1 over the disc) in the photons' world. Where this
+// departs from the paper: the paper rasterises photon G-buffers from each spot light and splats
+// photon quads into a screen-space caustic buffer (CBuf); relight traces the photons (exact
+// refraction, any light type, several specular vertices) and gathers them in world space, so the
+// same photons light the primary G-buffer and the secondary G-buffers of reflections and
+// refractions (caustics seen in a mirror, §4.2.1's last paragraph) without a buffer per view.
+//
+// Reads the MrScene through a RayTracer; writes CausticPhotons, which add_caustic_light()
+// gathers into DifferentialImages for any G-buffer.
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "relight/render/differential_images.h"
+#include "relight/render/dir/gbuffer.h"
+#include "relight/render/reference/ray_tracer.h"
+
+namespace relight::render {
+
+struct CausticPhoton {
+  Eigen::Vector3f position;
+  Eigen::Vector3f incident;  ///< unit, towards where the light came from
+  Eigen::Vector3f normal;    ///< the receiving surface's, on the incident side
+  Eigen::Vector3f flux;      ///< W
+  bool real_world = false;   ///< traced without the virtual objects (L_r), else with them (L_rv)
+};
+
+struct CausticOptions {
+  int photons_per_light = 16384;  ///< rays per light aimed at the specular objects; 0 = no caustics
+  float radius = 0.015f;          ///< metres: the density estimate's disc
+  int max_vertices = 8;           ///< specular vertices one photon path may pass
+  std::uint64_t seed = 1;
+};
+
+/// The photons of one frame, indexed by a grid of `radius` cells for the gather.
+class CausticPhotons {
+ public:
+  CausticPhotons() = default;
+  CausticPhotons(std::vector<CausticPhoton> photons, float radius);
+
+  [[nodiscard]] const std::vector<CausticPhoton>& photons() const { return photons_; }
+  [[nodiscard]] float radius() const { return radius_; }
+  [[nodiscard]] bool empty() const { return photons_.empty(); }
+  /// Calls visit(photon) for every photon within `radius` of `point` (in either world).
+  template <class Visit>
+  void for_each_near(const Eigen::Vector3f& point, const Visit& visit) const;
+
+ private:
+  [[nodiscard]] std::int64_t key(int x, int y, int z) const;
+  std::vector<CausticPhoton> photons_;
+  float radius_ = 0.f;
+  std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells_;
+};
+
+/// Traces the photons of every light of the tracer's scene (none without specular surfaces).
+[[nodiscard]] CausticPhotons trace_caustic_photons(const RayTracer& tracer, const CausticOptions& options,
+                                                   int threads = 0);
+
+/// Adds the caustic light that each pixel of `gbuffer` reflects towards its eye (`eyes`, or
+/// `camera_centre` for all) to `images`' L_rv (photons of the virtual world) and, on real
+/// surfaces, L_r (photons of the real world); `weights` (optional) scales it per pixel (a
+/// secondary G-buffer's branch weight). The indirect parts are left as they are.
+void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const MrScene& scene,
+                       const CausticPhotons& photons, const Eigen::Vector3f& camera_centre,
+                       const PositionMap* eyes = nullptr, const RadianceImage* weights = nullptr, int threads = 0);
+
+template <class Visit>
+void CausticPhotons::for_each_near(const Eigen::Vector3f& point, const Visit& visit) const {
+  if (photons_.empty()) return;
+  const Eigen::Vector3i cell = (point / radius_).array().floor().cast<int>();
+  const float r2 = radius_ * radius_;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const auto found = cells_.find(key(cell.x() + dx, cell.y() + dy, cell.z() + dz));
+        if (found == cells_.end()) continue;
+        for (const std::uint32_t i : found->second)
+          if ((photons_[i].position - point).squaredNorm() <= r2) visit(photons_[i]);
+      }
+}
+
+}  // namespace relight::render

@@ -1,0 +1,153 @@
+#include "relight/render/dir/caustic_photons.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "relight/core/parallel.h"
+#include "relight/render/scene/phong_brdf.h"
+#include "relight/render/scene/sampler.h"
+#include "relight/render/scene/specular_bsdf.h"
+#include "scene/caustic_emission.h"
+#include "scene/surface_shading.h"
+
+namespace relight::render {
+namespace {
+
+using Vec3 = Eigen::Vector3f;
+
+/// Mixed into the seed so that photons draw other numbers than the VPLs.
+constexpr std::uint64_t kPhotonSeed = 0x3d9f2a61c4b8e057ull;
+/// Photon paths per parallel work item, merged in order: the result does not depend on threads.
+constexpr int kPathsPerChunk = 1024;
+
+/// One photon path in one world; the photon it leaves, if it reaches a diffuse surface through
+/// at least one specular vertex.
+std::optional<CausticPhoton> follow(const RayTracer& tracer, const detail::Emission& emission, bool real_world,
+                                    Pcg32 rng, int max_vertices) {
+  const MrScene& scene = tracer.scene();
+  Vec3 origin = emission.origin, direction = emission.direction, flux = emission.beta;
+  const SpecularMaterial* medium = nullptr;
+  std::uint32_t rays = 0;
+  for (int vertex = 0;; ++vertex) {
+    const std::optional<SurfaceHit> hit = detail::nearest_hit(tracer, origin, direction, !real_world, rays);
+    if (!hit) return std::nullopt;
+    if (medium) flux = flux.cwiseProduct(beer_lambert(*medium, hit->t));
+    const detail::Vertex v = detail::make_vertex(*hit, direction, scene);
+    if (!v.specular) {
+      if (vertex == 0) return std::nullopt;  // direct light: the shadow maps' share
+      return CausticPhoton{v.point, v.wo, v.shading_normal, flux, real_world};
+    }
+    if (vertex >= max_vertices) return std::nullopt;
+    const std::optional<SpecularSample> sample =
+        sample_specular(*v.specular, v.outward, v.wo, rng.uniform(), Transport::Importance);
+    if (!sample) return std::nullopt;
+    flux = flux.cwiseProduct(sample->weight);
+    if (sample->transmitted) medium = v.outward.dot(v.wo) >= 0.f ? v.specular : nullptr;
+    origin = detail::offset_origin(v, sample->wi);
+    direction = sample->wi;
+  }
+}
+
+}  // namespace
+
+CausticPhotons::CausticPhotons(std::vector<CausticPhoton> photons, float radius)
+    : photons_(std::move(photons)), radius_(radius) {
+  for (std::size_t i = 0; i < photons_.size(); ++i) {
+    const Eigen::Vector3i cell = (photons_[i].position / radius_).array().floor().cast<int>();
+    cells_[key(cell.x(), cell.y(), cell.z())].push_back(static_cast<std::uint32_t>(i));
+  }
+}
+
+std::int64_t CausticPhotons::key(int x, int y, int z) const {
+  // 21 bits a coordinate: cells of a centimetre reach +-10 km.
+  const auto part = [](int v) { return static_cast<std::int64_t>(v & 0x1fffff); };
+  return part(x) | (part(y) << 21) | (part(z) << 42);
+}
+
+CausticPhotons trace_caustic_photons(const RayTracer& tracer, const CausticOptions& options, int threads) {
+  const MrScene& scene = tracer.scene();
+  const BoundingSphere target = bounding_sphere(scene, SceneMeshes::Specular);
+  if (options.photons_per_light <= 0 || target.radius <= 0.f || scene.lights.empty()) return {};
+  const BoundingSphere whole = bounding_sphere(scene, SceneMeshes::All);
+  const auto per_light = static_cast<std::size_t>(options.photons_per_light);
+  const std::size_t total = per_light * scene.lights.size();
+  const auto chunks = static_cast<int>((total + kPathsPerChunk - 1) / kPathsPerChunk);
+  std::vector<std::vector<CausticPhoton>> found(static_cast<std::size_t>(chunks));
+  const float inv_paths = 1.f / static_cast<float>(per_light);
+  parallel_rows(
+      chunks, threads,
+      [&](int begin, int end) {
+        for (int chunk = begin; chunk < end; ++chunk) {
+          const std::size_t first = static_cast<std::size_t>(chunk) * kPathsPerChunk;
+          const std::size_t last = std::min(total, first + kPathsPerChunk);
+          for (std::size_t i = first; i < last; ++i) {
+            const MrLight& light = scene.lights[i / per_light];
+            Pcg32 rng = Pcg32::for_sample(options.seed ^ kPhotonSeed, i, 0);
+            const float u1 = rng.uniform(), u2 = rng.uniform();
+            std::optional<detail::Emission> emission = detail::emit_towards(light, target, whole, u1, u2);
+            if (!emission) continue;
+            emission->beta *= inv_paths;
+            // Both worlds with the same numbers: where the path meets only real surfaces, the
+            // two photons are the same and cancel in L_rv - L_r.
+            for (const bool real_world : {false, true}) {
+              if (real_world && !light.real) continue;
+              if (auto photon = follow(tracer, *emission, real_world, rng, options.max_vertices))
+                found[static_cast<std::size_t>(chunk)].push_back(*photon);
+            }
+          }
+        }
+      },
+      1);
+  std::vector<CausticPhoton> photons;
+  for (std::vector<CausticPhoton>& chunk : found) photons.insert(photons.end(), chunk.begin(), chunk.end());
+  return {std::move(photons), options.radius};
+}
+
+void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const MrScene& scene,
+                       const CausticPhotons& photons, const Eigen::Vector3f& camera_centre, const PositionMap* eyes,
+                       const RadianceImage* weights, int threads) {
+  if (photons.empty()) return;
+  const RadianceImage kd_texture = texture_factors(gbuffer, scene, MaterialTexture::BaseColor);
+  const RadianceImage metallic_roughness = texture_factors(gbuffer, scene, MaterialTexture::MetallicRoughness);
+  const float r = photons.radius();
+  const float kernel = 3.f / (std::numbers::pi_v<float> * r * r);
+  const int width = gbuffer.distance.width();
+  const auto vec = [](const Float3& f) { return Vec3(f.x, f.y, f.z); };
+  parallel_rows(
+      gbuffer.distance.height(), threads,
+      [&](int begin, int end) {
+        for (int y = begin; y < end; ++y)
+          for (int x = 0; x < width; ++x) {
+            if (gbuffer.distance(y, x) == 0.f) continue;
+            const Float3 w = weights ? (*weights)(y, x) : Float3{1.f, 1.f, 1.f};
+            if (w == Float3{}) continue;
+            const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
+            const Phong phong = with_kd_factor(
+                surface_phong(material, metallic_roughness.empty() ? Vec3::Ones() : vec(metallic_roughness(y, x))),
+                kd_texture.empty() ? Vec3::Ones() : vec(kd_texture(y, x)));
+            const Vec3 p = vec(gbuffer.position(y, x)), n = vec(gbuffer.normal(y, x));
+            const Vec3 wo = ((eyes ? vec((*eyes)(y, x)) : camera_centre) - p).normalized();
+            const bool real_surface = !gbuffer.virtual_surface(y, x);
+            Vec3 rv = Vec3::Zero(), real = Vec3::Zero();
+            photons.for_each_near(p, [&](const CausticPhoton& q) {
+              // On this side of this surface: not through a thin wall, not from a surface at an angle.
+              if (q.normal.dot(n) < 0.7f || std::abs((q.position - p).dot(n)) > 0.5f * r || q.incident.dot(n) <= 0.f)
+                return;
+              const float falloff = kernel * (1.f - (q.position - p).norm() / r);
+              const Vec3 light = phong_brdf(phong, n, q.incident, wo).cwiseProduct(q.flux) * falloff;
+              if (q.real_world) {
+                if (real_surface) real += light;
+              } else {
+                rv += light;
+              }
+            });
+            const Vec3 scale = vec(w);
+            images.real_virtual(y, x) += Float3{rv.x() * scale.x(), rv.y() * scale.y(), rv.z() * scale.z()};
+            images.real(y, x) += Float3{real.x() * scale.x(), real.y() * scale.y(), real.z() * scale.z()};
+          }
+      },
+      4);
+}
+
+}  // namespace relight::render
