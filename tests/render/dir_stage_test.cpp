@@ -30,6 +30,7 @@ struct StageRun {
   RadianceImage real_direct;  ///< L_r without its VPL part
   std::size_t mesh_count = 0, vpls = 0, emitters = 0, lights_through_vpl = 0;
   std::size_t real_triangles = 0, coarse_triangles = 0;
+  int specular_pixels = 0, back_projected = 0;  ///< of specular_back_projection
 };
 
 /// A sun beside the room's lamps, so that the environment mode has a directional light to route.
@@ -53,14 +54,15 @@ RadianceImage direct_real(const DifferentialImages& images) {
 }
 
 StageRun run_stage(vk::VulkanContext* context, std::optional<EnvironmentLight> environment = std::nullopt,
-                   int coarse_mesh_stride = DirStageOptions{}.coarse_mesh_stride) {
+                   int coarse_mesh_stride = DirStageOptions{}.coarse_mesh_stride,
+                   const VirtualModel& object = make_glossy_pebble()) {
   const PinholeIntrinsics intrinsics{131.25, 131.25, 79.5, 59.5, 160, 120};
   FrameGraph graph(context ? &context->transfer() : nullptr);
   graph.emplace<test::SyntheticFrameStage>(intrinsics, synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.1, 0.75}));
   DirSceneContent content;
   content.lights = truth::scene_from_synth(synth::default_indoor_scene()).lights;
   if (environment) content.lights.push_back(window_sun());
-  content.objects.emplace_back(make_glossy_pebble(), Placement::parse("0.35,-0.2,0.75,30"));
+  content.objects.emplace_back(object, Placement::parse("0.35,-0.2,0.75,30"));
   DirStageOptions options;
   options.renderer.shadow_tile = 256;
   options.renderer.ism.tile = 64;
@@ -71,6 +73,7 @@ StageRun run_stage(vk::VulkanContext* context, std::optional<EnvironmentLight> e
   graph.keep("mr_scene");
   graph.keep("vpls");
   graph.keep("dir_images");
+  graph.keep("specular_back_projection");
   graph.compile();
   EXPECT_EQ(graph.execution_order(),
             (std::vector<std::string>{"synthetic_frame", "mr_scene", "vpls", "dir", "indirect_smoothing", "tone_map",
@@ -88,6 +91,12 @@ StageRun run_stage(vk::VulkanContext* context, std::optional<EnvironmentLight> e
   for (const TriangleMesh& mesh : scene.coarse_real_meshes) out.coarse_triangles += mesh.triangle_count();
   out.emitters =
       static_cast<std::size_t>(std::count_if(vpls.begin(), vpls.end(), [](const Vpl& v) { return v.emitter(); }));
+  const SpecularBackProjection& view = *graph.find<SpecularBackProjection>("specular_back_projection");
+  if (!view.empty())
+    for (std::size_t i = 0; i < view.specular.size(); ++i) {
+      out.specular_pixels += view.specular.pixels()[i];
+      out.back_projected += view.refracted.camera_pixel.pixels()[i].z > 0.f;
+    }
   out.lights_through_vpl = static_cast<std::size_t>(
       std::count_if(scene.lights.begin(), scene.lights.end(), [](const MrLight& l) { return l.through_vpl; }));
   return out;
@@ -130,13 +139,35 @@ TEST_F(DirStageTest, CpuFallbackMatchesTheVulkanRenderer) {
   EXPECT_GT(close, static_cast<int>(gpu.composite.pixels().size()) * 97 / 100);
 }
 
+// The glass pebble through the product's graph: the DIR stage traces what it shows and the
+// composite takes the camera's own view of the table behind it (back-projection) on both
+// backends alike; the glossy pebble leaves the buffer empty.
+TEST_F(DirStageTest, TheGlassPebbleShowsTheTableBehindItOnBothBackends) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const StageRun gpu = run_stage(&context, std::nullopt, DirStageOptions{}.coarse_mesh_stride, make_glass_pebble());
+  const StageRun cpu = run_stage(nullptr, std::nullopt, DirStageOptions{}.coarse_mesh_stride, make_glass_pebble());
+  std::printf("glass pebble: %d specular pixels, %d back-projected\n", gpu.specular_pixels, gpu.back_projected);
+  EXPECT_GT(gpu.specular_pixels, 100);
+  // The table behind it is in view through most of it (measured: 94 of 141 pixels; the
+  // rest refract to where the camera cannot see, e.g. under the pebble, or leave the scene).
+  EXPECT_GT(gpu.back_projected, gpu.specular_pixels / 2);
+  EXPECT_EQ(cpu.back_projected, gpu.back_projected);
+  int close = 0;
+  for (std::size_t i = 0; i < gpu.composite.pixels().size(); ++i)
+    if (channel_difference(gpu.composite.pixels()[i], cpu.composite.pixels()[i]) <= 3) ++close;
+  EXPECT_GT(close, static_cast<int>(gpu.composite.pixels().size()) * 97 / 100);
+  EXPECT_EQ(run_stage(nullptr).specular_pixels, 0);
+}
+
 // The reconstruction on a twice wider grid stands in for it in the shadow maps and as the VPLs'
 // surfaces (a quarter of its triangles): the room's real shadows (in the direct part of L_r; the
 // composite's differential cancels them) and the pebble's come out the same, and the VPLs' light
 // up to their sampling. At 160 x 120 a coarse stride of 16 (at 640 across) is 4 pixels; the
-// default (4, one pixel here) makes no coarse copy. Measured: 1324 of 5762 triangles; direct
-// L_r within 2 % on 98.2 % of the pixels (the copy lifted by 10 cm: 80.6 %), composites within
-// 3 levels on 99.9 %.
+// default (4, one pixel here) makes no coarse copy. Measured: 2019 of 8778 triangles; direct
+// L_r within 2 % on 96.0 % of the pixels (the copy lifted by 10 cm: 80.6 %), composites within
+// 3 levels on 100 %. (Before the edge rule kept slants to 75 degrees at every resolution, a
+// third of this grid - most of the table top - was dropped from both meshes alike: 1324 of 5762
+// triangles, 98.2 %.)
 TEST_F(DirStageTest, ACoarseCopyOfTheReconstructionKeepsThePicture) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   const StageRun exact = run_stage(&context, std::nullopt, 0);
@@ -159,7 +190,7 @@ TEST_F(DirStageTest, ACoarseCopyOfTheReconstructionKeepsThePicture) {
       "coarse copy: %zu of %zu real triangles; direct L_r within 2 %% on %.1f %% of the pixels, composites "
       "within 3 levels on %.1f %%\n",
       coarse.coarse_triangles, coarse.real_triangles, 100.0 * real_close / pixels, 100.0 * close / pixels);
-  EXPECT_GT(real_close, pixels * 97 / 100) << "the real shadows stay";
+  EXPECT_GT(real_close, pixels * 95 / 100) << "the real shadows stay";
   EXPECT_GT(close, pixels * 995 / 1000);
   EXPECT_GT(close_cpu, pixels * 97 / 100) << "the CPU fallback uses the same copy";
 }

@@ -96,7 +96,19 @@ void MrSceneStage::run(StageContext& context) {
   else
     materials.material = scene.add_material(reconstruction_material_);
   const Pose camera_to_world = context.get(frame_).camera_to_world.value_or(Pose::Identity());
-  TriangleMesh mesh = mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, mesh_);
+  // The edge rule (depth_mesh.h) keeps every surface up to a slant of at least 75 degrees, where
+  // an edge spans 1/cos(75 deg) ~ 4 pixel footprints: on a 640-pixel-wide image its
+  // relative_edge allows more, on a coarse one a grid step spans more of a surface and the rule
+  // grows with it (at 160 x 120 the table top behind glass was dropped and the refracted rays
+  // fell to the floor).
+  const double focal = context.get(frame_).intrinsics.fx;
+  const auto slant_limited = [focal](DepthMeshOptions options) {
+    if (focal > 0.0)
+      options.relative_edge = std::max(options.relative_edge, static_cast<float>(4.0 * options.stride / focal));
+    return options;
+  };
+  const DepthMeshOptions fine = slant_limited(mesh_);
+  TriangleMesh mesh = mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, fine);
   mesh.name = "reconstruction";
   scene.meshes.push_back(std::move(mesh));
   if (real_lights_buffer_) add_lights(scene, context.get(real_lights_));
@@ -114,6 +126,7 @@ void MrSceneStage::run(StageContext& context) {
     coarse.stride = coarse_stride;
     coarse.relative_edge *= scale;
     coarse.min_edge *= scale;
+    coarse = slant_limited(coarse);
     scene.coarse_real_meshes.push_back(
         mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, coarse));
     scene.coarse_real_meshes.back().name = "reconstruction (coarse)";

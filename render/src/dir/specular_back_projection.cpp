@@ -7,32 +7,31 @@
 namespace relight::render {
 namespace {
 
-/// Where the camera sees `point` (x, y, 1), if it sees that very point: inside the image, and
-/// the primary G-buffer's real surface there at the point's distance.
-Float3 camera_source(const Eigen::Vector3f& point, const GBuffer& primary, const MrCamera& camera,
+/// Where the camera sees `point` (x, y, 1), if its image shows that very point: inside the
+/// image, and no real surface between the camera and it (the virtual objects are not in the
+/// camera image).
+Float3 camera_source(const Eigen::Vector3f& point, const RayTracer& tracer, const MrCamera& camera,
                      float depth_tolerance) {
   const Eigen::Vector3d local = camera.camera_to_world.inverse() * point.cast<double>();
   if (!(local.z() > 0.0)) return {};
   const PinholeIntrinsics& k = camera.intrinsics;
   const double x = k.fx * local.x() / local.z() + k.cx, y = k.fy * local.y() / local.z() + k.cy;
   if (!(x >= 0.0 && y >= 0.0 && x <= k.width - 1.0 && y <= k.height - 1.0)) return {};
-  const int col = static_cast<int>(std::lround(x)), row = static_cast<int>(std::lround(y));
-  const float seen = primary.distance(row, col);
-  if (seen == 0.f || primary.virtual_surface(row, col)) return {};
-  const auto distance = static_cast<float>(local.norm());
-  if (std::abs(seen - distance) > depth_tolerance * distance) return {};
+  const Eigen::Vector3f centre = camera.camera_to_world.translation().cast<float>();
+  const Eigen::Vector3f to_point = point - centre;
+  const float distance = to_point.norm();
+  if (tracer.occluded(Layer::Real, centre, to_point / distance, distance * (1.f - depth_tolerance))) return {};
   return {static_cast<float>(x), static_cast<float>(y), 1.f};
 }
 
 }  // namespace
 
 SpecularBackProjection back_project(const SpecularGBuffers& specular, const RadianceImage& reflected_real,
-                                    const RadianceImage& refracted_real, const GBuffer& primary, const MrCamera& camera,
-                                    float depth_tolerance) {
+                                    const RadianceImage& refracted_real, const RayTracer& tracer,
+                                    const MrCamera& camera, float depth_tolerance) {
   const int width = specular.specular.width(), height = specular.specular.height();
-  if (!primary.distance.same_shape(specular.specular) || !reflected_real.same_shape(specular.specular) ||
-      !refracted_real.same_shape(specular.specular))
-    throw Error("back_project: the specular G-buffers, their light and the primary G-buffer differ in size");
+  if (!reflected_real.same_shape(specular.specular) || !refracted_real.same_shape(specular.specular))
+    throw Error("back_project: the specular G-buffers and their light differ in size");
   SpecularBackProjection out;
   out.specular = specular.specular;
   const auto branch = [&](const SpecularBranch& b, const RadianceImage& real) {
@@ -42,7 +41,7 @@ SpecularBackProjection back_project(const SpecularGBuffers& specular, const Radi
         if (!specular.specular(row, col) || b.gbuffer.distance(row, col) == 0.f || b.gbuffer.virtual_surface(row, col))
           continue;
         const Float3& p = b.gbuffer.position(row, col);
-        projected.camera_pixel(row, col) = camera_source({p.x, p.y, p.z}, primary, camera, depth_tolerance);
+        projected.camera_pixel(row, col) = camera_source({p.x, p.y, p.z}, tracer, camera, depth_tolerance);
       }
     return projected;
   };

@@ -80,7 +80,7 @@ SpecularBackProjection add_specular_light(DifferentialImages& images, const RayT
   const SpecularLight light = shade_specular_from_maps(specular, tracer.scene(), layout, shadow_atlas, vpls, ism_atlas,
                                                        ism_points, options, &photons);
   put_specular_light(images, light.light, specular);
-  return back_project(specular, light.reflected_real, light.refracted_real, gbuffer, camera);
+  return back_project(specular, light.reflected_real, light.refracted_real, tracer, camera);
 }
 
 }  // namespace relight::render

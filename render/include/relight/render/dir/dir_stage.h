@@ -107,6 +107,9 @@ struct RealAlbedoBuffers {
 struct DirStageOptions {
   DirRenderOptions renderer{};
   VplOptions vpls{.count = 64};
+  /// The reconstruction's rendered mesh. MrSceneStage raises its edge rule to keep surfaces up
+  /// to a 75-degree slant at the frame's focal length (4 pixel footprints per grid step), which
+  /// matters below 640 across: at 160 x 120 the default rule dropped a table top seen from 1.5 m.
   DepthMeshOptions mesh{.stride = 2};
   /// The grid stride of the reconstruction's coarse copy (MrScene::coarse_real_meshes: the
   /// occluders of the shadow-mapped lights' maps and the surfaces VPLs land on), in pixels of a

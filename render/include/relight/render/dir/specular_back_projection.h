@@ -11,9 +11,12 @@
 //
 // w_b is the branch's weight (the paper's eta_1, eta_2 T_c; specular_gbuffer.h), q_b the surface
 // it ends on and CI(x) the camera image where x projects. The validation v_b: q_b is real,
-// projects inside the image, and the primary G-buffer there sees a real surface at q_b's
-// distance (within `depth_tolerance` of it, relative): the camera sees that very point, not an
-// occluder. A branch that leaves the scene takes TM(w_b L_env), the environment's radiance.
+// projects inside the image, and no real surface lies between the camera and q_b (short of
+// `depth_tolerance` of its distance, relative): the camera image shows that very point. The
+// paper compares depths with the primary G-buffer instead; that G-buffer holds the virtual
+// objects, which the camera image does not, so it rejected exactly the table behind a glass
+// object - what its refraction shows most. A branch that leaves the scene takes
+// TM(w_b L_env), the environment's radiance.
 //
 // Where this departs from the paper: the paper validates the pixel as a whole (CI_bp is all
 // back-projection or all L'_r), with an exception for virtual refractive objects whose
@@ -23,11 +26,12 @@
 // (eq. 11) is the multiplicative composite rule of composite.h applied to CI_bp.
 //
 // Reads SpecularGBuffers, the branches' rendered real light (shade_specular_from_maps), the
-// primary G-buffer and the camera; writes SpecularBackProjection, which the differential
+// scene's real layer (a RayTracer) and the camera; writes SpecularBackProjection, which the differential
 // composites (composite.h) read to put CI_bp in place of the camera image at specular pixels.
 #include "relight/core/image.h"
 #include "relight/render/dir/gbuffer.h"
 #include "relight/render/dir/specular_gbuffer.h"
+#include "relight/render/reference/ray_tracer.h"
 
 namespace relight::render {
 
@@ -49,7 +53,7 @@ inline constexpr float kBackProjectionDepthTolerance = 0.02f;
 
 /// `reflected_real` and `refracted_real`: L_r of each branch's surface (SpecularLight).
 [[nodiscard]] SpecularBackProjection back_project(const SpecularGBuffers& specular, const RadianceImage& reflected_real,
-                                                  const RadianceImage& refracted_real, const GBuffer& primary,
+                                                  const RadianceImage& refracted_real, const RayTracer& tracer,
                                                   const MrCamera& camera,
                                                   float depth_tolerance = kBackProjectionDepthTolerance);
 
