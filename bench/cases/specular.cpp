@@ -14,6 +14,12 @@
 //   caustic_delta_rel_error: the mean relative error of DeltaL = TM(L_rv) - TM(L_r) where the
 //     path tracer's caustics change DeltaL by more than 0.02 (its images with and without caustic
 //     light paths);
+//   caustic_reference_noise: the same error of a second reference frame (another seed): the
+//     floor that the reference's noise sets under caustic_delta_rel_error;
+//   caustic_energy_ratio: what our caustics add to DeltaL over that region (64k photons per
+//     light, our frame with and without them) over what the reference's add (1 = as much);
+//   caustic_region_error_without_caustics: the same region's error of our frame without
+//     photons against the reference without caustic paths (DIR's shadows, VPLs there);
 //   composite_rmse: as dir/vs_reference.
 #include <chrono>
 
@@ -48,10 +54,11 @@ render::MrCamera camera() {
   return {PinholeIntrinsics{}, synth::look_at({1.2, -1.1, 1.35}, {0.25, -0.2, 0.75})};  // Kinect v1, 640x480
 }
 
-render::DifferentialImages path_traced(const render::MrScene& scene, const render::MrCamera& view, double caustics) {
+render::DifferentialImages path_traced(const render::MrScene& scene, const render::MrCamera& view, double caustics,
+                                       std::uint64_t seed = 99) {
   render::PathTracerOptions options;
   options.max_bounces = 1;
-  options.seed = 99;
+  options.seed = seed;
   options.caustic_paths_per_pixel = caustics;
   return render::render_reference(scene, view, kReferenceSpp, options);
 }
@@ -78,23 +85,53 @@ double specular_error(const render::DifferentialImages& ours, const render::Diff
   return norm > 0.0 ? diff / norm : 0.0;
 }
 
+/// Whether pixel i is a real surface whose DeltaL the reference's caustics change by > 0.02.
+bool in_caustic_region(const render::DifferentialImages& reference, const render::DifferentialImages& without_caustics,
+                       std::size_t i) {
+  if (reference.virtual_coverage.pixels()[i] > 0.f) return false;
+  const auto delta = [i](const render::DifferentialImages& images) {
+    return bench::tm(images.real_virtual.pixels()[i]) - bench::tm(images.real.pixels()[i]);
+  };
+  return length(delta(reference) - delta(without_caustics)) > 0.02f;
+}
+
 /// caustic_delta_rel_error and how many pixels the caustics change.
+/// `compared_with` (default: the reference) is what `ours` is measured against over that region.
 std::pair<double, int> caustic_error(const render::DifferentialImages& ours,
                                      const render::DifferentialImages& reference,
-                                     const render::DifferentialImages& without_caustics) {
+                                     const render::DifferentialImages& without_caustics,
+                                     const render::DifferentialImages* compared_with = nullptr) {
+  const render::DifferentialImages& truth = compared_with ? *compared_with : reference;
   const auto delta = [](const render::DifferentialImages& images, std::size_t i) {
     return bench::tm(images.real_virtual.pixels()[i]) - bench::tm(images.real.pixels()[i]);
   };
   double diff = 0.0, norm = 0.0;
   int pixels = 0;
   for (std::size_t i = 0; i < reference.real.size(); ++i) {
-    if (reference.virtual_coverage.pixels()[i] > 0.f) continue;
-    if (length(delta(reference, i) - delta(without_caustics, i)) <= 0.02f) continue;
-    diff += length(delta(ours, i) - delta(reference, i));
-    norm += length(delta(reference, i));
+    if (!in_caustic_region(reference, without_caustics, i)) continue;
+    diff += length(delta(ours, i) - delta(truth, i));
+    norm += length(delta(truth, i));
     ++pixels;
   }
   return {norm > 0.0 ? diff / norm : 0.0, pixels};
+}
+
+/// Sum over the caustic region of what the caustics add to DeltaL in ours over the same in the
+/// reference (all channels).
+double caustic_energy_ratio(const render::DifferentialImages& ours, const render::DifferentialImages& ours_without,
+                            const render::DifferentialImages& reference,
+                            const render::DifferentialImages& without_caustics) {
+  const auto delta = [](const render::DifferentialImages& images, std::size_t i) {
+    const Float3 d = bench::tm(images.real_virtual.pixels()[i]) - bench::tm(images.real.pixels()[i]);
+    return static_cast<double>(d.x) + d.y + d.z;
+  };
+  double added = 0.0, reference_added = 0.0;
+  for (std::size_t i = 0; i < reference.real.size(); ++i) {
+    if (!in_caustic_region(reference, without_caustics, i)) continue;
+    added += delta(ours, i) - delta(ours_without, i);
+    reference_added += delta(reference, i) - delta(without_caustics, i);
+  }
+  return reference_added != 0.0 ? added / reference_added : 0.0;
 }
 
 bench::Json specular_640x480(const bench::Options& options) {
@@ -142,6 +179,10 @@ bench::Json specular_640x480(const bench::Options& options) {
   const auto [caustic, caustic_pixels] = caustic_error(ours.images, reference, without_caustics);
   json["caustic_delta_rel_error"] = caustic;
   json["caustic_pixels"] = caustic_pixels;
+  // The reference's own noise over that region: a second path-traced frame (another seed)
+  // measured as if it were ours. The floor under caustic_delta_rel_error at this sample count.
+  json["caustic_reference_noise"] =
+      caustic_error(path_traced(ours.scene, view, 2.0, 7), reference, without_caustics).first;
   json["composite_rmse"] = bench::compare(ours.images, reference).composite_rmse;
   json["caustic_photons_per_light"] = dir_options.caustics.photons_per_light;
   // The caustic error against the photon count (the VPL count stays at 256).
@@ -155,6 +196,17 @@ bench::Json specular_640x480(const bench::Options& options) {
                           {"specular_ms", ours.renderer.last_timings().specular_ms}});
   }
   json["by_photon_count"] = by_photons;
+  // How much caustic light we add in that region against the reference (1 = as much): our
+  // frame with and without photons against the reference's with and without caustic paths.
+  {
+    const render::DifferentialImages with_photons = ours.images;  // the last: 64k photons
+    render::DirRenderOptions none = dir_options;
+    none.caustics.photons_per_light = 0;
+    ours.draw(view, none);
+    json["caustic_energy_ratio"] = caustic_energy_ratio(with_photons, ours.images, reference, without_caustics);
+    json["caustic_region_error_without_caustics"] =
+        caustic_error(ours.images, reference, without_caustics, &without_caustics).first;
+  }
   json["width"] = width;
   json["height"] = height;
   json["light_samples"] = 256;
