@@ -86,5 +86,20 @@ TEST_F(ModelRobustness, GltfWithNonFiniteVertex) {
   expect_rejected(write("nan.gltf", gltf), "not finite");
 }
 
+TEST_F(ModelRobustness, GltfClaimingHugeVertexCounts) {
+  // 3 vertices in the buffer; the accessor claims 2^31 of them, or a count whose size in bytes
+  // wraps around 2^64 to 20 bytes (which once passed the check and read far past the buffer).
+  for (const std::string count : {"2147483648", "1537228672809129303"}) {
+    const std::string gltf =
+        R"({"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+    "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+    "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36}],
+    "accessors": [{"bufferView": 0, "componentType": 5126, "count": )" +
+        count + R"(, "type": "VEC3"}]})";
+    expect_rejected(write("huge_" + count + ".gltf", gltf), "past the end of its buffer");
+  }
+}
+
 }  // namespace
 }  // namespace relight::robustness

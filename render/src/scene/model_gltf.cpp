@@ -147,10 +147,18 @@ class AccessorReader {
     if (components <= 0 || component_size <= 0) fail("an accessor has an unknown type");
     element_size_ = static_cast<std::size_t>(components * component_size);
     stride_ = view.byteStride != 0 ? view.byteStride : element_size_;
+    // Checked without a product that can wrap around: a file may claim any count or offset (a
+    // count near 2^64 / stride made (count - 1) * stride small, and the reader then ran far
+    // past the buffer), and the count is what the mesh's arrays are sized by.
+    if (view.byteOffset > data.size()) fail("a buffer view starts past the end of its buffer");
+    const std::size_t view_end =
+        view.byteOffset + std::min<std::size_t>(view.byteLength, data.size() - view.byteOffset);
+    if (accessor_->byteOffset > view_end - view.byteOffset) fail("an accessor reaches past the end of its buffer");
     const std::size_t begin = view.byteOffset + accessor_->byteOffset;
-    const std::size_t span = accessor_->count == 0 ? 0 : (accessor_->count - 1) * stride_ + element_size_;
-    if (begin > data.size() || span > data.size() - begin || accessor_->byteOffset + span > view.byteLength)
-      fail("an accessor reaches past the end of its buffer");
+    const std::size_t room = view_end - begin;
+    if (accessor_->count != 0 && (room < element_size_ || accessor_->count - 1 > (room - element_size_) / stride_))
+      fail("an accessor reaches past the end of its buffer (" + std::to_string(accessor_->count) + " elements in " +
+           std::to_string(room) + " bytes)");
     bytes_ = data.data() + begin;
   }
 
