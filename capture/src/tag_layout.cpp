@@ -1,5 +1,8 @@
 #include "relight/capture/tag_layout.h"
 
+#include <cmath>
+#include <set>
+
 #include <nlohmann/json.hpp>
 
 #include "relight/core/atomic_file.h"
@@ -20,7 +23,10 @@ TagLayout::Tag parse_tag(const nlohmann::json& json) {
     if (!corner.is_array() || corner.size() != 3) throw Error("each corner must be [x, y, z]");
     tag.corners_world[k] = {corner[0].get<double>(), corner[1].get<double>(), corner[2].get<double>()};
   }
-  if (!(tag.size > 0)) throw Error("tag " + std::to_string(tag.id) + " has a non-positive size");
+  if (!(tag.size > 0) || !std::isfinite(tag.size))
+    throw Error("tag " + std::to_string(tag.id) + " needs a positive finite size");
+  for (const auto& corner : tag.corners_world)
+    if (!corner.allFinite()) throw Error("tag " + std::to_string(tag.id) + " has a corner that is not finite");
   return tag;
 }
 
@@ -48,6 +54,11 @@ TagLayout parse_tag_layout(std::string_view json_text, const std::string& origin
     }
     if (layout.family != "tag36h11") throw Error("family '" + layout.family + "' is not supported (tag36h11 is)");
     if (layout.tags.empty()) throw Error("the layout lists no tag");
+    // The pose solver looks a detection up by id: a second entry with the same id would be
+    // unreachable, and which one is "right" cannot be guessed.
+    std::set<int> ids;
+    for (const auto& tag : layout.tags)
+      if (!ids.insert(tag.id).second) throw Error("tag " + std::to_string(tag.id) + " is listed twice");
     return layout;
   } catch (const nlohmann::json::exception& e) {
     throw Error(origin + ": bad tag layout: " + e.what());

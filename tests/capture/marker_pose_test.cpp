@@ -174,9 +174,14 @@ TEST(TagLayout, ReadsSceneJsonOfTheSyntheticSequence) {
 }
 
 TEST(TagLayout, RejectsBadLayoutsNamingTheOrigin) {
-  for (const char* bad : {"{", "{}", R"({"tags": []})", R"({"tags": [{"id": 1, "size": 0.1, "corners_world": [[0,0,0]]}]})",
-                          R"({"family": "tag16h5", "tags": [{"id": 1, "size": 0.1,
-                              "corners_world": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}]})"}) {
+  for (const char* bad :
+       {"{", "{}", R"({"tags": []})", R"({"tags": [{"id": 1, "size": 0.1, "corners_world": [[0,0,0]]}]})",
+        R"({"family": "tag16h5", "tags": [{"id": 1, "size": 0.1,
+                              "corners_world": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}]})",
+        // the same id twice: the solver could reach only one of them
+        R"({"tags": [{"id": 7, "size": 0.1, "corners_world": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]},
+                                       {"id": 7, "size": 0.1, "corners_world": [[2,0,0],[3,0,0],[3,1,0],[2,1,0]]}]})",
+        R"({"tags": [{"id": 1, "size": 1e999, "corners_world": [[0,0,0],[1,0,0],[1,1,0],[0,1,0]]}]})"}) {
     try {
       (void)parse_tag_layout(bad, "layout.json");
       ADD_FAILURE() << "accepted " << bad;
