@@ -210,7 +210,8 @@ class RelightDevice final : public oni::driver::DeviceBase {
 
  private:
   void run(const std::stop_token& stop);
-  bool wait_for_streams(const std::stop_token& stop, std::vector<RelightStream*>& targets);
+  /// Waits until a stream is started; `sizes` gets the resolutions the started streams want.
+  bool wait_for_streams(const std::stop_token& stop, std::vector<Resolution>& sizes);
 
   RelightDriver& driver_;
   OniDeviceInfo info_;
@@ -467,10 +468,16 @@ void RelightStream::emit(const ProducedFrame& produced) {
 
 // ---- RelightDevice frame thread ----
 
-bool RelightDevice::wait_for_streams(const std::stop_token& stop, std::vector<RelightStream*>& targets) {
+bool RelightDevice::wait_for_streams(const std::stop_token& stop, std::vector<Resolution>& sizes) {
   std::unique_lock lock(state_mutex_);
   if (!wake_.wait(lock, stop, [this] { return !started_.empty(); })) return false;
-  targets = started_;
+  // The sizes are read while state_mutex_ is held: a client that stops and destroys a stream
+  // (destroyStream) waits in stream_stopped() for it, so no stream is freed under us. Reading them
+  // after the lock was released read a destroyed stream's mutex (ThreadSanitizer found it).
+  sizes.clear();
+  for (const RelightStream* stream : started_) {
+    if (std::find(sizes.begin(), sizes.end(), stream->size()) == sizes.end()) sizes.push_back(stream->size());
+  }
   return true;
 }
 
@@ -479,13 +486,9 @@ void RelightDevice::run(const std::stop_token& stop) {
   std::int64_t anchor_index = -1;  // -1: streaming (re)starts, anchor the clock at the next frame
   Clock::time_point anchor_time;
   const auto period = std::chrono::microseconds(std::llround(1e6 / uri_.fps));
-  std::vector<RelightStream*> targets;
+  std::vector<Resolution> sizes;
   while (!stop.stop_requested()) {
-    if (!wait_for_streams(stop, targets)) return;
-    std::vector<Resolution> sizes;
-    for (RelightStream* stream : targets) {
-      if (std::find(sizes.begin(), sizes.end(), stream->size()) == sizes.end()) sizes.push_back(stream->size());
-    }
+    if (!wait_for_streams(stop, sizes)) return;
     std::vector<ProducedFrame> frames;
     try {
       for (const Resolution& size : sizes) frames.push_back(producer_->produce(index, size));
