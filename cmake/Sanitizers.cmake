@@ -21,3 +21,12 @@ endif()
 add_library(relight_keep_libraries_loaded OBJECT ${CMAKE_CURRENT_LIST_DIR}/../sanitizers/keep_libraries_loaded.cpp)
 # Shared libraries call dlclose() through the executable's definition only if it is exported.
 target_link_options(relight_keep_libraries_loaded INTERFACE "LINKER:--export-dynamic-symbol=dlclose")
+
+# ThreadSanitizer reads its suppressions and options from the program itself
+# (sanitizers/tsan_default_options.cpp), so that gtest's test discovery at build time and the CLI
+# under the app tests apply them as ctest does.
+if(RELIGHT_SANITIZE MATCHES "thread")
+  target_sources(relight_keep_libraries_loaded PRIVATE ${CMAKE_CURRENT_LIST_DIR}/../sanitizers/tsan_default_options.cpp)
+  target_compile_definitions(relight_keep_libraries_loaded
+    PRIVATE RELIGHT_TSAN_SUPPRESSIONS="${PROJECT_SOURCE_DIR}/sanitizers/tsan.supp")
+endif()

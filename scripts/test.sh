@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Installs what is missing, checks the format and clang-tidy of the last commit's changes, builds
-# (optimised, with assertions) and runs every test CI runs, then compiles the Release+tests
-# combination, runs the unit tests of six labels under AddressSanitizer + UndefinedBehaviorSanitizer
-# and a short run of every fuzz target.
+# (optimised, with assertions) and runs every test CI runs, then runs the unit tests of six labels
+# under AddressSanitizer + UndefinedBehaviorSanitizer, the tests that start threads under
+# ThreadSanitizer, a short run of every fuzz target, and compiles the Release+tests combination.
 # Usage: scripts/test.sh [extra ctest arguments for the main suite, e.g. -L core]
-# RELIGHT_ASAN=0 skips the sanitizer stage, RELIGHT_FUZZ_SECONDS=0 the fuzzing stage,
+# RELIGHT_ASAN=0 skips the sanitizer stage, RELIGHT_TSAN=0 the thread sanitizer stage,
+# RELIGHT_FUZZ_SECONDS=0 the fuzzing stage,
 # RELIGHT_RELEASE_BUILD=0 the Release+tests build, RELIGHT_LINT=0 the format and tidy checks.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
@@ -45,6 +46,30 @@ if [ "${RELIGHT_ASAN:-1}" != 0 ]; then
   # sanitizers/lsan.supp names. It is too slow for the rest (lavapipe allocates a lot).
   ASAN_OPTIONS=fast_unwind_on_malloc=0 ctest --preset asan --parallel "$(nproc)" --timeout 900 -L "$asan_labels" -R 'OpenNi'
   echo "sanitizer stage: $((SECONDS - start)) s"
+fi
+
+# ThreadSanitizer (the tsan preset, build/tsan; suppressions with their reasons in
+# sanitizers/tsan.supp, read by the programs themselves): the tests whose code runs on several
+# threads - the worker pool of the parallel loops, the write queue, the frame graph, the prefetching
+# source, the OpenNI2 driver's frame thread and live capture from the synthetic device, method 2's
+# banded warp and the other row-parallel reconstruct, brdf, colormap and synth stages, K-means, the
+# path tracer, DIR on the CPU and caustic photons. Left out: the Vulkan twins (lavapipe's own
+# threads, and 10-50 times slower), OpenNiDriver.ShortLoopRuns... (it measures the frame rate, which
+# the sanitizer's slowdown breaks) and TemporalSmoothingStageTest (minutes of DIR frames; the
+# smoothing's parallel rows are checked by TemporalSmoothing.ParallelRowsGiveTheSerialResult).
+if [ "${RELIGHT_TSAN:-1}" != 0 ]; then
+  tsan_tests=(relight_core_tests relight_capture_tests relight_reconstruct_tests relight_brdf_tests
+              relight_synth_tests relight_colormap_tests render_tests)
+  tsan_filter='ParallelRows|WorkerPool|WriteQueue|FrameGraph|PrefetchSource|OpenNi|SourceStage|DepthWarpMerge'
+  tsan_filter+='|HierarchicalWarp|NormalsRawDepth|NormalsFromPositions|DepthWarp|KMeans\.|Highlight|Diffuse'
+  tsan_filter+='|BrdfPreview|LightEstimation|Raycast|KinectNoise|CameraBlur|StatisticsTransfer\.|CameraLook'
+  tsan_filter+='|DifferentialPathTracer|DirCpu|TemporalSmoothing|DirCaustics|EdgeCoverage|SpecularGBuffer'
+  start=$SECONDS
+  cmake --preset tsan >/dev/null
+  cmake --build --preset tsan --parallel "$(nproc)" --target "${tsan_tests[@]}"
+  ctest --preset tsan --parallel "$(nproc)" --timeout 900 -LE soak -R "$tsan_filter" \
+    -E 'Vk|Vulkan|OpenNiDriver\.ShortLoopRunsAtTheFrameRateOnceRendered|TemporalSmoothingStageTest'
+  echo "thread sanitizer stage: $((SECONDS - start)) s"
 fi
 
 # Fuzzing: a short run of every libFuzzer target (scripts/fuzz.sh, build/fuzz); longer runs by

@@ -4,15 +4,13 @@
 #include <limits>
 #include <map>
 
-#include <oneapi/tbb/blocked_range.h>
-#include <oneapi/tbb/parallel_for.h>
-#include <oneapi/tbb/task_arena.h>
-
+#include "kmeans_step_kernel.h"
 #include "relight/brdf/brdf_shared.h"
 #include "relight/brdf/kmeans.h"
+#include "relight/core/cpu_dispatch.h"
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
-#include "kmeans_step_kernel.h"
+#include "relight/core/worker_pool.h"
 
 namespace relight::brdf {
 
@@ -44,11 +42,6 @@ void ClusterSums::update(std::vector<Eigen::Vector3f>& centres) const {
                                  static_cast<float>(static_cast<double>(c.sum[2]) * scale));
   }
 }
-
-struct KMeansCpu::Arena {
-  explicit Arena(int threads) : arena(threads) {}
-  tbb::task_arena arena;
-};
 
 KMeansCpu::KMeansCpu(int threads, KMeansCpuKernel kernel) : threads_(threads), kernel_(kernel) {}
 KMeansCpu::~KMeansCpu() = default;
@@ -82,9 +75,10 @@ ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres) {
     soa.y[k] = centres[k].y();
     soa.z[k] = centres[k].z();
   }
-  // TBB rather than parallel_rows(): its workers stay alive between the 20-100 steps of a run,
-  // and a chunk that no worker has taken yet runs on the calling thread instead of waiting for a
-  // helper thread to be scheduled (on a loaded machine that wait cost more than the step).
+  // A pool kept by the engine rather than parallel_rows()'s per call: its workers stay alive
+  // between the 20-100 steps of a run, and a chunk that no worker has taken yet runs on the
+  // calling thread instead of waiting for a helper thread to be scheduled (on a loaded machine
+  // that wait cost more than the step).
   const auto run_chunks = [&](int begin, int end) {
     for (int chunk = begin; chunk < end; ++chunk) {
       const std::size_t first = static_cast<std::size_t>(chunk) * kChunk;
@@ -97,11 +91,8 @@ ClusterSums KMeansCpu::step(std::span<const Eigen::Vector3f> centres) {
   if (worker_count(threads_) <= 1 || chunks <= 1) {
     run_chunks(0, static_cast<int>(chunks));
   } else {
-    if (!arena_) arena_ = std::make_unique<Arena>(worker_count(threads_));
-    arena_->arena.execute([&] {
-      tbb::parallel_for(tbb::blocked_range<int>(0, static_cast<int>(chunks), 1),
-                        [&](const tbb::blocked_range<int>& range) { run_chunks(range.begin(), range.end()); });
-    });
+    if (!pool_) pool_ = std::make_unique<WorkerPool>(threads_);
+    pool_->for_ranges(static_cast<int>(chunks), run_chunks, 1);
   }
   ClusterSums total;
   total.clusters.resize(k_count);
@@ -149,9 +140,9 @@ struct SeedPoints {
 
 /// nearest[i] = min(previous[i], |point i - centre|^2) (nearest may alias previous); returns the
 /// sum (the k-means++ potential). Eight running sums, so that the sum vectorises too.
-__attribute__((target_clones("avx2", "default"))) double nearest_squared_distances(
-    const float* x, const float* y, const float* z, std::size_t n, float cx, float cy, float cz,
-    const float* previous, float* nearest) {
+RELIGHT_AVX2_CLONES double nearest_squared_distances(const float* x, const float* y, const float* z, std::size_t n,
+                                                     float cx, float cy, float cz, const float* previous,
+                                                     float* nearest) {
   for (std::size_t i = 0; i < n; ++i) {
     const float dx = x[i] - cx, dy = y[i] - cy, dz = z[i] - cz;
     nearest[i] = std::min(previous[i], dx * dx + dy * dy + dz * dz);

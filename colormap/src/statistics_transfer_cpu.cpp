@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "relight/colormap/statistics_transfer.h"
+#include "relight/core/cpu_dispatch.h"
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
 
@@ -267,10 +268,8 @@ struct RowAccumulator {
 /// The passes over one row. Also built for AVX2, picked at load time where the CPU has it;
 /// "avx2" does not enable FMA, so both versions round alike. Returns whether the row has pixels
 /// with L_rv != L_r.
-__attribute__((target_clones("avx2", "default"))) VirtualSpan row_sums(std::span<const Float3> real,
-                                                                       std::span<const Float3> real_virtual,
-                                                                       std::span<const Rgb8> camera, const ToneMap& tm,
-                                                                       LabSums& sums) {
+RELIGHT_AVX2_CLONES VirtualSpan row_sums(std::span<const Float3> real, std::span<const Float3> real_virtual,
+                                         std::span<const Rgb8> camera, const ToneMap& tm, LabSums& sums) {
   const Srgb8Table& decode = srgb8_table();
   RowAccumulator accumulator;
   PixelBlock block;
@@ -335,9 +334,8 @@ LabSums reduce_rows(const RadianceImage& real, const RadianceImage& real_virtual
 
 /// delta_L on pixels [begin, end) of a row, in blocks: tau_st(L_rv) - tau_st(L_r), exactly 0 where
 /// L_rv == L_r. Built for AVX2 as well, like row_sums.
-__attribute__((target_clones("avx2", "default"))) void delta_span(const Float3* real, const Float3* real_virtual,
-                                                                  Float3* delta, int count,
-                                                                  const ReinhardTransfer& transfer, const ToneMap& tm) {
+RELIGHT_AVX2_CLONES void delta_span(const Float3* real, const Float3* real_virtual, Float3* delta, int count,
+                                    const ReinhardTransfer& transfer, const ToneMap& tm) {
   PixelBlock block;
   for (int begin = 0; begin < count; begin += kBlock) {
     const int n = std::min(kBlock, count - begin);

@@ -1,4 +1,5 @@
 #include "relight/core/parallel.h"
+#include "relight/core/worker_pool.h"
 
 #include <gtest/gtest.h>
 
@@ -44,6 +45,51 @@ TEST(ParallelRows, EmptyRangeDoesNothingAndForEachRowVisitsRows) {
   for (int i = 0; i < 10; ++i) EXPECT_EQ(rows[static_cast<std::size_t>(i)], i + 1);
   EXPECT_GE(worker_count(0), 1);
   EXPECT_EQ(worker_count(3), 3);
+}
+
+TEST(WorkerPool, ReusedPoolCoversEveryIndexOnceAndSumsAgreeWithTheSerialLoop) {
+  WorkerPool pool(3);
+  EXPECT_EQ(pool.threads(), 3);
+  for (int call = 0; call < 20; ++call) {
+    const int count = 1000 + call * 37;
+    std::vector<long> per_chunk_sums(static_cast<std::size_t>(count), 0);
+    std::vector<std::atomic<int>> visits(static_cast<std::size_t>(count));
+    pool.for_ranges(
+        count,
+        [&](int begin, int end) {
+          for (int i = begin; i < end; ++i) {
+            ++visits[static_cast<std::size_t>(i)];
+            per_chunk_sums[static_cast<std::size_t>(i)] = static_cast<long>(i) * i;  // each index writes its own slot
+          }
+        },
+        64);
+    long total = 0;
+    for (int i = 0; i < count; ++i) {
+      ASSERT_EQ(visits[static_cast<std::size_t>(i)].load(), 1) << "call " << call << ", index " << i;
+      total += per_chunk_sums[static_cast<std::size_t>(i)];
+    }
+    const long n = count - 1;
+    EXPECT_EQ(total, n * (n + 1) * (2 * n + 1) / 6);
+  }
+}
+
+TEST(WorkerPool, RethrowsTheFirstFailureAndStaysUsable) {
+  WorkerPool pool(2);
+  EXPECT_THROW(pool.for_ranges(
+                   40,
+                   [](int begin, int) {
+                     if (begin == 30) throw std::runtime_error("chunk failed");
+                   },
+                   10),
+               std::runtime_error);
+  int calls = 0;
+  pool.for_ranges(
+      0, [&](int, int) { ++calls; }, 1);
+  EXPECT_EQ(calls, 0);
+  std::atomic<int> covered{0};
+  pool.for_ranges(
+      17, [&](int begin, int end) { covered += end - begin; }, 4);
+  EXPECT_EQ(covered.load(), 17);
 }
 
 }  // namespace

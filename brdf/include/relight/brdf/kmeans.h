@@ -26,6 +26,7 @@
 
 #include "relight/brdf/brdf_shared.h"
 #include "relight/core/pixel.h"
+#include "relight/core/worker_pool.h"
 
 namespace relight::brdf {
 
@@ -88,7 +89,7 @@ enum class KMeansCpuKernel {
   Portable,  ///< plain C++ (for CPUs without AVX2, and to test the two against each other)
 };
 
-/// The CPU engine: points split into chunks of 8192 over TBB workers, each assigned and summed
+/// The CPU engine: points split into chunks of 8192 over a WorkerPool, each assigned and summed
 /// eight at a time with AVX2 where the CPU has it (a portable loop otherwise), integer sums per
 /// chunk added up.
 class KMeansCpu final : public KMeansEngine {
@@ -103,10 +104,9 @@ class KMeansCpu final : public KMeansEngine {
   void read_labels(std::vector<std::uint8_t>& labels) override { labels = labels_; }
 
  private:
-  struct Arena;  // the TBB task arena of `threads_` workers (kept out of this header)
   int threads_;
   KMeansCpuKernel kernel_;
-  std::unique_ptr<Arena> arena_;
+  std::unique_ptr<WorkerPool> pool_;         // of `threads_` workers, made on the first parallel step
   std::size_t active_ = 0;                   // points that step() works on
   std::vector<float> xs_, ys_, zs_;  // points, structure of arrays
   std::vector<std::uint8_t> labels_;

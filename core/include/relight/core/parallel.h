@@ -1,5 +1,6 @@
 #pragma once
-// Row-parallel loops for per-pixel CPU stages and the synthetic renderer, on TBB's thread pool:
+// Row-parallel loops for per-pixel CPU stages and the synthetic renderer, on a WorkerPool (TBB's
+// thread pool, worker_pool.h):
 // chunks of `grain` rows are scheduled by work stealing, so uneven rows (a ray caster's sky
 // against its table) balance across threads. The result must not depend on the schedule: each
 // row (or chunk) writes only its own outputs.
