@@ -1,7 +1,12 @@
 // Robustness matrix, a replay in progress: Ctrl-C in the middle of a TUM folder (with and without
 // rendering) finalises the outputs and exits 130 with one line; an AprilTag layout none of whose
-// tags is in view runs to the end with one warning and no marker pose.
+// tags is in view runs to the end with one warning and no marker pose; a disk that fills up is
+// one line naming the file, exit 1, and what was written before it intact.
 #include <gtest/gtest.h>
+#include <sys/mount.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <nlohmann/json.hpp>
 
@@ -84,6 +89,43 @@ TEST(ReplayRunRobustness, MalformedTagLayout) {
   expect_clean_error(run_relight({"replay", "--quiet", "--cpu", (kData / "tum_fr1_rpy").string(), "--markers",
                                   layout.string(), "--out", out.string()}),
                      1, layout.string(), out);
+}
+
+// A 1 MiB tmpfs mounted over the output folder by the test itself (root only; a machine where it
+// cannot mount skips the row and says why): the first frame's PNGs fit, the second frame's do not.
+class TmpfsMount {
+ public:
+  TmpfsMount(const std::filesystem::path& at, const char* options) : at_(at) {
+    mounted_ = ::mount("tmpfs", at.c_str(), "tmpfs", 0, options) == 0;
+    if (!mounted_) why_not_ = std::strerror(errno);
+  }
+  ~TmpfsMount() {
+    if (mounted_) (void)::umount2(at_.c_str(), MNT_DETACH);
+  }
+  TmpfsMount(const TmpfsMount&) = delete;
+  TmpfsMount& operator=(const TmpfsMount&) = delete;
+  [[nodiscard]] bool mounted() const { return mounted_; }
+  [[nodiscard]] const std::string& why_not() const { return why_not_; }
+
+ private:
+  std::filesystem::path at_;
+  bool mounted_ = false;
+  std::string why_not_;
+};
+
+TEST(ReplayRunRobustness, DiskFullDuringReplay) {
+  test::TempDir dir;
+  const auto out = dir.path() / "out";
+  std::filesystem::create_directories(out);
+  const TmpfsMount small_disk(out, "size=1m");
+  if (!small_disk.mounted()) GTEST_SKIP() << "cannot mount a 1 MiB tmpfs to fill (" << small_disk.why_not() << ")";
+  const auto run = run_relight({"replay", "--quiet", "--cpu", (kData / "tum_fr1_rpy").string(), "--out", out.string()});
+  // one line naming the file that did not fit, exit 1, no temporary or half-written file left
+  expect_clean_error(run, 1, (out / "frames").string(), out);
+  EXPECT_NE(run.err.find("No space left on device"), std::string::npos) << run.err;
+  // the first frame's images, written before the disk filled, are there and read back
+  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000000_color.png"));
+  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000000_depth.png"));
 }
 
 }  // namespace
