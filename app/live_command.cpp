@@ -182,6 +182,17 @@ std::filesystem::path temporary_oni(const std::filesystem::path& out) {
   return out.parent_path() / (out.stem().string() + ".tmp-" + std::to_string(getpid()) + ".oni");
 }
 
+// "; the disk ... is full" when the file system holding `file` has less room left than one more
+// 640x480 frame pair would take, else "".
+std::string full_disk_cause(const std::filesystem::path& file) {
+  constexpr std::uintmax_t kFramePairBytes = std::uintmax_t{640} * 480 * 5;  // 16-bit depth + RGB
+  std::error_code ec;
+  const std::filesystem::space_info space =
+      std::filesystem::space(file.parent_path().empty() ? "." : file.parent_path(), ec);
+  if (ec || space.available >= kFramePairBytes) return "";
+  return "; the disk holding it is full (" + std::to_string(space.available) + " bytes free)";
+}
+
 // Every frame read after the recorder started must be in the file, at its device time. Played
 // back, the file's timestamps count from its first frame, which may be one frame older than the
 // first we read (it can come in while the recorder starts): try both alignments.
@@ -193,6 +204,8 @@ std::string check_recording(const capture::OniRecordingSummary& summary,
   }
   if (delivered_us.empty()) return "";
   const auto& recorded = summary.depth_timestamps_us;
+  if (recorded.empty())
+    return "none of the " + std::to_string(delivered_us.size()) + " frames delivered is in the recording";
   std::string first_missing;
   for (std::size_t first = 0; first < std::min<std::size_t>(2, recorded.size()); ++first) {
     const std::uint64_t offset = delivered_us.front() - recorded[first];
@@ -259,10 +272,21 @@ int run_record(const RecordOptions& options) {
   std::string held;
   if (to_oni) {
     source.stop_recording();
-    const capture::OniRecordingSummary summary = capture::inspect_oni(temporary);
-    if (const std::string lost = check_recording(summary, delivered_us); !lost.empty()) {
-      std::filesystem::remove(temporary);
-      throw Error(options.out.string() + ": " + lost);
+    // OpenNI2's recorder reports no write error (a full disk truncates the file silently), so the
+    // file is read back; a file that fails the check is removed and the likely cause named.
+    capture::OniRecordingSummary summary;
+    std::string lost;
+    try {
+      summary = capture::inspect_oni(temporary);
+      lost = check_recording(summary, delivered_us);
+    } catch (const Error& e) {
+      lost = e.what();
+    }
+    if (!lost.empty()) {
+      const std::string cause = full_disk_cause(temporary);  // before the removal frees its space
+      std::error_code ignored;
+      std::filesystem::remove(temporary, ignored);
+      throw Error(options.out.string() + ": " + lost + cause);
     }
     std::filesystem::rename(temporary, options.out);
     held = "; the file holds " + std::to_string(summary.depth_frames) + " depth and " +

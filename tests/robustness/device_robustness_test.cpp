@@ -1,6 +1,6 @@
 // Robustness matrix, devices: no Vulkan driver at all (the CPU path, with one warning), relight's
 // OpenNI2 device (relight://synthetic) unplugged mid-stream or stopped with Ctrl-C during live and
-// record, cut or empty .oni recordings.
+// record, cut or empty .oni recordings, a disk that fills up while recording.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -10,6 +10,7 @@
 #include "outcome_checks.h"
 #include "relight/capture/openni_source.h"
 #include "relight/capture/tum_sequence.h"
+#include "tmpfs_mount.h"
 
 namespace relight::robustness {
 namespace {
@@ -133,6 +134,29 @@ TEST(DeviceRobustness, CutOrEmptyRecording) {
                        recording.string(), out);
     EXPECT_FALSE(std::filesystem::exists(out / "report.json"));
   }
+}
+
+// A full disk while recording. OpenNI2's recorder drops what does not fit without an error; the
+// read-back check turns that into one line naming the file and the full disk, and removes the
+// file. A TUM folder's writer fails on the first file that does not fit.
+TEST(DeviceRobustness, DiskFullDuringRecord) {
+  test::TempDir dir;
+  const auto out = dir.path() / "out";
+  std::filesystem::create_directories(out);
+  const TmpfsMount small_disk(out, "size=1m");
+  if (!small_disk.mounted()) GTEST_SKIP() << "cannot mount a 1 MiB tmpfs to fill (" << small_disk.why_not() << ")";
+  const auto oni = out / "recording.oni";
+  const auto to_oni = run_relight({"record", "--quiet", "--device", kDevice, "--frames", "60", "--out", oni.string()});
+  expect_clean_error(to_oni, 1, oni.string(), out);
+  EXPECT_NE(to_oni.err.find("the disk holding it is full"), std::string::npos) << to_oni.err;
+  EXPECT_EQ(to_oni.err.find("frame  of"), std::string::npos) << "a frame number is missing: " << to_oni.err;
+  EXPECT_TRUE(std::filesystem::is_empty(out)) << "the cut recording is removed";
+
+  const auto folder = out / "tum";
+  const auto to_folder =
+      run_relight({"record", "--quiet", "--device", kDevice, "--frames", "60", "--out", folder.string()});
+  expect_clean_error(to_folder, 1, folder.string(), out);
+  EXPECT_NE(to_folder.err.find("No space left on device"), std::string::npos) << to_folder.err;
 }
 
 }  // namespace

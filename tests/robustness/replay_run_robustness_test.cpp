@@ -3,15 +3,12 @@
 // tags is in view runs to the end with one warning and no marker pose; a disk that fills up is
 // one line naming the file, exit 1, and what was written before it intact.
 #include <gtest/gtest.h>
-#include <sys/mount.h>
-
-#include <cerrno>
-#include <cstring>
 
 #include <nlohmann/json.hpp>
 
 #include "inputs.h"
 #include "outcome_checks.h"
+#include "tmpfs_mount.h"
 
 namespace relight::robustness {
 namespace {
@@ -90,28 +87,6 @@ TEST(ReplayRunRobustness, MalformedTagLayout) {
                                   layout.string(), "--out", out.string()}),
                      1, layout.string(), out);
 }
-
-// A 1 MiB tmpfs mounted over the output folder by the test itself (root only; a machine where it
-// cannot mount skips the row and says why): the first frame's PNGs fit, the second frame's do not.
-class TmpfsMount {
- public:
-  TmpfsMount(const std::filesystem::path& at, const char* options) : at_(at) {
-    mounted_ = ::mount("tmpfs", at.c_str(), "tmpfs", 0, options) == 0;
-    if (!mounted_) why_not_ = std::strerror(errno);
-  }
-  ~TmpfsMount() {
-    if (mounted_) (void)::umount2(at_.c_str(), MNT_DETACH);
-  }
-  TmpfsMount(const TmpfsMount&) = delete;
-  TmpfsMount& operator=(const TmpfsMount&) = delete;
-  [[nodiscard]] bool mounted() const { return mounted_; }
-  [[nodiscard]] const std::string& why_not() const { return why_not_; }
-
- private:
-  std::filesystem::path at_;
-  bool mounted_ = false;
-  std::string why_not_;
-};
 
 TEST(ReplayRunRobustness, DiskFullDuringReplay) {
   test::TempDir dir;
