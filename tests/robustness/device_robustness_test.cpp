@@ -142,9 +142,8 @@ TEST(DeviceRobustness, CutOrEmptyRecording) {
 TEST(DeviceRobustness, DiskFullDuringRecord) {
   test::TempDir dir;
   const auto out = dir.path() / "out";
-  std::filesystem::create_directories(out);
-  const TmpfsMount small_disk(out, "size=1m");
-  if (!small_disk.mounted()) GTEST_SKIP() << "cannot mount a 1 MiB tmpfs to fill (" << small_disk.why_not() << ")";
+  const TmpfsMount small_disk(out, "1m");
+  if (!small_disk.mounted()) GTEST_SKIP() << small_disk.why_not();
   const auto oni = out / "recording.oni";
   const auto to_oni = run_relight({"record", "--quiet", "--device", kDevice, "--frames", "60", "--out", oni.string()});
   expect_clean_error(to_oni, 1, oni.string(), out);

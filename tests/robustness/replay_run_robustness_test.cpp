@@ -91,9 +91,8 @@ TEST(ReplayRunRobustness, MalformedTagLayout) {
 TEST(ReplayRunRobustness, DiskFullDuringReplay) {
   test::TempDir dir;
   const auto out = dir.path() / "out";
-  std::filesystem::create_directories(out);
-  const TmpfsMount small_disk(out, "size=1m");
-  if (!small_disk.mounted()) GTEST_SKIP() << "cannot mount a 1 MiB tmpfs to fill (" << small_disk.why_not() << ")";
+  const TmpfsMount small_disk(out, "1m");
+  if (!small_disk.mounted()) GTEST_SKIP() << small_disk.why_not();
   const auto run = run_relight({"replay", "--quiet", "--cpu", (kData / "tum_fr1_rpy").string(), "--out", out.string()});
   // one line naming the file that did not fit, exit 1, no temporary or half-written file left
   expect_clean_error(run, 1, (out / "frames").string(), out);

@@ -13,9 +13,11 @@ namespace relight::robustness {
 
 class TmpfsMount {
  public:
-  TmpfsMount(const std::filesystem::path& at, const char* options) : at_(at) {
-    mounted_ = ::mount("tmpfs", at.c_str(), "tmpfs", 0, options) == 0;
-    if (!mounted_) why_not_ = std::strerror(errno);
+  /// Makes the folder `at` and mounts a tmpfs of `size` (mount(8)'s size=, e.g. "1m") over it.
+  TmpfsMount(const std::filesystem::path& at, const std::string& size) : at_(at) {
+    std::filesystem::create_directories(at);
+    mounted_ = ::mount("tmpfs", at.c_str(), "tmpfs", 0, ("size=" + size).c_str()) == 0;
+    if (!mounted_) why_not_ = "cannot mount a " + size + " tmpfs to fill (" + std::strerror(errno) + ")";
   }
   ~TmpfsMount() {
     if (mounted_) (void)::umount2(at_.c_str(), MNT_DETACH);
@@ -23,6 +25,7 @@ class TmpfsMount {
   TmpfsMount(const TmpfsMount&) = delete;
   TmpfsMount& operator=(const TmpfsMount&) = delete;
   [[nodiscard]] bool mounted() const { return mounted_; }
+  /// Why the mount failed: the row's skip message.
   [[nodiscard]] const std::string& why_not() const { return why_not_; }
 
  private:
