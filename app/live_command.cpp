@@ -4,11 +4,13 @@
 // live runs the replay frame graph (build_replay_pipeline) on a device; record writes what a
 // device sends to a .oni file (openni::Recorder) or a TUM folder. Both stop after --frames N,
 // on Ctrl-C (outputs finalised, device closed, exit 0) or when the device goes away (outputs
-// finalised, then a one-line error, exit 1).
+// finalised, then a one-line error, exit 1); live with --reconnect-timeout S first waits up to
+// S seconds for the device to be plugged back and goes on (report.json lists the reconnects).
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <iostream>
@@ -17,6 +19,7 @@
 
 #include "camera_trajectory_stage.h"
 #include "commands.h"
+#include "device_loss.h"
 #include "interrupt.h"
 #include "live_view.h"
 #include "option_values.h"
@@ -57,6 +60,8 @@ class LiveStatus {
     if (drawn_) std::fputc('\n', stderr);
     drawn_ = false;
   }
+  /// Counts the frame rate from now (the device and the pipeline are set up).
+  void restart() { start_ = Clock::now(); }
 
  private:
   std::string label_;
@@ -94,6 +99,7 @@ class StoppableSource final : public capture::FrameSource {
 struct LiveOptions {
   std::string device;  ///< OpenNI2 URI; empty = first device
   std::int64_t frames = 0;
+  double reconnect_timeout_s = 0.0;  ///< how long to wait for an unplugged device; 0 = fail at once
   ReplayOptions replay;
 };
 
@@ -106,8 +112,17 @@ int run_devices() {
 
 int run_live(const LiveOptions& options) {
   InterruptGuard interrupt;
+  const bool quiet = options.replay.quiet;
+  LiveStatus status("live", quiet);
   capture::OpenNiOptions device_options;
   device_options.uri = options.device;
+  device_options.reconnect_timeout = std::chrono::milliseconds(std::llround(options.reconnect_timeout_s * 1000.0));
+  device_options.stop_waiting = [] { return InterruptGuard::interrupted(); };
+  device_options.on_notice = [&status, quiet](const std::string& line) {
+    if (quiet) return;  // the report lists the reconnects
+    status.finish();
+    std::cerr << "relight live: " << line << "\n";
+  };
   auto device = std::make_unique<capture::OpenNiSource>(device_options);
   if (device->is_file()) throw Error(options.device + " is a recording: use relight replay for .oni files");
   const std::filesystem::path device_scene = device->scene_folder();
@@ -130,18 +145,21 @@ int run_live(const LiveOptions& options) {
   FrameGraph& graph = *pipeline.graph;
   graph.compile();
   write_file_atomically(options.replay.out / "graph.dot", graph.to_dot());
-  const bool quiet = options.replay.quiet;
   if (!quiet) std::cerr << "relight live: " << description << "; " << pipeline.compute << "; Ctrl-C stops\n";
 
-  LiveStatus status("live", quiet);
+  status.restart();
   const auto start = Clock::now();
   std::string failure;
+  DeviceLossHook device_loss(pipeline.vulkan.get());
   try {
-    while (graph.run_frame()) {
+    while (true) {
+      device_loss.before_frame(graph.frames_run());
+      if (!graph.run_frame()) break;
       status.update(graph.frames_run(), stoppable.device().dropped(), pipeline.trajectory->last());
     }
   } catch (const Error& e) {
-    failure = e.what();  // e.g. the device was unplugged: keep what was processed, then report it
+    // e.g. the device was unplugged or the GPU lost: keep what was processed, then report it
+    failure = device_loss_message(e, graph.frames_run()).value_or(e.what());
   }
   status.finish();
   graph.finish();
@@ -152,6 +170,12 @@ int run_live(const LiveOptions& options) {
   report["source"] = description;
   report["compute"] = pipeline.compute;
   report["dropped_frames"] = dropped;
+  const auto& reconnects = stoppable.device().reconnects();
+  report["reconnects"] = nlohmann::json::array();
+  for (const capture::DeviceReconnect& reconnect : reconnects) {
+    report["reconnects"].push_back(
+        {{"after_frames", reconnect.after_frames}, {"seconds_away", reconnect.seconds_away}});
+  }
   const bool quit_from_view = pipeline.view && pipeline.view->quit_requested();
   report["stopped_by"] = !failure.empty()                ? "error: " + failure
                          : InterruptGuard::interrupted() ? "interrupt"
@@ -162,7 +186,11 @@ int run_live(const LiveOptions& options) {
   if (!quiet) {
     std::cerr << "relight live: " << graph.frames_run() << " frames in " << seconds << " s ("
               << (seconds > 0 ? static_cast<double>(graph.frames_run()) / seconds : 0.0) << " fps), " << dropped
-              << " dropped" << (InterruptGuard::interrupted() ? ", interrupted" : "") << "; results in "
+              << " dropped"
+              << (reconnects.empty() ? ""
+                                     : ", device back " + std::to_string(reconnects.size()) +
+                                           (reconnects.size() == 1 ? " time" : " times") + " after an unplug")
+              << (InterruptGuard::interrupted() ? ", interrupted" : "") << "; results in "
               << options.replay.out.string() << "\n";
   }
   if (!failure.empty()) throw Error(failure);
@@ -328,6 +356,11 @@ void register_live(CLI::App& app, Runners& runners) {
                    "default: the first device");
   live->add_option("--frames", live_options->frames, "Stop after N frames (default: until Ctrl-C)")
       ->check(CLI::NonNegativeNumber);
+  live->add_option("--reconnect-timeout", live_options->reconnect_timeout_s,
+                   "Seconds to wait for an unplugged device to come back (the same URI reopened every 0.1 s; "
+                   "the run goes on and says so); 0: an unplug ends the run with an error")
+      ->check(CLI::Range(0.0, 86400.0))
+      ->capture_default_str();
   live->add_option("--out", live_options->replay.out, "Output folder")->required();
   live->add_flag("--quiet", live_options->replay.quiet, "No progress or summary on stderr");
   live->add_flag("!--no-frames", live_options->replay.write_frames, "Do not write per-frame images");

@@ -10,6 +10,7 @@
 #include "as_rendered_composite_stage.h"
 #include "camera_trajectory_stage.h"
 #include "constant_stage.h"
+#include "device_loss.h"
 #include "frame_range.h"
 #include "frame_writer_stage.h"
 #include "interrupt.h"
@@ -449,9 +450,18 @@ int run_replay(const ReplayOptions& options) {
   // Device memory allocations after the first two frames (a steady run should need none: every
   // stage keeps its device buffers, the graph double-buffers history).
   std::uint64_t allocations_at_frame_2 = 0;
-  while (!InterruptGuard::interrupted() && !view_quit() && graph.run_frame()) {
-    progress.update(graph.frames_run());
-    if (pipeline.vulkan && graph.frames_run() == 2) allocations_at_frame_2 = pipeline.vulkan->memory_allocations();
+  DeviceLossHook device_loss(pipeline.vulkan.get());
+  std::optional<std::string> failure;  // a lost Vulkan device: finalised like an end, then an error
+  try {
+    while (!InterruptGuard::interrupted() && !view_quit()) {
+      device_loss.before_frame(graph.frames_run());
+      if (!graph.run_frame()) break;
+      progress.update(graph.frames_run());
+      if (pipeline.vulkan && graph.frames_run() == 2) allocations_at_frame_2 = pipeline.vulkan->memory_allocations();
+    }
+  } catch (const Error& e) {
+    failure = device_loss_message(e, graph.frames_run());
+    if (!failure) throw;
   }
   progress.finish();
   graph.finish();
@@ -462,7 +472,7 @@ int run_replay(const ReplayOptions& options) {
   auto report = timing_report(graph, seconds);
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
-  report["stopped_by"] = interrupted ? "interrupt" : quit_from_view ? "view" : "end";
+  report["stopped_by"] = failure ? "error: " + *failure : interrupted ? "interrupt" : quit_from_view ? "view" : "end";
   if (pipeline.vulkan) {
     const std::uint64_t allocations = pipeline.vulkan->memory_allocations();
     report["device_memory"] = {
@@ -471,6 +481,7 @@ int run_replay(const ReplayOptions& options) {
   }
   add_pipeline_summaries(report, pipeline, options);
   write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
+  if (failure) throw Error(*failure);
   if (interrupted) {
     // Not a failure of the input, but the run did not cover it: 128 + SIGINT, as shells report it.
     std::cerr << "relight: warning: replay interrupted after " << graph.frames_run() << " of " << total

@@ -47,6 +47,9 @@ void apply(DeviceUri& device, std::string_view uri, const std::string& key, cons
   } else if (key == "disconnect_after") {
     device.disconnect_after = parse_number<std::int64_t>(uri, key, value);
     if (device.disconnect_after < 0) fail("is negative");
+  } else if (key == "reconnect_after") {
+    device.reconnect_after = parse_number<std::int64_t>(uri, key, value);
+    if (device.reconnect_after < 0 || device.reconnect_after > 1000000) fail("is outside [0, 1000000]");
   } else if (key == "seed") {
     device.seed = parse_number<std::uint64_t>(uri, key, value);
   } else if (key == "trajectory") {
@@ -66,7 +69,7 @@ void apply(DeviceUri& device, std::string_view uri, const std::string& key, cons
     if (device.width <= 0 || device.height <= 0) fail("is not a positive size");
   } else {
     throw Error("device URI " + std::string(uri) + ": unknown option '" + key +
-                "' (fps, disconnect_after, seed, trajectory, loop, noise, size)");
+                "' (fps, disconnect_after, reconnect_after, seed, trajectory, loop, noise, size)");
   }
 }
 
@@ -91,6 +94,9 @@ DeviceUri parse_device_uri(std::string_view uri) {
     throw Error("device URI " + std::string(uri) + ": expected relight://synthetic or relight://tum/<folder>");
   }
   for (const auto& [key, value] : parse_query(uri, query)) apply(device, uri, key, value);
+  if (device.reconnect_after > 0 && device.disconnect_after == 0) {
+    throw Error("device URI " + std::string(uri) + ": reconnect_after needs disconnect_after");
+  }
   return device;
 }
 

@@ -8,7 +8,13 @@
 // Keys (all optional):
 //   fps=30                 frame rate and timestamp spacing (synthetic; TUM uses its timestamps)
 //   disconnect_after=N     after N frames the device reports itself disconnected (an unplugged
-//                          camera, for testing clients); 0 = never
+//                          camera, for testing clients); 0 = never. Counted per connection: a
+//                          device opened again (or plugged back) disconnects after N more
+//   reconnect_after=M      with disconnect_after: M frame periods (M / fps seconds) after the
+//                          disconnect the device is plugged back (announced again; opening it
+//                          fails until then) and, opened again, goes on at frame N + M with
+//                          its timestamps, as a camera that was away while the scene went on;
+//                          0 = it stays away until opened again (the default)
 //   seed=0                 synth seed (handheld trajectory, noise)
 //   trajectory=orbit       static | orbit | handheld
 //   loop=540               synthetic trajectory length before it repeats (540 frames = one orbit);
@@ -30,6 +36,7 @@ struct DeviceUri {
   std::filesystem::path folder;  ///< Tum
   double fps = 30.0;
   std::int64_t disconnect_after = 0;
+  std::int64_t reconnect_after = 0;
   std::uint64_t seed = 0;
   std::string trajectory = "orbit";
   int loop = 540;

@@ -11,20 +11,28 @@
 // Device::open); instead a short synthetic loop (loop=N, up to 256 MB) is cached as it is first
 // rendered, so from the second pass on the device runs at its frame rate (frame_producer.cpp).
 //
-// Disconnect: with disconnect_after=N the thread stops after N frames and reports the device
-// disconnected (the OpenNI2 core then fires OpenNI::DeviceDisconnectedListener), as an unplugged
-// camera would.
+// Disconnect: with disconnect_after=N the thread stops after N frames of a connection and reports
+// the device disconnected (the OpenNI2 core then fires OpenNI::DeviceDisconnectedListener), as an
+// unplugged camera would. With reconnect_after=M the same thread then waits M frame periods and
+// announces the device again (the core fires DeviceConnectedListener and makes a fresh device
+// object, as for a camera plugged back in); opened again, it resumes at frame N + M, so the
+// timestamps say how long the camera was away. The countdown belongs to the unplugged device
+// object: closing its handle before the device is back stops it (clients keep the old handle
+// until the new one opens, as OpenNiSource does). Not a timer thread of the driver's own: OpenNI2's
+// shutdown holds the core's lock while it destroys the driver and announcing takes that lock, so
+// joining such a thread in shutdown deadlocks when a plug-back falls due meanwhile (it did).
 #include <OniCProperties.h>
 #include <OniCTypes.h>
 #include <Driver/OniDriverAPI.h>
 
 #include <algorithm>
 #include <atomic>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <cstring>
 #include <exception>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <set>
@@ -110,8 +118,10 @@ class RelightDriver;
 
 class RelightDevice final : public oni::driver::DeviceBase {
  public:
-  RelightDevice(RelightDriver& driver, OniDeviceInfo info, DeviceUri uri, std::unique_ptr<FrameProducer> producer)
-      : driver_(driver), info_(info), uri_(std::move(uri)), producer_(std::move(producer)) {
+  /// `first_index`: the frame the device starts at (0, or where a reconnected device resumes).
+  RelightDevice(RelightDriver& driver, OniDeviceInfo info, DeviceUri uri, std::unique_ptr<FrameProducer> producer,
+                std::int64_t first_index)
+      : driver_(driver), info_(info), uri_(std::move(uri)), producer_(std::move(producer)), first_index_(first_index) {
     for (const auto& size : producer_->resolutions()) {
       depth_modes_.push_back({ONI_PIXEL_FORMAT_DEPTH_1_MM, size.width, size.height, static_cast<int>(std::lround(uri_.fps))});
       color_modes_.push_back({ONI_PIXEL_FORMAT_RGB888, size.width, size.height, static_cast<int>(std::lround(uri_.fps))});
@@ -217,6 +227,7 @@ class RelightDevice final : public oni::driver::DeviceBase {
   OniDeviceInfo info_;
   DeviceUri uri_;
   std::unique_ptr<FrameProducer> producer_;
+  std::int64_t first_index_;
   std::vector<OniVideoMode> depth_modes_, color_modes_;
   OniSensorInfo sensors_[2]{};
   std::atomic<OniImageRegistrationMode> registration_{ONI_IMAGE_REGISTRATION_OFF};
@@ -264,7 +275,10 @@ class RelightDriver final : public oni::driver::DriverBase {
       auto producer = make_producer(parsed);
       const OniDeviceInfo info = device_info(parsed, producer->name());
       std::lock_guard lock(mutex_);
-      devices_.push_back(std::make_unique<RelightDevice>(*this, info, std::move(parsed), std::move(producer)));
+      const auto resume = resume_index_.find(parsed.text);
+      const std::int64_t first_index = resume == resume_index_.end() ? 0 : resume->second;
+      devices_.push_back(
+          std::make_unique<RelightDevice>(*this, info, std::move(parsed), std::move(producer), first_index));
       return devices_.back().get();
     } catch (const std::exception& e) {
       getServices().errorLoggerAppend("%s", e.what());
@@ -298,12 +312,23 @@ class RelightDriver final : public oni::driver::DriverBase {
     std::erase_if(sync_groups_, [group](const auto& g) { return g.get() == group; });
   }
 
+  /// Called on a device's frame thread when it stops.
   void disconnected(const OniDeviceInfo& info) {
     {
       std::lock_guard lock(mutex_);
       announced_.erase(info.uri);
     }
     deviceDisconnected(&info);
+  }
+
+  /// Called on an unplugged device's frame thread when it comes back: the next open of `uri`
+  /// starts at `next_index`.
+  void plugged_back(const DeviceUri& uri, const std::string& name, std::int64_t next_index) {
+    {
+      std::lock_guard lock(mutex_);
+      resume_index_[uri.text] = next_index;
+    }
+    announce(uri, name);
   }
   void log_error(const std::string& message) { getServices().errorLoggerAppend("%s", message.c_str()); }
 
@@ -329,6 +354,7 @@ class RelightDriver final : public oni::driver::DriverBase {
   std::vector<std::unique_ptr<RelightDevice>> devices_;
   std::vector<std::unique_ptr<int>> sync_groups_;
   std::set<std::string> announced_;
+  std::map<std::string, std::int64_t> resume_index_;  // where a plugged-back device goes on
 };
 
 // ---- RelightStream ----
@@ -482,7 +508,7 @@ bool RelightDevice::wait_for_streams(const std::stop_token& stop, std::vector<Re
 }
 
 void RelightDevice::run(const std::stop_token& stop) {
-  std::int64_t index = 0;
+  std::int64_t index = first_index_;
   std::int64_t anchor_index = -1;  // -1: streaming (re)starts, anchor the clock at the next frame
   Clock::time_point anchor_time;
   const auto period = std::chrono::microseconds(std::llround(1e6 / uri_.fps));
@@ -532,8 +558,16 @@ void RelightDevice::run(const std::stop_token& stop) {
       }
     }
     ++index;
-    if (uri_.disconnect_after > 0 && index >= uri_.disconnect_after) {
+    if (uri_.disconnect_after > 0 && index - first_index_ >= uri_.disconnect_after) {
       driver_.disconnected(info_);
+      if (uri_.reconnect_after > 0) {
+        const auto away =
+            std::chrono::microseconds(std::llround(1e6 * static_cast<double>(uri_.reconnect_after) / uri_.fps));
+        std::unique_lock lock(state_mutex_);
+        if (wake_.wait_for(lock, stop, away, [] { return false; }); stop.stop_requested()) return;  // closed meanwhile
+        lock.unlock();
+        driver_.plugged_back(uri_, info_.name, index + uri_.reconnect_after);
+      }
       return;
     }
   }

@@ -6,8 +6,11 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
+#include <thread>
+#include <utility>
 
 #include "relight/capture/depth_millimetres.h"
 #include "relight/capture/relight_device.h"
@@ -82,6 +85,14 @@ class DisconnectWatch final : public openni::OpenNI::DeviceDisconnectedListener 
 };
 
 constexpr int kWaitSliceMs = 100;
+
+std::string frames_text(std::int64_t count) { return std::to_string(count) + (count == 1 ? " frame" : " frames"); }
+
+std::string one_decimal(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f", value);
+  return text;
+}
 
 bool is_oni_file(const std::string& uri) {
   const std::filesystem::path path(uri);
@@ -219,7 +230,7 @@ struct OpenNiSource::Impl {
   OpenNiOptions options;
   bool file = false;
   std::shared_ptr<OpenNiRuntime> runtime;  // first member: destroyed last, after the device
-  Device device;
+  std::unique_ptr<Device> device = std::make_unique<Device>();  // replaced on a reconnect
   std::unique_ptr<DisconnectWatch> watch;
   Stream depth, color;
   openni::Recorder recorder;
@@ -236,8 +247,26 @@ struct OpenNiSource::Impl {
   std::optional<double> host_minus_device;
   int last_depth_index = -1;
   std::optional<openni::VideoFrameRef> pending_depth, pending_color;
+  std::vector<DeviceReconnect> reconnects;
+  /// Added to the device's timestamps: 0 unless a device came back with its clock restarted.
+  std::int64_t timestamp_offset_us = 0;
+  std::uint64_t last_output_timestamp_us = 0;
+  /// Host time of the last frame next() returned.
+  std::chrono::steady_clock::time_point last_frame_time;
+  /// Set by reconnect() to last_frame_time: the next frame completes the reconnect.
+  std::optional<std::chrono::steady_clock::time_point> unplugged_since;
 
   void open();
+  /// Opens the device, its streams and modes (everything but the intrinsics and the start).
+  void connect(const std::string& target);
+  void start_streams();
+  void close_streams();
+  /// Waits for an unplugged device to come back and starts it again; false when stop_waiting
+  /// said stop. Throws when it is not back within the reconnect timeout.
+  bool reconnect();
+  void notice(const std::string& line) const {
+    if (options.on_notice) options.on_notice(line);
+  }
   [[nodiscard]] RgbdFrame convert(const openni::VideoFrameRef& depth_frame, const openni::VideoFrameRef& color_frame);
   void note_depth_index(int index) {
     if (last_depth_index >= 0 && index > last_depth_index + 1) dropped += index - last_depth_index - 1;
@@ -248,26 +277,46 @@ struct OpenNiSource::Impl {
 void OpenNiSource::Impl::open() {
   file = is_oni_file(options.uri);
   runtime = OpenNiRuntime::acquire();
-  open_device(device, options.uri, file);
-  uri = device.device.getDeviceInfo().getUri();
-  name = device.device.getDeviceInfo().getName();
+  connect(options.uri);
+  const openni::VideoMode depth_mode = depth.stream.getVideoMode();
+  if (depth_mode.getFps() > 0) half_period_us = static_cast<std::uint64_t>(500000 / depth_mode.getFps());
+  const int width = depth_mode.getResolutionX(), height = depth_mode.getResolutionY();
+  if (options.intrinsics) {
+    intrinsics = *options.intrinsics;
+  } else {
+    const double hfov = depth.stream.getHorizontalFieldOfView(), vfov = depth.stream.getVerticalFieldOfView();
+    if (!(hfov > 0.0 && vfov > 0.0)) throw Error(uri + ": the depth stream reports no field of view");
+    intrinsics = {width / (2.0 * std::tan(hfov / 2.0)),
+                  height / (2.0 * std::tan(vfov / 2.0)),
+                  (width - 1) / 2.0,
+                  (height - 1) / 2.0,
+                  width,
+                  height};
+  }
+  start_streams();
+}
+
+void OpenNiSource::Impl::connect(const std::string& target) {
+  open_device(*device, target, file);
+  uri = device->device.getDeviceInfo().getUri();
+  name = device->device.getDeviceInfo().getName();
   watch = std::make_unique<DisconnectWatch>(uri);
-  create_stream(depth, device, openni::SENSOR_DEPTH, "depth", uri);
-  create_stream(color, device, openni::SENSOR_COLOR, "colour", uri);
+  create_stream(depth, *device, openni::SENSOR_DEPTH, "depth", uri);
+  create_stream(color, *device, openni::SENSOR_COLOR, "colour", uri);
   if (file) {
     // Sequential reads only (seek crashes in OpenNI2 2.2); speed -1: as fast as we read, no repeat.
-    openni::PlaybackControl* playback = device.device.getPlaybackControl();
+    openni::PlaybackControl* playback = device->device.getPlaybackControl();
     if (playback == nullptr) throw Error(uri + " did not open as a recording");
     playback->setRepeatEnabled(false);
     playback->setSpeed(-1.0f);
     total = playback->getNumberOfFrames(depth.stream);
   } else {
-    if (device.device.isImageRegistrationModeSupported(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR)) {
-      device.device.setImageRegistrationMode(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR);
+    if (device->device.isImageRegistrationModeSupported(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR)) {
+      device->device.setImageRegistrationMode(openni::IMAGE_REGISTRATION_DEPTH_TO_COLOR);
     }
-    device.device.setDepthColorSyncEnabled(true);  // best effort: pairing below works without it
+    device->device.setDepthColorSyncEnabled(true);  // best effort: pairing below works without it
+    choose_modes(*device, depth.stream, color.stream);
   }
-  if (!file) choose_modes(device, depth.stream, color.stream);
   const openni::VideoMode depth_mode = depth.stream.getVideoMode(), color_mode = color.stream.getVideoMode();
   if (depth_mode.getPixelFormat() != openni::PIXEL_FORMAT_DEPTH_1_MM) {
     throw Error(uri + ": depth stream is not in millimetres (pixel format " +
@@ -282,18 +331,67 @@ void OpenNiSource::Impl::open() {
                 std::to_string(depth_mode.getResolutionY()) + " and colour " + std::to_string(color_mode.getResolutionX()) +
                 "x" + std::to_string(color_mode.getResolutionY()) + " differ; relight needs registered images of one size");
   }
-  if (depth_mode.getFps() > 0) half_period_us = static_cast<std::uint64_t>(500000 / depth_mode.getFps());
-  const int width = depth_mode.getResolutionX(), height = depth_mode.getResolutionY();
-  if (options.intrinsics) {
-    intrinsics = *options.intrinsics;
-  } else {
-    const double hfov = depth.stream.getHorizontalFieldOfView(), vfov = depth.stream.getVerticalFieldOfView();
-    if (!(hfov > 0.0 && vfov > 0.0)) throw Error(uri + ": the depth stream reports no field of view");
-    intrinsics = {width / (2.0 * std::tan(hfov / 2.0)), height / (2.0 * std::tan(vfov / 2.0)), (width - 1) / 2.0,
-                  (height - 1) / 2.0, width, height};
+}
+
+void OpenNiSource::Impl::close_streams() {
+  for (Stream* stream : {&depth, &color}) {
+    if (stream->stream.isValid()) {
+      stream->stream.stop();
+      stream->stream.destroy();
+    }
   }
+  watch.reset();
+}
+
+void OpenNiSource::Impl::start_streams() {
   if (depth.stream.start() != openni::STATUS_OK) throw Error("cannot start the depth stream of " + uri + ": " + extended_error());
   if (color.stream.start() != openni::STATUS_OK) throw Error("cannot start the colour stream of " + uri + ": " + extended_error());
+}
+
+bool OpenNiSource::Impl::reconnect() {
+  using Clock = std::chrono::steady_clock;
+  const auto since = Clock::now();
+  const std::string gone = "OpenNI2 device " + uri + " disconnected after " + frames_text(delivered);
+  const std::string timeout = one_decimal(static_cast<double>(options.reconnect_timeout.count()) / 1000.0) + " s";
+  notice(gone + "; waiting up to " + timeout + " for it to come back");
+  // The old connection's streams go first: they belong to a device OpenNI2 has dropped (a device
+  // plugged back is a new device object in OpenNI2's core).
+  pending_depth.reset();
+  pending_color.reset();
+  close_streams();
+  // The old handle stays open until the device is back: a real device does not care, and relight's
+  // own device counts down to its return on the unplugged device object (openni_driver/driver.cpp).
+  const std::unique_ptr<Device> unplugged = std::exchange(device, std::make_unique<Device>());
+  const std::string target = options.uri.empty() ? std::string() : uri;
+  const int width = intrinsics.width, height = intrinsics.height;
+  while (true) {
+    if (options.stop_waiting && options.stop_waiting()) return false;
+    try {
+      connect(target);
+      break;
+    } catch (const Error&) {
+      // Not back yet (or back but not usable yet): try again until the timeout.
+      close_streams();
+      if (device->device.isValid()) device->device.close();
+    }
+    if (Clock::now() - since >= options.reconnect_timeout) {
+      std::string message = gone;
+      throw Error(message.append(" and did not come back within ").append(timeout));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(kWaitSliceMs));
+  }
+  const openni::VideoMode mode = depth.stream.getVideoMode();
+  if (mode.getResolutionX() != width || mode.getResolutionY() != height) {
+    throw Error(gone + " and came back with " + std::to_string(mode.getResolutionX()) + "x" +
+                std::to_string(mode.getResolutionY()) + " frames instead of " + std::to_string(width) + "x" +
+                std::to_string(height));
+  }
+  start_streams();
+  last_depth_index = -1;  // frame indices of the new connection: the time away is not "dropped"
+  host_minus_device.reset();
+  unplugged_since = last_frame_time;
+  reconnects.push_back({delivered, 0.0});
+  return true;
 }
 
 RgbdFrame OpenNiSource::Impl::convert(const openni::VideoFrameRef& depth_frame, const openni::VideoFrameRef& color_frame) {
@@ -317,11 +415,29 @@ RgbdFrame OpenNiSource::Impl::convert(const openni::VideoFrameRef& depth_frame, 
     }
   }
   frame.info.index = delivered++;
-  frame.info.timestamp = static_cast<double>(depth_frame.getTimestamp()) * 1e-6;
+  const std::uint64_t device_us = depth_frame.getTimestamp();
+  const auto now_host = std::chrono::steady_clock::now();
+  if (unplugged_since) {
+    // The first frame after a reconnect: a device whose clock restarted would send time backwards
+    // (tracking, smoothing and the report assume it runs forwards), so its clock is moved to go
+    // on from the last frame plus the time away. relight's own device keeps its clock.
+    const double away = std::chrono::duration<double>(now_host - *unplugged_since).count();
+    reconnects.back().seconds_away = away;
+    if (static_cast<std::int64_t>(device_us) + timestamp_offset_us <=
+        static_cast<std::int64_t>(last_output_timestamp_us)) {
+      timestamp_offset_us = static_cast<std::int64_t>(last_output_timestamp_us) + std::llround(away * 1e6) -
+                            static_cast<std::int64_t>(device_us);
+    }
+    unplugged_since.reset();
+    notice("OpenNI2 device " + uri + " is back after " + one_decimal(away) + " s; going on");
+  }
+  last_frame_time = now_host;
+  last_output_timestamp_us = static_cast<std::uint64_t>(static_cast<std::int64_t>(device_us) + timestamp_offset_us);
+  frame.info.timestamp = static_cast<double>(last_output_timestamp_us) * 1e-6;
   frame.info.intrinsics = intrinsics;
-  last_timestamp_us = depth_frame.getTimestamp();
+  last_timestamp_us = device_us;
   if (!file) {
-    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    const double now = std::chrono::duration<double>(now_host.time_since_epoch()).count();
     const double offset = now - frame.info.timestamp;
     if (!host_minus_device || offset < *host_minus_device) host_minus_device = offset;
     frame.info.capture_time = frame.info.timestamp + *host_minus_device;
@@ -378,7 +494,13 @@ std::optional<RgbdFrame> OpenNiSource::next() {
         return std::nullopt;
       }
       if (s.watch->disconnected()) {
-        throw Error("OpenNI2 device " + s.uri + " disconnected after " + std::to_string(s.delivered) + " frames");
+        // A .oni recording cannot follow the device to a new connection: the recorder holds the
+        // old streams.
+        if (s.options.reconnect_timeout.count() > 0 && !s.recorder.isValid()) {
+          if (!s.reconnect()) return std::nullopt;
+          continue;
+        }
+        throw Error("OpenNI2 device " + s.uri + " disconnected after " + frames_text(s.delivered));
       }
       throw Error("OpenNI2 device " + s.uri + " sent no frame for " + std::to_string(timeout) + " ms (after " +
                   std::to_string(s.delivered) + " frames)");
@@ -413,9 +535,10 @@ bool OpenNiSource::is_file() const { return impl_->file; }
 const std::string& OpenNiSource::uri() const { return impl_->uri; }
 std::int64_t OpenNiSource::dropped() const { return impl_->dropped; }
 std::uint64_t OpenNiSource::last_timestamp_us() const { return impl_->last_timestamp_us; }
+const std::vector<DeviceReconnect>& OpenNiSource::reconnects() const { return impl_->reconnects; }
 
 std::filesystem::path OpenNiSource::scene_folder() const {
-  openni::Device& device = impl_->device.device;
+  openni::Device& device = impl_->device->device;
   if (impl_->file || !device.isPropertySupported(kRelightDeviceSceneFolderProperty)) return {};
   std::vector<char> text(4096, '\0');
   int size = static_cast<int>(text.size());

@@ -234,9 +234,84 @@ TEST(OpenNiDriver, DisconnectIsAClearErrorAndNoHang) {
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
 }
 
+// Unplugged after 3 frames and plugged back 6 frame periods (0.2 s) later: the source waits,
+// opens the device again and goes on at the device's frame 9, with its timestamps and frames.
+TEST(OpenNiDriver, DeviceThatComesBackIsReopenedAndReadingGoesOn) {
+  OpenNiOptions options;
+  options.uri = "relight://synthetic?size=320x240&disconnect_after=3&reconnect_after=6";
+  options.reconnect_timeout = std::chrono::milliseconds(10000);
+  std::vector<std::string> notices;
+  options.on_notice = [&notices](const std::string& line) { notices.push_back(line); };
+  OpenNiSource source(options);
+  std::vector<RgbdFrame> frames;
+  while (frames.size() < 6) {
+    auto frame = source.next();
+    ASSERT_TRUE(frame) << "the stream ended after " << frames.size() << " frames";
+    frames.push_back(std::move(*frame));
+  }
+  ASSERT_EQ(source.reconnects().size(), 1u);
+  const DeviceReconnect& reconnect = source.reconnects().front();
+  // The OpenNI2 core may drop the frame in flight when the device goes (DeviceUnpluggedDuringLive).
+  ASSERT_GE(reconnect.after_frames, 2);
+  ASSERT_LE(reconnect.after_frames, 3);
+  EXPECT_GE(reconnect.seconds_away, 0.15);  // 0.2 s less the delivery delay of the last frame
+  EXPECT_LT(reconnect.seconds_away, 5.0);
+  ASSERT_EQ(notices.size(), 2u);
+  EXPECT_NE(notices[0].find("disconnected after " + std::to_string(reconnect.after_frames) + " frame"),
+            std::string::npos)
+      << notices[0];
+  EXPECT_NE(notices[0].find("; waiting up to 10.0 s"), std::string::npos) << notices[0];
+  EXPECT_NE(notices[1].find("is back after"), std::string::npos) << notices[1];
+  const auto after = static_cast<std::size_t>(reconnect.after_frames);
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    const std::int64_t k = synthetic_index(static_cast<std::uint64_t>(std::llround(frames[i].info.timestamp * 1e6)));
+    EXPECT_EQ(k, i < after ? static_cast<std::int64_t>(i) : 9 + static_cast<std::int64_t>(i - after)) << i;
+    EXPECT_EQ(frames[i].info.index, static_cast<std::int64_t>(i));
+    EXPECT_EQ(to_mm(frames[i].depth), expected_depth_mm(k, 320, 240)) << i;
+  }
+  EXPECT_EQ(source.dropped(), 0);  // the time away is not dropped frames
+}
+
+TEST(OpenNiDriver, DeviceThatStaysAwayFailsAfterTheReconnectTimeout) {
+  OpenNiOptions options;
+  options.uri = "relight://synthetic?size=320x240&disconnect_after=2&reconnect_after=3000";  // back after 100 s
+  options.reconnect_timeout = std::chrono::milliseconds(500);
+  OpenNiSource source(options);
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    while (source.next()) {
+    }
+    FAIL() << "the stream ended without an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("did not come back within 0.5 s"), std::string::npos) << e.what();
+  }
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+  EXPECT_TRUE(source.reconnects().empty());
+}
+
+// Ctrl-C while waiting: the stream ends as at the end of a recording, no error.
+TEST(OpenNiDriver, WaitForADeviceStopsWhenAsked) {
+  OpenNiOptions options;
+  options.uri = "relight://synthetic?size=320x240&disconnect_after=2&reconnect_after=3000";
+  options.reconnect_timeout = std::chrono::milliseconds(60000);
+  bool waiting = false;
+  options.on_notice = [&waiting](const std::string&) { waiting = true; };
+  const auto start = std::chrono::steady_clock::now();
+  options.stop_waiting = [&] {
+    return waiting && std::chrono::steady_clock::now() - start > std::chrono::milliseconds(300);
+  };
+  OpenNiSource source(options);
+  int frames = 0;
+  while (source.next()) ++frames;
+  EXPECT_TRUE(waiting);
+  EXPECT_GE(frames, 1);
+  EXPECT_LE(frames, 2);
+  EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+}
+
 TEST(OpenNiDriver, BadUrisAreClearErrors) {
   for (const std::string uri : {"relight://nothing", "relight://synthetic?fps=0", "relight://synthetic?colour=red",
-                                "relight://tum//no/such/folder"}) {
+                                "relight://tum//no/such/folder", "relight://synthetic?reconnect_after=5"}) {
     OpenNiOptions options;
     options.uri = uri;
     try {

@@ -252,6 +252,7 @@ void full_barrier(VkCommandBuffer cmd, VkPipelineStageFlags destination_stages, 
 }  // namespace
 
 void VulkanContext::submit(const std::function<void(VkCommandBuffer)>& record) {
+  if (device_lost_) throw_vulkan_error(VK_ERROR_DEVICE_LOST, "vkQueueSubmit", __FILE__, __LINE__);
   VkCommandBufferAllocateInfo allocate{};
   allocate.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
   allocate.commandPool = command_pool_.get();
@@ -275,8 +276,10 @@ void VulkanContext::submit(const std::function<void(VkCommandBuffer)>& record) {
   submit_info.commandBufferCount = 1;
   submit_info.pCommandBuffers = &raw;
   VkFence fence = fence_.get();
-  RELIGHT_VK_CHECK(vkQueueSubmit(compute_queue_, 1, &submit_info, fence));
-  RELIGHT_VK_CHECK(vkWaitForFences(device_.get(), 1, &fence, VK_TRUE, kSubmitTimeoutNs));
+  VkResult result = vkQueueSubmit(compute_queue_, 1, &submit_info, fence);
+  if (result == VK_SUCCESS) result = vkWaitForFences(device_.get(), 1, &fence, VK_TRUE, kSubmitTimeoutNs);
+  if (result == VK_ERROR_DEVICE_LOST) device_lost_ = true;
+  if (result != VK_SUCCESS) throw_vulkan_error(result, "vkQueueSubmit/vkWaitForFences", __FILE__, __LINE__);
   RELIGHT_VK_CHECK(vkResetFences(device_.get(), 1, &fence));
 }
 

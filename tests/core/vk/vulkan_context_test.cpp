@@ -116,6 +116,31 @@ TEST_F(VulkanContextTest, ComputePipelineRunsAnEmbeddedShader) {
   EXPECT_THROW((void)pipeline.bind({&input}), LogicError);
 }
 
+// A lost device fails every later submission at once with VK_ERROR_DEVICE_LOST (no wait, no
+// hang), and the context says so; its own context, as the loss is for good.
+TEST_F(VulkanContextTest, ALostDeviceFailsEverySubmissionAtOnce) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(shared);
+  (void)shared;
+  auto context = try_create_vulkan({.validation = Validation::On});
+  ASSERT_NE(context, nullptr);
+  expect_round_trip(*context, 64);
+  EXPECT_FALSE(context->device_lost());
+  context->simulate_device_loss();
+  EXPECT_TRUE(context->device_lost());
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    bool recorded = false;
+    try {
+      context->submit([&](VkCommandBuffer) { recorded = true; });
+      ADD_FAILURE() << "submit() after the loss returned";
+    } catch (const VulkanError& e) {
+      EXPECT_EQ(e.result(), VK_ERROR_DEVICE_LOST);
+      EXPECT_NE(std::string(e.what()).find("VK_ERROR_DEVICE_LOST"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(recorded);  // nothing is recorded for a device that is gone
+  }
+  EXPECT_EQ(context->validation_errors(), 0) << context->validation_log()->summary();
+}
+
 TEST_F(VulkanContextTest, TransferRejectsForeignBuffers) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   struct Foreign final : DeviceBuffer {

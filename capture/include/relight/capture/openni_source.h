@@ -5,8 +5,9 @@
 //
 // Reading follows docs/platform.md: every wait is OpenNI::waitForAnyStream with a
 // timeout (a plain readFrame blocks forever on an unplugged device), a device-disconnected
-// listener turns an unplug into a relight::Error, and .oni files are read sequentially (seek
-// crashes in this OpenNI2 version), their end being the wait timing out.
+// listener turns an unplug into a relight::Error (or, with a reconnect timeout, into a wait for the
+// device to be plugged back, after which reading goes on), and .oni files are read sequentially
+// (seek crashes in this OpenNI2 version), their end being the wait timing out.
 //
 // Depth (1 mm) and colour are opened at their default video modes, with depth-to-colour
 // registration and frame sync where the device supports them; depth and colour are paired by
@@ -14,6 +15,7 @@
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,6 +35,21 @@ struct OpenNiOptions {
   /// Intrinsics of the registered images; default: from the depth stream's field of view with the
   /// principal point at the image centre.
   std::optional<PinholeIntrinsics> intrinsics;
+  /// How long next() waits for a live device that was unplugged to come back: it opens the same
+  /// URI again (the first device, when `uri` is empty) every 100 ms and goes on with the new
+  /// connection's frames. 0: an unplug is an error at once. Not while recording to a .oni file.
+  std::chrono::milliseconds reconnect_timeout{0};
+  /// Asked while waiting for the device to come back: true gives up and ends the stream (next()
+  /// returns nullopt), e.g. on Ctrl-C.
+  std::function<bool()> stop_waiting;
+  /// Told, one line each, when the device is gone and being waited for and when it is back.
+  std::function<void(const std::string&)> on_notice;
+};
+
+/// One unplug that the device came back from.
+struct DeviceReconnect {
+  std::int64_t after_frames = 0;  ///< frames next() had returned when the device went away
+  double seconds_away = 0.0;      ///< from the last frame before the unplug to the first after it
 };
 
 struct OpenNiDeviceInfo {
@@ -78,6 +95,8 @@ class OpenNiSource final : public FrameSource {
   [[nodiscard]] std::int64_t dropped() const;
   /// Device timestamp of the last frame next() returned, microseconds (as OpenNI2 reports it).
   [[nodiscard]] std::uint64_t last_timestamp_us() const;
+  /// The unplugs the device came back from (see OpenNiOptions::reconnect_timeout).
+  [[nodiscard]] const std::vector<DeviceReconnect>& reconnects() const;
   /// The folder with the device scene's scene.json and probe.hdr that relight's own driver
   /// serves (relight_device.h); empty for any other device.
   [[nodiscard]] std::filesystem::path scene_folder() const;

@@ -101,11 +101,20 @@ class VulkanContext {
   /// commands inside one `record` that depend on each other still need their own barriers.
   void submit(const std::function<void(VkCommandBuffer)>& record);
 
+  /// True once a submission returned VK_ERROR_DEVICE_LOST: the device is gone for good (a driver
+  /// reset, a GPU fault, an unplugged eGPU) and every later submit() fails the same way at once.
+  [[nodiscard]] bool device_lost() const { return device_lost_.load(); }
+  /// Test hook for the device-lost fault (the robustness rows, RELIGHT_TEST_DEVICE_LOST_AT_FRAME):
+  /// from now on submit() fails with VK_ERROR_DEVICE_LOST as after a real loss. No driver can be
+  /// made to lose its device on demand, lavapipe least of all.
+  void simulate_device_loss() { device_lost_ = true; }
+
   /// The frame graph's host<->device mover for this context.
   [[nodiscard]] VulkanTransfer& transfer() { return *transfer_; }
 
  private:
   mutable std::atomic<std::uint64_t> memory_allocations_{0};
+  std::atomic<bool> device_lost_{false};
   void create_instance(bool want_validation);
   void pick_physical_device(const std::string& selector);
   void create_device();
