@@ -26,6 +26,8 @@ export RELIGHT_REQUIRE_VULKAN="${RELIGHT_REQUIRE_VULKAN:-1}"
 # RELIGHT_REQUIRE_VALIDATION does the same for the Vulkan validation layer (vulkan-validationlayers).
 export RELIGHT_REQUIRE_VALIDATION="${RELIGHT_REQUIRE_VALIDATION:-1}"
 ctest --test-dir "$root/build/debug" --output-on-failure --parallel "$(nproc)" --timeout 600 -LE soak "$@"
+# The soak label bounded: the record -> replay round trip over 100 live frames instead of 1 000.
+RELIGHT_SOAK_FRAMES="${RELIGHT_SOAK_FRAMES:-100}" ctest --test-dir "$root/build/debug" --output-on-failure --timeout 600 -L soak
 
 # Sanitizers (the asan preset, build/asan; suppressions and options in sanitizers/ and the
 # preset). Only these labels: with ASan + UBSan our numeric code runs 8-30 times slower, and
