@@ -7,6 +7,7 @@
 // on a full pipe; stdin is /dev/null.
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -38,6 +39,7 @@ struct RunOutcome {
   bool timed_out = false;  ///< killed by us after BoundedRun::limit
   bool interrupted = false;  ///< SIGINT was sent
   double seconds = 0;
+  double peak_rss_mb = 0;  ///< the child's peak resident memory (wait4's ru_maxrss)
   std::string out, err;
 };
 
@@ -88,13 +90,14 @@ inline RunOutcome run_relight(const BoundedRun& run) {
   }
   RunOutcome outcome;
   int status = 0;
+  struct rusage usage {};
   for (;;) {
-    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    const pid_t done = ::wait4(pid, &status, WNOHANG, &usage);
     if (done == pid) break;
     if (std::chrono::steady_clock::now() - start > run.limit) {
       ::kill(-pid, SIGKILL);
       ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
+      ::wait4(pid, &status, 0, &usage);
       outcome.timed_out = true;
       break;
     }
@@ -105,6 +108,7 @@ inline RunOutcome run_relight(const BoundedRun& run) {
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   outcome.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  outcome.peak_rss_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;
   if (!outcome.timed_out && WIFEXITED(status)) outcome.exit_code = WEXITSTATUS(status);
   if (!outcome.timed_out && WIFSIGNALED(status)) outcome.signal = WTERMSIG(status);
   outcome.out = read_text_file(out_file);

@@ -82,6 +82,17 @@ inline void loop_sequence(const std::filesystem::path& folder, int frames) {
   }
 }
 
+/// Rewrites a PNG's header to claim `width` x `height` pixels; the data stays as it was (a file of
+/// a few kilobytes claiming gigabytes).
+inline void claim_png_size(const std::filesystem::path& png, std::uint32_t width, std::uint32_t height) {
+  std::string bytes = read_text_file(png);
+  for (int i = 0; i < 4; ++i) {
+    bytes[static_cast<std::size_t>(16 + i)] = static_cast<char>((width >> (24 - 8 * i)) & 0xff);  // IHDR width
+    bytes[static_cast<std::size_t>(20 + i)] = static_cast<char>((height >> (24 - 8 * i)) & 0xff);
+  }
+  write_file_atomically(png, bytes);
+}
+
 /// Keeps the first `fraction` of the file's bytes.
 inline void truncate_file(const std::filesystem::path& file, double fraction) {
   const std::string bytes = read_text_file(file);

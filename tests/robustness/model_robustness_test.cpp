@@ -21,6 +21,7 @@ class ModelRobustness : public ::testing::Test {
     expect_clean_error(run, 1, model.string() + ": ", out);
     EXPECT_NE(run.err.find(reason), std::string::npos) << run.err;
     EXPECT_FALSE(std::filesystem::exists(out / "composite.mp4"));
+    expect_bounded_memory(run);  // e.g. a glTF claiming 2^31 vertices allocates nothing for them
   }
   std::filesystem::path write(const std::string& name, std::string_view text) {
     write_file_atomically(dir.path() / name, text);

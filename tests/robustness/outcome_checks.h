@@ -94,6 +94,16 @@ inline void expect_clean_error(const RunOutcome& run, int exit_code, const std::
   EXPECT_TRUE(unfinished.empty()) << unfinished.front();
 }
 
+/// Peak memory of a run refusing a huge input: a normal replay of the sample peaks at about 320 MB
+/// here (500 MB rendering), a 30 000 x 30 000 image would take 2.7 GB decoded as 8-bit RGB.
+inline constexpr double kBoundedPeakMb = 1024.0;
+
+/// The run stayed within kBoundedPeakMb (the input was refused before anything was allocated for it).
+inline void expect_bounded_memory(const RunOutcome& run) {
+  EXPECT_GT(run.peak_rss_mb, 0.0) << describe(run);
+  EXPECT_LT(run.peak_rss_mb, kBoundedPeakMb) << describe(run);
+}
+
 /// Success with nothing unfinished under `out`.
 inline void expect_clean_success(const RunOutcome& run, const std::filesystem::path& out) {
   expect_no_crash_or_hang(run);

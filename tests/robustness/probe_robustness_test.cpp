@@ -81,6 +81,18 @@ TEST_F(ProbeRobustness, TruncatedHdrProbe) {
   expect_rejected(file, "");
 }
 
+// A probe whose Radiance header claims 30 000 x 30 000 pixels (10.8 GB as float RGB) over a few
+// bytes of data: refused from the header, naming the limit, with memory bounded.
+TEST_F(ProbeRobustness, HdrProbeClaiming30000x30000Pixels) {
+  const auto file = dir.path() / "huge.hdr";
+  write_file_atomically(file,
+                        std::string_view("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 30000 +X 30000\n\x02\x02\x75\x30"));
+  const auto run = lights(file);
+  expect_clean_error(run, 1, file.string() + ": a 30000x30000 ", out);
+  EXPECT_NE(run.err.find("over the limit of"), std::string::npos) << run.err;
+  expect_bounded_memory(run);
+}
+
 // replay --object on a synthetic sequence takes its lights from the sequence's probe.hdr.
 TEST_F(ProbeRobustness, BlackSequenceProbeWhileRendering) {
   const auto sequence = copy_of_synthetic(dir.path() / "seq");

@@ -57,6 +57,17 @@ TEST_F(SequenceRobustness, CorruptDepthPng) {
   expect_clean_error(replay(sequence, out), 1, broken.string(), out);
 }
 
+// A colour PNG of a few kilobytes whose header claims 30 000 x 30 000 pixels is refused from its
+// header, naming the file, its claimed size and the limit, with memory bounded.
+TEST_F(SequenceRobustness, ColourPngClaiming30000x30000Pixels) {
+  const auto sequence = copy_of_sample(dir.path() / "seq");
+  const auto huge = sample_files(sequence, "rgb")[1];
+  claim_png_size(huge, 30000, 30000);
+  const auto run = replay(sequence, out);
+  expect_clean_error(run, 1, huge.string() + ": a 30000x30000 PNG image, over the limit of", out);
+  expect_bounded_memory(run);
+}
+
 TEST_F(SequenceRobustness, NotAPngAtAll) {
   const auto sequence = copy_of_sample(dir.path() / "seq");
   const auto broken = sample_files(sequence, "depth")[0];
