@@ -20,6 +20,7 @@
 #include "camera_trajectory_stage.h"
 #include "commands.h"
 #include "device_loss.h"
+#include "device_memory_watch.h"
 #include "interrupt.h"
 #include "live_view.h"
 #include "option_values.h"
@@ -151,10 +152,12 @@ int run_live(const LiveOptions& options) {
   const auto start = Clock::now();
   std::string failure;
   DeviceLossHook device_loss(pipeline.vulkan.get());
+  DeviceMemoryWatch device_memory(pipeline.vulkan.get());
   try {
     while (true) {
       device_loss.before_frame(graph.frames_run());
       if (!graph.run_frame()) break;
+      device_memory.after_frame(graph.frames_run());
       status.update(graph.frames_run(), stoppable.device().dropped(), pipeline.trajectory->last());
     }
   } catch (const Error& e) {
@@ -170,6 +173,7 @@ int run_live(const LiveOptions& options) {
   report["source"] = description;
   report["compute"] = pipeline.compute;
   report["dropped_frames"] = dropped;
+  device_memory.add_to(report);
   const auto& reconnects = stoppable.device().reconnects();
   report["reconnects"] = nlohmann::json::array();
   for (const capture::DeviceReconnect& reconnect : reconnects) {

@@ -11,6 +11,7 @@
 #include "camera_trajectory_stage.h"
 #include "constant_stage.h"
 #include "device_loss.h"
+#include "device_memory_watch.h"
 #include "frame_range.h"
 #include "frame_writer_stage.h"
 #include "interrupt.h"
@@ -447,9 +448,7 @@ int run_replay(const ReplayOptions& options) {
   ProgressBar progress("replay", total, options.quiet);
   const auto start = std::chrono::steady_clock::now();
   const auto view_quit = [&pipeline] { return pipeline.view && pipeline.view->quit_requested(); };
-  // Device memory allocations after the first two frames (a steady run should need none: every
-  // stage keeps its device buffers, the graph double-buffers history).
-  std::uint64_t allocations_at_frame_2 = 0;
+  DeviceMemoryWatch device_memory(pipeline.vulkan.get());
   DeviceLossHook device_loss(pipeline.vulkan.get());
   std::optional<std::string> failure;  // a lost Vulkan device: finalised like an end, then an error
   try {
@@ -457,7 +456,7 @@ int run_replay(const ReplayOptions& options) {
       device_loss.before_frame(graph.frames_run());
       if (!graph.run_frame()) break;
       progress.update(graph.frames_run());
-      if (pipeline.vulkan && graph.frames_run() == 2) allocations_at_frame_2 = pipeline.vulkan->memory_allocations();
+      device_memory.after_frame(graph.frames_run());
     }
   } catch (const Error& e) {
     failure = device_loss_message(e, graph.frames_run());
@@ -473,12 +472,7 @@ int run_replay(const ReplayOptions& options) {
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
   report["stopped_by"] = failure ? "error: " + *failure : interrupted ? "interrupt" : quit_from_view ? "view" : "end";
-  if (pipeline.vulkan) {
-    const std::uint64_t allocations = pipeline.vulkan->memory_allocations();
-    report["device_memory"] = {
-        {"allocations", allocations},
-        {"allocations_after_frame_2", graph.frames_run() > 2 ? allocations - allocations_at_frame_2 : 0}};
-  }
+  device_memory.add_to(report);
   add_pipeline_summaries(report, pipeline, options);
   write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
   if (failure) throw Error(*failure);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numeric>
 
 #include <sys/resource.h>
@@ -31,6 +32,15 @@ nlohmann::ordered_json timing_report(const FrameGraph& graph, double total_secon
   report["fps"] = total_seconds > 0 ? static_cast<double>(graph.frames_run()) / total_seconds : 0.0;
   rusage usage{};
   if (::getrusage(RUSAGE_SELF, &usage) == 0) report["peak_rss_mb"] = static_cast<double>(usage.ru_maxrss) / 1024.0;
+  // Open at the end of the run (the outputs being written are closed by then): a count that grows
+  // with the run's length is a leak (scripts/soak.sh compares 1 000 and 10 000 frames).
+  std::error_code ec;
+  std::int64_t descriptors = 0;
+  for (auto it = std::filesystem::directory_iterator("/proc/self/fd", ec);
+       !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+    ++descriptors;
+  }
+  if (!ec) report["open_file_descriptors"] = descriptors - 1;  // less the one the listing holds
   report["execution_order"] = graph.execution_order();
   report["culled_stages"] = graph.culled_stages();
   auto& stages = report["stages"] = nlohmann::ordered_json::array();

@@ -100,6 +100,9 @@ TEST(Cli, LoopPlaysTheRangeAgainAndReportsPeakMemory) {
   EXPECT_EQ(report["frames"], 6);
   EXPECT_NE(report["sequence"].get<std::string>().find("played 3 times"), std::string::npos);
   EXPECT_GT(report["peak_rss_mb"].get<double>(), 1.0);
+  // stdin, stdout and stderr at least; the outputs are closed by the end of the run.
+  EXPECT_GE(report["open_file_descriptors"].get<int>(), 3);
+  EXPECT_LT(report["open_file_descriptors"].get<int>(), 64);
   expect_one_line_error(relight("replay --quiet --loop 0 --out " + dir.path().string()), 2);
   // A value outside an option's choices is a usage error, like every other bad choice.
   expect_one_line_error(relight("replay --intrinsics fr9 --out " + dir.path().string()), 2);

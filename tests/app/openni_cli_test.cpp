@@ -103,6 +103,8 @@ TEST(OpenNiCli, LiveTracksTheCameraAndLightsAVirtualDeviceFromTheSceneItServes) 
   EXPECT_EQ(lit_report["tracking"]["source"], "marker+odometry");  // --markers auto: the device's tag
   EXPECT_EQ(lit_report["latency_ms"]["frames"], 1);
   EXPECT_GT(lit_report["latency_ms"]["median_ms"].get<double>(), 0.0);
+  ASSERT_TRUE(lit_report.contains("device_memory")) << lit_report.dump();  // live reports it as replay does
+  EXPECT_GT(lit_report["device_memory"]["allocations"].get<int>(), 0);
   const std::string tum = "relight://tum/" + std::string(RELIGHT_TEST_DATA) + "/tum_fr1_rpy";
   expect_one_line_error(relight("live --quiet --device " + tum + " --frames 1 --object " + model +
                                 " --place 0,0,0.8 --out " + (dir.path() / "tum").string()),
