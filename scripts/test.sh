@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what is missing, checks the format and clang-tidy of the last commit's changes, builds
-# (optimised, with assertions) and runs every test CI runs, then runs the unit tests of six labels
+# (optimised, with assertions) and runs every test CI runs, then runs the unit tests of seven labels
 # under AddressSanitizer + UndefinedBehaviorSanitizer, the tests that start threads under
 # ThreadSanitizer, a short run of every fuzz target, and compiles the Release+tests combination.
 # Usage: scripts/test.sh [extra ctest arguments for the main suite, e.g. -L core]
@@ -30,15 +30,17 @@ ctest --test-dir "$root/build/debug" --output-on-failure --parallel "$(nproc)" -
 RELIGHT_SOAK_FRAMES="${RELIGHT_SOAK_FRAMES:-100}" ctest --test-dir "$root/build/debug" --output-on-failure --timeout 600 -L soak
 
 # Sanitizers (the asan preset, build/asan; suppressions and options in sanitizers/ and the
-# preset). Only these labels: with ASan + UBSan our numeric code runs 8-30 times slower, and
-# reconstruct, render, app (and so pipeline, robustness) would need a second build of nearly
-# everything. Within them, MarkerPose.NoiseFreeSyntheticFrames... is left out: its minutes go to
-# synth's ray caster rendering 640x480 frames, which the synth label already runs under the
-# sanitizers.
+# preset). These labels, reconstruct's SSE2/AVX2 kernels among them (AVX2 where the CPU has it,
+# as here): 64 s for its 50 tests under the sanitizers on two cores. Not in CI: render (all 152
+# tests pass under them, 139 s, but its sanitizer build costs about 10 minutes with a cold cache,
+# which CI's 90 minutes do not hold) and app, pipeline and robustness (a sanitized build of the
+# CLI and minutes of rendering per test). Within them, MarkerPose.NoiseFreeSyntheticFrames... is
+# left out: its minutes go to synth's ray caster rendering 640x480 frames, which the synth label
+# already runs under the sanitizers.
 if [ "${RELIGHT_ASAN:-1}" != 0 ]; then
-  asan_labels='core|capture|synth|colormap|lights|brdf'
+  asan_labels='core|capture|synth|colormap|lights|brdf|reconstruct'
   asan_tests=(relight_core_tests relight_capture_tests relight_synth_tests relight_colormap_tests
-              relight_lights_tests relight_brdf_tests)
+              relight_lights_tests relight_brdf_tests relight_reconstruct_tests)
   start=$SECONDS
   cmake --preset asan >/dev/null
   cmake --build --preset asan --parallel "$(nproc)" --target "${asan_tests[@]}"
