@@ -173,7 +173,7 @@ int run_live(const LiveOptions& options) {
   report["source"] = description;
   report["compute"] = pipeline.compute;
   report["dropped_frames"] = dropped;
-  device_memory.add_to(report);
+  device_memory.add_to(report, graph.frames_run());
   const auto& reconnects = stoppable.device().reconnects();
   report["reconnects"] = nlohmann::json::array();
   for (const capture::DeviceReconnect& reconnect : reconnects) {

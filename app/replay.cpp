@@ -472,7 +472,7 @@ int run_replay(const ReplayOptions& options) {
   report["sequence"] = description;
   report["compute"] = pipeline.compute;
   report["stopped_by"] = failure ? "error: " + *failure : interrupted ? "interrupt" : quit_from_view ? "view" : "end";
-  device_memory.add_to(report);
+  device_memory.add_to(report, graph.frames_run());
   add_pipeline_summaries(report, pipeline, options);
   write_reports(options.out, "relight replay: " + description, graph, report, pipeline.report);
   if (failure) throw Error(*failure);

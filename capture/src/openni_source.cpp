@@ -99,13 +99,14 @@ bool is_oni_file(const std::string& uri) {
   return path.extension() == ".oni" || path.extension() == ".ONI";
 }
 
-// openni::VideoStream, stopped and destroyed on scope exit.
+// openni::VideoStream, stopped and destroyed by close() or on scope exit.
 struct Stream {
   openni::VideoStream stream;
   Stream() = default;
   Stream(const Stream&) = delete;
   Stream& operator=(const Stream&) = delete;
-  ~Stream() {
+  ~Stream() { close(); }
+  void close() {
     if (stream.isValid()) {
       stream.stop();
       stream.destroy();
@@ -113,12 +114,14 @@ struct Stream {
   }
 };
 
+// openni::Device, closed by close() or on scope exit.
 struct Device {
   openni::Device device;
   Device() = default;
   Device(const Device&) = delete;
   Device& operator=(const Device&) = delete;
-  ~Device() {
+  ~Device() { close(); }
+  void close() {
     if (device.isValid()) device.close();
   }
 };
@@ -334,12 +337,8 @@ void OpenNiSource::Impl::connect(const std::string& target) {
 }
 
 void OpenNiSource::Impl::close_streams() {
-  for (Stream* stream : {&depth, &color}) {
-    if (stream->stream.isValid()) {
-      stream->stream.stop();
-      stream->stream.destroy();
-    }
-  }
+  depth.close();
+  color.close();
   watch.reset();
 }
 
@@ -372,7 +371,7 @@ bool OpenNiSource::Impl::reconnect() {
     } catch (const Error&) {
       // Not back yet (or back but not usable yet): try again until the timeout.
       close_streams();
-      if (device->device.isValid()) device->device.close();
+      device->close();
     }
     if (Clock::now() - since >= options.reconnect_timeout) {
       std::string message = gone;

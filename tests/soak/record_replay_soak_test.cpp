@@ -97,6 +97,11 @@ std::int64_t check_frames(const std::vector<RgbdFrame>& frames, const std::vecto
   return missing;
 }
 
+/// `relight record` of `frames` frames from the device into `out` (.oni or folder), with its summary.
+test::CommandResult record(int frames, const std::filesystem::path& out) {
+  return relight("record --device " + kDevice + " --frames " + std::to_string(frames) + " --out " + out.string());
+}
+
 void expect_replay_runs_over(const std::filesystem::path& input, std::size_t frames, const std::filesystem::path& out) {
   const auto replayed = relight("replay --quiet --no-frames --cpu " + input.string() + " --out " + out.string());
   ASSERT_EQ(replayed.exit_code, 0) << replayed.err;
@@ -107,8 +112,7 @@ TEST(RecordReplaySoak, OniRecordingKeepsEveryFrameBitExact) {
   const int n = soak_frames();
   test::TempDir dir;
   const auto oni = dir.path() / "take.oni";
-  const auto recorded =
-      relight("record --device " + kDevice + " --frames " + std::to_string(n) + " --out " + oni.string());
+  const auto recorded = record(n, oni);
   ASSERT_EQ(recorded.exit_code, 0) << recorded.err;
   capture::OpenNiOptions options;
   options.uri = oni.string();
@@ -135,8 +139,7 @@ TEST(RecordReplaySoak, TumFolderKeepsEveryFrameTheReaderGotBitExact) {
   const int n = soak_frames();
   test::TempDir dir;
   const auto folder = dir.path() / "take";
-  const auto recorded =
-      relight("record --device " + kDevice + " --frames " + std::to_string(n) + " --out " + folder.string());
+  const auto recorded = record(n, folder);
   ASSERT_EQ(recorded.exit_code, 0) << recorded.err;
   const capture::TumSequence sequence = capture::TumSequence::open(folder);
   ASSERT_EQ(sequence.size(), static_cast<std::size_t>(n));
