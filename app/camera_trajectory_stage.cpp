@@ -47,6 +47,10 @@ nlohmann::ordered_json CameraTrajectoryStage::summary() const {
   if (!recorded.empty() && recorded.front().pose.source == capture::PoseSource::MarkerOdometry) {
     json["max_marker_correction_cm"] = correction_max_cm;
   }
+  if (!recorded.empty() && recorded.back().pose.keyframes > 0) {  // the odometry's model at the end
+    json["keyframes"] = recorded.back().pose.keyframes;
+    json["keyframe_model_mb"] = recorded.back().pose.keyframe_model_mb;
+  }
   const bool compared =
       !recorded.empty() && recorded.front().pose.source != capture::PoseSource::Sequence && estimate.size() >= 3;
   if (compared) {

@@ -3,7 +3,8 @@
 // DIR/camera_trajectory.txt (TUM format, "timestamp tx ty tz qx qy qz qw", camera-to-world, one
 // line per frame with a pose; held frames repeat the last good pose and are listed in the
 // summary), whatever the pose source. summary() is report.json's "tracking": the source, the
-// frames tracked and held (with why), and, when the sequence has poses of its own and they were
+// frames tracked and held (with why), the odometry's keyframe model at the end (count and MB),
+// and, when the sequence has poses of its own and they were
 // not the source, the absolute trajectory error (after rigid alignment) and relative pose error
 // against them.
 // Reads: "camera_pose" (CameraPose), "source_frame" (FrameInfo: timestamp, the sequence's pose).

@@ -184,6 +184,7 @@ Json odometry_640x480(const bench::Options&) {
   json["rpe_cm"] = mine["rpe_cm"];
   json["lost_frames"] = mine["failed_frames"];
   json["keyframes"] = ours.keyframe_count();
+  json["model_mb"] = static_cast<double>(ours.model_bytes()) / (1024.0 * 1024.0);
   json["frames"] = truth.size();
   json["sequence"] = folder.filename().string();
   json["libraries"] = libraries;

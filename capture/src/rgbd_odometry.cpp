@@ -369,12 +369,23 @@ double condition_of(const Eigen::Matrix<double, 6, 6>& h) {
 
 }  // namespace
 
+/// Keyframes whose derived data (normals, intensity gradients: 20 bytes a pixel at the levels the
+/// alignment reads) is kept; the others rebuild it when they are aligned against again.
+constexpr int kPreparedKeyframes = 8;
+
 struct Keyframe {
   int id = 0;
   Pose camera_to_world = Pose::Identity();
   Pyramid pyramid;
   std::vector<PreparedLevel> prepared;  ///< built when first aligned against, dropped when idle
   std::uint64_t last_used = 0;
+
+  /// The pyramids: what the model budget counts (the derived data is a cache of 8 keyframes).
+  [[nodiscard]] std::size_t pyramid_bytes() const {
+    std::size_t total = 0;
+    for (const Level& level : pyramid) total += (level.depth.capacity() + level.intensity.capacity()) * sizeof(float);
+    return total;
+  }
 };
 
 struct RgbdOdometry::State {
@@ -406,7 +417,7 @@ struct RgbdOdometry::State {
     std::sort(with_prepared.begin(), with_prepared.end(),
               [](const Keyframe* a, const Keyframe* b) { return a->last_used > b->last_used; });
     for (Keyframe* other : with_prepared) {
-      if (++kept > 8) other->prepared.clear();
+      if (++kept > kPreparedKeyframes) other->prepared.clear();
     }
     return key.prepared;
   }
@@ -510,6 +521,12 @@ RgbdOdometry::RgbdOdometry(RgbdOdometry&&) noexcept = default;
 RgbdOdometry& RgbdOdometry::operator=(RgbdOdometry&&) noexcept = default;
 
 std::size_t RgbdOdometry::keyframe_count() const { return state_->keyframes.size(); }
+
+std::size_t RgbdOdometry::model_bytes() const {
+  std::size_t total = 0;
+  for (const Keyframe& key : state_->keyframes) total += key.pyramid_bytes();
+  return total;
+}
 bool RgbdOdometry::started() const { return state_->started; }
 
 void RgbdOdometry::reset(const Pose& pose) {
@@ -544,8 +561,10 @@ OdometryResult RgbdOdometry::track(const DepthMap& depth, const ColorImage& colo
     key.pyramid = std::move(pyramid);
     key.last_used = ++state.clock;
     state.keyframes.push_back(std::move(key));
-    if (static_cast<int>(state.keyframes.size()) > options_.max_keyframes) {
-      auto oldest = std::min_element(state.keyframes.begin(), state.keyframes.end(),
+    const auto budget = static_cast<std::size_t>(std::max(0.f, options_.model_budget_mb) * 1024.f * 1024.f);
+    // The new keyframe stays even when it alone is over the budget (the tracker needs one).
+    while (state.keyframes.size() > 1 && model_bytes() > budget) {
+      auto oldest = std::min_element(state.keyframes.begin(), std::prev(state.keyframes.end()),
                                      [](const Keyframe& a, const Keyframe& b) { return a.last_used < b.last_used; });
       state.keyframes.erase(oldest);
     }

@@ -104,6 +104,35 @@ TEST(RgbdOdometry, TracksTheOrbitAndTheHandheldPathWithKinectNoise) {
   }
 }
 
+// The keyframe model is a byte budget: with room for three 320x240 keyframes (0.8 MB each) the
+// orbit, which makes a keyframe every two frames, keeps at most three and still tracks.
+TEST(RgbdOdometry, TheKeyframeModelStaysWithinItsByteBudget) {
+  PinholeIntrinsics intrinsics;
+  const auto frames = render(synth::Trajectory::Orbit, 24, 3, intrinsics);
+  RgbdOdometryOptions options = options_for_320x240();
+  RgbdOdometry unbounded(options);
+  options.model_budget_mb = 2.6f;
+  RgbdOdometry bounded(options);
+  unbounded.reset(frames.front().truth);
+  bounded.reset(frames.front().truth);
+  std::vector<Pose> estimate, truth;
+  for (const Frame& frame : frames) {
+    (void)unbounded.track(frame.depth, frame.color, intrinsics);
+    const auto result = bounded.track(frame.depth, frame.color, intrinsics);
+    EXPECT_TRUE(result.quality.tracked) << result.quality.failure;
+    EXPECT_LE(bounded.model_bytes(), static_cast<std::size_t>(2.6 * 1024 * 1024));
+    estimate.push_back(result.camera_to_world);
+    truth.push_back(frame.truth);
+  }
+  std::printf("keyframes %zu (%.2f MB) unbounded, %zu (%.2f MB) within 2.6 MB\n", unbounded.keyframe_count(),
+              static_cast<double>(unbounded.model_bytes()) / (1024 * 1024), bounded.keyframe_count(),
+              static_cast<double>(bounded.model_bytes()) / (1024 * 1024));
+  EXPECT_GT(unbounded.keyframe_count(), 5u);  // the budget matters in this run
+  EXPECT_GE(bounded.keyframe_count(), 2u);
+  EXPECT_LE(bounded.keyframe_count(), 3u);
+  EXPECT_LT(100.0 * absolute_trajectory_error(estimate, truth), 1.0);
+}
+
 TEST(RgbdOdometry, ABlankWallIsLostWithinAFrameHeldAndRecoveredFrom) {
   PinholeIntrinsics intrinsics;
   const auto frames = render(synth::Trajectory::Orbit, 12, 3, intrinsics);

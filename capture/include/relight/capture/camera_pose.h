@@ -42,6 +42,8 @@ struct CameraPose {
   // Odometry
   double inlier_ratio = 0;
   int keyframe = -1;
+  int keyframes = 0;             ///< stored in the tracker's model after this frame
+  double keyframe_model_mb = 0;  ///< their memory (RgbdOdometryOptions::model_budget_mb bounds it)
   double correction_cm = 0;  ///< marker+odometry: how far the marker moved the pose this frame
   static constexpr const char* type_name = "CameraPose";
 };

@@ -3,7 +3,7 @@
 // geometric and a photometric term, against the stored keyframes nearest its predicted pose
 // (frame-to-model: up to `model_keyframes` of them at once, in one least-squares problem).
 //
-// Keyframes are kept for the whole run (up to max_keyframes), so a camera that comes back to a
+// Keyframes are kept for the whole run (within model_budget_mb), so a camera that comes back to a
 // view it has seen (the hand-held sweeps of the TUM rpy sequences, a user looking around a
 // table) is tracked against the same references again instead of accumulating frame-to-frame
 // drift. A frame becomes a keyframe when no stored one is within `keyframe_angle_deg` and
@@ -26,9 +26,12 @@
 // prediction (or a given prior).
 //
 // Where it departs from the literature's frame-to-model trackers: no TSDF volume (KinectFusion)
-// is fused and ray-cast; the stored keyframes are the model (depth and intensity pyramids, ~0.65 MB
-// a keyframe at 320x240 as measured in a live run, four times that at 640x480, so up to ~60 and
-// ~250 MB at max_keyframes) instead of a volume, which suits the 2-core machine.
+// is fused and ray-cast; the stored keyframes are the model (depth and intensity pyramids, 8 bytes
+// a pixel over the levels: 0.8 MB a keyframe at 320x240, 3.3 MB at 640x480) instead of a volume,
+// which suits the 2-core machine. The model's memory is a byte budget, not a keyframe count, so
+// that it is bounded the same at every frame size (a count of 96 was 300 MB at 640x480 and would
+// be 1.2 GB at 1280x960); beyond it the least recently used keyframe goes. On top of it, the 8
+// most recently aligned keyframes keep their normals and gradients (20 bytes a pixel more).
 //
 // Failure is a state, not a wild pose (see TrackingQuality): too few inliers, an ill-conditioned
 // system (a blank wall: a point-to-plane system with three free directions and no texture), a
@@ -69,7 +72,9 @@ struct RgbdOdometryOptions {
   /// frame and ATE 1.91 cm, against 22.5 ms and 1.87 cm with all three on every level).
   int coarse_model_keyframes = 1;
   float model_radius_deg = 12.f;       ///< farther keyframes (pose distance, 1 cm = 1 deg) are not
-  int max_keyframes = 96;              ///< the least recently used is dropped beyond this (memory: above)
+  /// The keyframe model's memory; the least recently used keyframes are dropped beyond it. 160 MB:
+  /// ~48 keyframes at 640x480 (the TUM fr1/rpy slice makes 46), ~200 at 320x240.
+  float model_budget_mb = 160.f;
   // Failure detection.
   float min_inlier_ratio = 0.25f;       ///< of the valid pixels at the finest level
   float recovery_min_inlier_ratio = 0.5f;  ///< while lost, a stricter bar for taking a pose again
@@ -125,6 +130,8 @@ class RgbdOdometry {
   void correct(const Pose& pose);
 
   [[nodiscard]] std::size_t keyframe_count() const;
+  /// Bytes the keyframe model holds now (the pyramids, which model_budget_mb bounds).
+  [[nodiscard]] std::size_t model_bytes() const;
   /// A first frame has been placed (since construction or the last reset).
   [[nodiscard]] bool started() const;
   [[nodiscard]] const RgbdOdometryOptions& options() const { return options_; }
