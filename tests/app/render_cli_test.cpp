@@ -112,9 +112,12 @@ TEST(RenderReferenceCli, VirtualLightBrightensOnlyLrv) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const RadianceImage lit_lr = read_radiance(dir.path() / "lit.Lr.exr"), dark_lr = read_radiance(dir.path() / "dark.Lr.exr");
   EXPECT_TRUE(std::equal(lit_lr.pixels().begin(), lit_lr.pixels().end(), dark_lr.pixels().begin())) << "L_r ignores virtual lights";
+  // Named: a range-for over read_radiance(...).pixels() would read the temporary after its end.
+  const RadianceImage dark_image = read_radiance(dir.path() / "dark.exr");
+  const RadianceImage lit_image = read_radiance(dir.path() / "lit.exr");
   double dark = 0.0, lit = 0.0;
-  for (const Float3& p : read_radiance(dir.path() / "dark.exr").pixels()) dark += p.x;
-  for (const Float3& p : read_radiance(dir.path() / "lit.exr").pixels()) lit += p.x;
+  for (const Float3& p : dark_image.pixels()) dark += p.x;
+  for (const Float3& p : lit_image.pixels()) lit += p.x;
   EXPECT_GT(lit, 1.1 * dark);
   expect_one_line_error(relight(common + " --virtual-light 0,0,1.5 --out " + (dir.path() / "x.exr").string()), 1);
 }
