@@ -80,9 +80,9 @@ void LiveView::show(ColorImage picture, std::string overlay) {
   changed_.notify_all();
 }
 
-void LiveView::wait_while_paused() {
+void LiveView::wait_while_paused(const std::function<bool()>& give_up) {
   std::unique_lock lock(mutex_);
-  changed_.wait(lock, [this] { return !paused_ || quit_ || stop_; });
+  changed_.wait(lock, [this, &give_up] { return !paused_ || quit_ || stop_ || give_up(); });
 }
 
 void LiveView::snapshot(const ColorImage& shown) {

@@ -13,6 +13,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <filesystem>
+#include <functional>
 #include <future>
 #include <mutex>
 #include <optional>
@@ -35,8 +36,9 @@ class LiveView {
   /// Hands `picture` to the display with `overlay` (lines separated by '\n') written over its
   /// top-left corner; returns at once. A picture not yet drawn is replaced (counted as skipped).
   void show(ColorImage picture, std::string overlay);
-  /// Blocks while the view is paused (space), until resumed or quit.
-  void wait_while_paused();
+  /// Blocks while the view is paused (space), until resumed, quit or `give_up()` (Ctrl-C: the
+  /// commands' signal flag, which no one notifies; polled at the display loop's 15 ms pace).
+  void wait_while_paused(const std::function<bool()>& give_up);
   [[nodiscard]] bool quit_requested() const { return quit_.load(); }
   [[nodiscard]] bool paused() const { return paused_.load(); }
   /// Pictures the display replaced before drawing them.

@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "interrupt.h"
+
 namespace relight::app {
 
 namespace {
@@ -48,7 +50,7 @@ void ViewStage::run(StageContext& context) {
   if (dropped_) overlay += "\ndropped " + std::to_string(dropped_());
   if (view_.skipped() > 0) overlay += "\nview skipped " + std::to_string(view_.skipped());
   view_.show(std::move(picture), std::move(overlay));
-  view_.wait_while_paused();
+  view_.wait_while_paused([] { return InterruptGuard::interrupted(); });
 }
 
 }  // namespace relight::app

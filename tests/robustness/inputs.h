@@ -64,11 +64,11 @@ inline std::filesystem::path copy_of_synthetic(const std::filesystem::path& fold
   return folder;
 }
 
-/// Rewrites the folder's rgb.txt, depth.txt and groundtruth.txt (when present) to list `frames`
-/// frames at 30 fps that cycle through the images and poses it has: a long sequence, for
-/// interrupting a run in its middle, without more files.
+/// Rewrites the folder's rgb.txt, depth.txt, groundtruth.txt and probe.txt (when present) to list
+/// `frames` frames at 30 fps that cycle through the images, poses and probes it has: a long
+/// sequence, for interrupting a run in its middle, without more files.
 inline void loop_sequence(const std::filesystem::path& folder, int frames) {
-  for (const char* list : {"rgb.txt", "depth.txt", "groundtruth.txt"}) {
+  for (const char* list : {"rgb.txt", "depth.txt", "groundtruth.txt", "probe.txt"}) {
     if (!std::filesystem::exists(folder / list)) continue;
     std::vector<std::string> payloads;  // each entry without its timestamp
     std::istringstream in(read_text_file(folder / list));

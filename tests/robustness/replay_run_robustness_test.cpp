@@ -1,7 +1,8 @@
 // Robustness matrix, a replay in progress: Ctrl-C in the middle of a TUM folder (with and without
-// rendering) finalises the outputs and exits 130 with one line; an AprilTag layout none of whose
-// tags is in view runs to the end with one warning and no marker pose; a disk that fills up is
-// one line naming the file, exit 1, and what was written before it intact.
+// rendering, and with a probe stream and the odometry) finalises the outputs and exits 130 with
+// one line; an AprilTag layout none of whose tags is in view runs to the end with one warning and
+// no marker pose; a disk that fills up is one line naming the file, exit 1, and what was written
+// before it intact.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -56,6 +57,38 @@ TEST(ReplayRunRobustness, CtrlCDuringReplayWithRendering) {
   const auto run = run_relight(replay);
   expect_interrupted_replay(run, out, 200);
   EXPECT_TRUE(std::filesystem::exists(out / "composite.mp4"));
+}
+
+// The stages the tracking and dynamic-light work added - the odometry, the probe stream and the
+// per-frame light extraction - are running when the signal comes.
+TEST(ReplayRunRobustness, CtrlCDuringReplayWithAProbeStreamAndOdometry) {
+  test::TempDir dir;
+  const auto sequence = dir.path() / "seq";
+  std::filesystem::copy(animated_light_sequence(), sequence, std::filesystem::copy_options::recursive);
+  loop_sequence(sequence, 200);
+  const auto out = dir.path() / "out";
+  BoundedRun replay;
+  replay.arguments = {"replay",
+                      "--quiet",
+                      sequence.string(),
+                      "--pose",
+                      "odometry",
+                      "--object",
+                      (kData / "models" / "glossy_pebble.gltf").string(),
+                      "--vpls",
+                      "8",
+                      "--out",
+                      out.string()};
+  replay.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_composite.png"); };
+  const auto run = run_relight(replay);
+  expect_interrupted_replay(run, out, 200);
+  EXPECT_TRUE(std::filesystem::exists(out / "composite.mp4"));
+  const auto report = read_report(out);
+  EXPECT_EQ(report["tracking"]["source"], "odometry") << report["tracking"].dump();
+  EXPECT_GE(report["probe"]["probes_used"].get<int>(), report["frames"].get<int>()) << report["probe"].dump();
+  EXPECT_EQ(report["probe"]["frames_kept_last_probe"], 0) << report["probe"].dump();
+  const auto trajectory = read_text_file(out / "camera_trajectory.txt");
+  EXPECT_EQ(trajectory.back(), '\n') << "camera_trajectory.txt ends in the middle of a line";
 }
 
 TEST(ReplayRunRobustness, TagLayoutWithNoTagInView) {
