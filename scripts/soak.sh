@@ -66,7 +66,9 @@ if [ "$mode" = live ]; then
   short_model=${short_model:-0}
   long_model=${long_model:-0}
 fi
-echo "soak ($mode): peak RSS ${short_mb} MB after 1000 frames, ${long_mb} MB after $long frames" \
+short_frames=$(field "${runs[0]}" frames)
+long_frames=$(field "${runs[1]}" frames)
+echo "soak ($mode): peak RSS ${short_mb} MB after ${short_frames} frames, ${long_mb} MB after ${long_frames} frames" \
   "(keyframe model ${short_model} and ${long_model} MB); open file descriptors ${short_fds} and ${long_fds}"
 status=0
 # Flat: at most 5 % (and 16 MB) above the short run, the keyframe model aside.
