@@ -50,6 +50,7 @@ nlohmann::ordered_json CameraTrajectoryStage::summary() const {
   if (!recorded.empty() && recorded.back().pose.keyframes > 0) {  // the odometry's model at the end
     json["keyframes"] = recorded.back().pose.keyframes;
     json["keyframe_model_mb"] = recorded.back().pose.keyframe_model_mb;
+    json["keyframe_model_budget_mb"] = recorded.back().pose.keyframe_model_budget_mb;
   }
   const bool compared =
       !recorded.empty() && recorded.front().pose.source != capture::PoseSource::Sequence && estimate.size() >= 3;

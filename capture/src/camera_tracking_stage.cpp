@@ -81,6 +81,7 @@ CameraPose CameraTrackingStage::track_odometry(const FrameInfo& frame, const Dep
   out.keyframe = result.quality.keyframe;
   out.keyframes = static_cast<int>(odometry_.keyframe_count());
   out.keyframe_model_mb = static_cast<double>(odometry_.model_bytes()) / (1024.0 * 1024.0);
+  out.keyframe_model_budget_mb = odometry_.options().model_budget_mb;
   out.camera_to_world = result.camera_to_world;
   out.held = !result.quality.tracked;
   out.failure = result.quality.failure;

@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include "cli.h"
+#include "relight/capture/rgbd_odometry.h"
 #include "relight/core/atomic_file.h"
 #include "relight/core/image_io.h"
 #include "temp_dir.h"
@@ -287,6 +288,8 @@ TEST(ReplayTracking, OdometryKeepsThePebbleWhereTheTruePosesPutIt) {
     const int keyframes = tracking.value("keyframes", 0);
     EXPECT_GE(keyframes, 1) << tracking.dump();
     EXPECT_NEAR(tracking.value("keyframe_model_mb", 0.0), 0.77 * keyframes, 0.05 * keyframes) << tracking.dump();
+    EXPECT_EQ(tracking.value("keyframe_model_budget_mb", 0.0), capture::RgbdOdometryOptions{}.model_budget_mb)
+        << tracking.dump();
     double worst = 1.0;
     for (int frame = 0; frame < 8; ++frame) {
       char name[32];

@@ -44,6 +44,7 @@ struct CameraPose {
   int keyframe = -1;
   int keyframes = 0;             ///< stored in the tracker's model after this frame
   double keyframe_model_mb = 0;  ///< their memory (RgbdOdometryOptions::model_budget_mb bounds it)
+  double keyframe_model_budget_mb = 0;  ///< that bound, so reports and scripts need no second copy of it
   double correction_cm = 0;  ///< marker+odometry: how far the marker moved the pose this frame
   static constexpr const char* type_name = "CameraPose";
 };
