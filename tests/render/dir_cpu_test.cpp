@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <random>
 #include <tuple>
 
 #include "relight/core/error.h"
@@ -74,6 +75,48 @@ TEST(ShadowMaps, VirtualContactShadowOfADirectionalLightIsSharp) {
               1e3f * layout.view(layout.light_views[1][0], 1).texel_size);
   EXPECT_GT(shadowed, 300);
   EXPECT_LT(wrong, shadowed / 20);
+}
+
+// A lamp grazing a real table at 13 degrees (25-degree spot, 256-texel map, 1.5 m away): table
+// points scattered about the table's mesh as a Kinect's depth scatters them 2 m from the camera
+// (sigma 6 mm) are lit through the real layer with real_surface_tolerance; with the one-texel
+// tolerance alone many of them shadow themselves (the lamp's shadows came out speckled). Points
+// truly in the shadow of a real 10 cm blocker stay dark.
+TEST(ShadowMaps, RealSurfacesScatteredByDepthNoiseAreNotTheirOwnShadowAtGrazingLight) {
+  MrScene scene = test::floor_scene(Eigen::Vector3f::Constant(0.5f), {0.f, 0.f, 2.f}, 0.f);
+  scene.lights.clear();
+  const Eigen::Vector3f lamp(-0.94f, 0.f, 0.34f), aim = Eigen::Vector3f(1.f, 0.f, -0.364f).normalized();  // 20 deg
+  scene.lights.push_back(spot_light(lamp, aim, 25.f, 20.f, Eigen::Vector3f::Ones(), true));
+  TriangleMesh blocker = truth::tessellate(synth::Box{{-0.05, -0.2, 0.0}, {0.0, 0.2, 0.1}}, 0);
+  blocker.name = "real blocker";
+  scene.meshes.push_back(blocker);
+  const RayTracer tracer(scene);
+  const ShadowLayout layout = plan_shadow_views(scene, 256);
+  const std::vector<float> atlas = shadow_atlas_cpu(tracer, layout);
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  const float tolerance = real_surface_tolerance(2.f, 2.f);
+  EXPECT_NEAR(tolerance, 2.f * 0.0060640f, 1e-5f);
+  std::mt19937 rng(7);
+  std::normal_distribution<float> depth_noise(0.f, 0.5f * tolerance);  // sigma at 2 m
+  int lit_exact = 0, lit_plain = 0, lit_tolerant = 0;
+  for (int row = 0; row < 20; ++row) {
+    for (int col = 0; col < 20; ++col) {
+      const Eigen::Vector3f on_table(0.5f + 0.001f * static_cast<float>(col), -0.1f + 0.01f * static_cast<float>(row),
+                                     0.f);
+      const Eigen::Vector3f point = on_table + depth_noise(rng) * up;
+      lit_exact += 1;
+      lit_plain += shadow_visibility(layout, atlas, 0, 0, point, up) > 0.5f ? 1 : 0;
+      lit_tolerant += shadow_visibility(layout, atlas, 0, 0, point, up, tolerance) > 0.5f ? 1 : 0;
+    }
+  }
+  std::printf("grazing lamp over a noisy table: %d of %d points lit with the noise tolerance, %d with one texel\n",
+              lit_tolerant, lit_exact, lit_plain);
+  EXPECT_GE(lit_tolerant, lit_exact * 98 / 100);
+  EXPECT_LT(lit_plain, lit_exact * 80 / 100);
+  // Behind the 10 cm real blocker (its shadow on the table reaches x = 0.39 m) it stays dark.
+  for (const float x : {0.05f, 0.1f, 0.2f, 0.3f}) {
+    EXPECT_EQ(shadow_visibility(layout, atlas, 0, 0, Eigen::Vector3f(x, 0.f, 0.f), up, tolerance), 0.f) << x;
+  }
 }
 
 TEST(DirCpu, VirtualCubeBleedsRedOntoTheRealFloorOnlyInLrv) {

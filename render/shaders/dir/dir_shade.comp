@@ -68,7 +68,7 @@ layout(push_constant) uniform Params {
   uint interleave;
   uint emitter_count;  // the last emitter_count VPLs are emitters (vpl.h)
   vec4 camera_centre;
-  vec4 environment;
+  vec4 environment;     // w: DirOptions::real_depth_noise_sigmas
   vec4 virtual_bounds;  // IsmPointPools::virtual_bounds
   vec4 scene_bounds;    // IsmPointPools::scene_bounds
 } params;
@@ -90,7 +90,7 @@ Material surface_material(Material m, vec3 mr) {
 vec3 phong(Material m, vec3 n, vec3 wi, vec3 wo) { return phong_brdf(m.kd_ks.xyz, m.kd_ks.w, m.emission_n.w, n, wi, wo); }
 
 // shadow_visibility() (shadow_maps.h).
-float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
+float shadow_visibility(Light light, int layer, vec3 point, vec3 normal, float surface_tolerance) {
   const uint first = floatBitsToUint(light.outer_views.y), count = floatBitsToUint(light.outer_views.z);
   if (count == 0u) return 1.0;
   const int rows = max(params.shadow_rows, 1);
@@ -107,6 +107,8 @@ float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
   const ShadowView view = views[layer_base + index];
   const float texel = positional ? view.texel_size.x * length(towards_light) : view.texel_size.x;
   const vec3 facing = dot(normal, towards_light) < 0.0 ? -normal : normal;
+  const float cos_incidence = max(abs(dot(normal, normalize(towards_light))), 0.2);
+  const float tolerance = texel + surface_tolerance / cos_incidence;
   const vec3 receiver = point + 0.5 * texel * facing;
   const vec4 clip = view.world_to_clip * vec4(receiver, 1.0);
   if (clip.w <= 0.0) return 1.0;
@@ -117,7 +119,7 @@ float shadow_visibility(Light light, int layer, vec3 point, vec3 normal) {
   const ivec2 origin = ivec2((int(index) % params.shadow_columns) * tile, (layer * rows + int(index) / params.shadow_columns) * tile);
   const float stored = shadow_atlas[(origin.y + texel_xy.y) * params.shadow_columns * tile + origin.x + texel_xy.x];
   const float depth = positional ? length(receiver - view.eye.xyz) : -dot(receiver, view.eye.xyz);
-  return depth <= stored + texel ? 1.0 : 0.0;
+  return depth <= stored + tolerance ? 1.0 : 0.0;
 }
 
 // IsmLookup::visible (ism.h).
@@ -161,6 +163,9 @@ void main() {
   const vec3 point = position.xyz;
   const float real_pixel = position.w > 0.0 ? 1.0 : 0.0;  // r(p)
   const vec3 wo = normalize(params.camera_centre.xyz - point);
+  // real_surface_tolerance() (shadow_maps.h); params.environment.w: DirOptions::real_depth_noise_sigmas.
+  const float z = length(params.camera_centre.xyz - point) - 0.4;
+  const float real_tolerance = real_pixel * params.environment.w * (0.0012 + 0.0019 * z * z);
   // texture_factors() (gbuffer.h): the textures at the pixel's coordinates and footprint.
   const vec4 t = gbuffer[2u * pixels + i];
   const Material material = materials[uint(normal_material.w)];
@@ -207,9 +212,9 @@ void main() {
       const float cos_i = dot(wi, n);
       if (cos_i <= 0.0) continue;
       const vec3 contribution = phong(m, n, wi, wo) * irradiance * cos_i;
-      const float v_r = shadow_visibility(light, 0, point, n);
+      const float v_r = shadow_visibility(light, 0, point, n, real_tolerance);
       if (v_r == 0.0) continue;
-      if (want_rv) rv += contribution * shadow_visibility(light, 1, point, n);
+      if (want_rv) rv += contribution * shadow_visibility(light, 1, point, n, 0.0);
       r += contribution * (light.direction_real.w * real_pixel);
     }
     // Emitter VPLs (vpl.h), the last emitter_count VPLs: every pixel sees all of them.

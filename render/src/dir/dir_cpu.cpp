@@ -39,14 +39,18 @@ class MapShader {
   /// average over neighbouring pixels does not blur the texture into it. `m` is the surface's
   /// Phong (surface_phong(): its metallic-roughness texture applied; that, k_s and n vary
   /// slowly enough for the merge, and are not demodulated).
+  /// `camera_distance`: of the point from the camera that measured it (real_surface_tolerance).
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const Phong& m,
-                               const Vec3& kd_texture, const Vec3& emission, float real_pixel,
-                               std::uint32_t subset) const {
+                               const Vec3& kd_texture, const Vec3& emission, float real_pixel, std::uint32_t subset,
+                               float camera_distance) const {
     Radiance out;
     out.real_virtual = emission;
     out.real = real_pixel * emission;
     out.kd_texture = kd_texture;
-    if (options_.shading.direct) add_direct(point, normal, wo, with_kd_factor(m, kd_texture), real_pixel, out);
+    const float tolerance =
+        real_pixel > 0.f ? real_surface_tolerance(options_.shading.real_depth_noise_sigmas, camera_distance) : 0.f;
+    if (options_.shading.direct)
+      add_direct(point, normal, wo, with_kd_factor(m, kd_texture), real_pixel, tolerance, out);
     if (options_.shading.indirect) add_indirect(point, normal, wo, m, real_pixel, subset, out);
     return out;
   }
@@ -56,7 +60,7 @@ class MapShader {
   [[nodiscard]] bool want_r() const { return options_.output != DirOutput::RealVirtualOnly; }
 
   void add_direct(const Vec3& point, const Vec3& n, const Vec3& wo, const Phong& m, float real_pixel,
-                  Radiance& out) const {
+                  float real_tolerance, Radiance& out) const {
     for (std::size_t l = 0; l < scene_.lights.size(); ++l) {
       const MrLight& light = scene_.lights[l];
       if (light.through_vpl) continue;  // its emitter VPL lights the point (vpl.h)
@@ -66,7 +70,7 @@ class MapShader {
       if (cos_i <= 0.f) continue;
       // The real layer's shadow first: no BRDF to evaluate where it is dark.
       const auto index = static_cast<std::uint32_t>(l);
-      if (shadow_visibility(layout_, shadow_atlas_, index, 0, point, n) == 0.f) continue;
+      if (shadow_visibility(layout_, shadow_atlas_, index, 0, point, n, real_tolerance) == 0.f) continue;
       const Vec3 contribution = phong_brdf(m, n, sample->wi, wo).cwiseProduct(sample->irradiance) * cos_i;
       if (want_rv()) out.real_virtual += contribution * shadow_visibility(layout_, shadow_atlas_, index, 1, point, n);
       out.real += contribution * ((light.real ? 1.f : 0.f) * real_pixel);
@@ -244,9 +248,10 @@ DifferentialImages shade_from_maps(const GBuffer& gbuffer, const MrScene& scene,
         };
         const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
         const Vec3 eye = eyes ? Vec3((*eyes)(y, x).x, (*eyes)(y, x).y, (*eyes)(y, x).z) : camera_centre;
-        shaded(y, x) = shader.shade(point, normal, (eye - point).normalized(),
-                                    surface_phong(material, factor(metallic_roughness)), factor(kd_texture),
-                                    material.emission.cwiseProduct(factor(emission_texture)), real_pixel, subset);
+        shaded(y, x) =
+            shader.shade(point, normal, (eye - point).normalized(), surface_phong(material, factor(metallic_roughness)),
+                         factor(kd_texture), material.emission.cwiseProduct(factor(emission_texture)), real_pixel,
+                         subset, (camera_centre - point).norm());
       }
   }, 4);
   DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,

@@ -30,7 +30,7 @@ struct ShadeParams {
   float min_distance;
   std::uint32_t flags, interleave, emitter_count;
   float camera_centre[4];
-  float environment[4];
+  float environment[4];  ///< w: DirOptions::real_depth_noise_sigmas
   float virtual_bounds[4];
   float scene_bounds[4];
 };
@@ -334,7 +334,7 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
       static_cast<std::uint32_t>(options.interleave),
       static_cast<std::uint32_t>(emitter_count(vpls)),
       {centre.x(), centre.y(), centre.z(), 1.f},
-      {environment.x(), environment.y(), environment.z(), 0.f},
+      {environment.x(), environment.y(), environment.z(), options.shading.real_depth_noise_sigmas},
       {d.points.virtual_bounds.x(), d.points.virtual_bounds.y(), d.points.virtual_bounds.z(),
        d.points.virtual_bounds.w()},
       {d.points.scene_bounds.x(), d.points.scene_bounds.y(), d.points.scene_bounds.z(), d.points.scene_bounds.w()}};

@@ -136,7 +136,7 @@ std::vector<float> shadow_atlas_cpu(const RayTracer& tracer, const ShadowLayout&
 }
 
 float shadow_visibility(const ShadowLayout& layout, std::span<const float> atlas, std::uint32_t light, int layer,
-                        const Vec3& point, const Vec3& normal) {
+                        const Vec3& point, const Vec3& normal, float surface_tolerance) {
   if (light >= layout.light_views.size()) return 1.f;
   const auto [first, count] = layout.light_views[light];
   if (count == 0) return 1.f;
@@ -152,6 +152,8 @@ float shadow_visibility(const ShadowLayout& layout, std::span<const float> atlas
   // dir/vs_reference: 1.5 texels doubled the direct-light error of DeltaL).
   const float texel = positional ? view.texel_size * towards_light.norm() : view.texel_size;
   const Vec3 facing = normal.dot(towards_light) < 0.f ? Vec3(-normal) : normal;
+  const float cos_incidence = std::max(std::abs(normal.dot(towards_light.normalized())), 0.2f);
+  const float tolerance = texel + surface_tolerance / cos_incidence;
   const Vec3 receiver = point + 0.5f * texel * facing;
   const Eigen::Vector4f clip = view.world_to_clip * receiver.homogeneous();
   if (clip.w() <= 0.f) return 1.f;
@@ -164,7 +166,7 @@ float shadow_visibility(const ShadowLayout& layout, std::span<const float> atlas
   const float stored =
       atlas[static_cast<std::size_t>(oy + ty) * static_cast<std::size_t>(layout.atlas_width()) + static_cast<std::size_t>(ox + tx)];
   const float depth = light_depth(view, receiver);
-  return depth <= stored + texel ? 1.f : 0.f;
+  return depth <= stored + tolerance ? 1.f : 0.f;
 }
 
 }  // namespace relight::render

@@ -79,9 +79,26 @@ struct ShadowLayout {
 /// MrScene::coarse_real_meshes.
 [[nodiscard]] std::vector<float> shadow_atlas_cpu(const RayTracer& tracer, const ShadowLayout& layout, int threads = 0);
 
+/// How far (metres, along the normal) a real surface point reconstructed from depth may lie from
+/// the real mesh's surface: `sigmas` standard deviations of Kinect v1's axial noise at the
+/// point's distance `camera_distance` from the camera, sigma(z) = 0.0012 + 0.0019 (z - 0.4)^2
+/// (Nguyen, Izadi & Lovell 2012; synth/kinect_noise.h simulates the same). At 2 m that is 6 mm
+/// per sigma: against a lamp grazing the table at 20 degrees it is 18 mm of light depth, where
+/// the one-texel tolerance of a 25-degree spot's 256-texel map is 4 mm, and the real layer
+/// shadowed the table from its own mesh at random pixels (the virtual object's shadow showed the
+/// camera's lit table through them). dir_shade.comp mirrors it.
+[[nodiscard]] inline float real_surface_tolerance(float sigmas, float camera_distance) {
+  const float z = camera_distance - 0.4f;
+  return sigmas * (0.0012f + 0.0019f * z * z);
+}
+
 /// 1 when `point` (on a surface of unit normal `normal`, facing the light or not) is lit by light
 /// `light` through layer `layer` according to `atlas`, else 0. Points outside every view are lit.
+/// `surface_tolerance`: how far (metres, along the normal) the receiver may lie from the surface
+/// that cast the map (real_surface_tolerance for real points in the real layer, else 0); the
+/// depth test allows it along the light's ray, surface_tolerance / cos(incidence) (at most 5x).
 [[nodiscard]] float shadow_visibility(const ShadowLayout& layout, std::span<const float> atlas, std::uint32_t light,
-                                      int layer, const Eigen::Vector3f& point, const Eigen::Vector3f& normal);
+                                      int layer, const Eigen::Vector3f& point, const Eigen::Vector3f& normal,
+                                      float surface_tolerance = 0.f);
 
 }  // namespace relight::render
