@@ -121,6 +121,13 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--real-spot", options.real_spots,
                      "A real spot light - a lamp of the real scene - as --virtual-spot: it lights real and virtual "
                      "surfaces alike, and the virtual objects cast its shadows onto the real ones (repeatable)");
+  command.add_option("--real-spot-tag", options.real_spot_tag,
+                     "A tracked real lamp id,size,angle_degrees,intensity[,r,g,b]: a real spot light fixed to the "
+                     "AprilTag (tag36h11) of that id and black-square edge in metres, re-posed every frame from the "
+                     "tag and the camera's pose; the lamp stays where it was last seen while the tag is out of view");
+  command.add_option("--real-spot-tag-offset", options.real_spot_tag_offset,
+                     "Where the --real-spot-tag lamp's light sits in its tag's frame, x,y,z[,axis_x,axis_y,axis_z] "
+                     "(x right, y down in the tag image, z into the tag; metres; default 0,0,0 shining along +z)");
   command.add_option("--vpls", options.vpls, "Light samples for virtual point lights per frame")
       ->check(CLI::Range(0, 4096))
       ->capture_default_str();

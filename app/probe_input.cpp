@@ -69,10 +69,11 @@ lights::ProbeStreamStage& add_probe_stream_stage(FrameGraph& graph, const RealLi
 }  // namespace
 
 RealLightStages add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
-                                      const ProbeInputOptions& options, Backend per_pixel, vk::VulkanContext* context) {
+                                      const ProbeInputOptions& options, Backend per_pixel, vk::VulkanContext* context,
+                                      BufferName<lights::LightSet> output) {
   if (!source.lights_file.empty()) {
     graph.emplace<ConstantStage<lights::LightSet>>(
-        lights::kLights, lights::lights_from_json(read_text_file(source.lights_file), source.lights_file.string()));
+        output, lights::lights_from_json(read_text_file(source.lights_file), source.lights_file.string()));
     return {};
   }
   if (options.lights < 1 || options.lights > 4096) throw Error("--probe-lights must be 1 to 4096");
@@ -87,9 +88,11 @@ RealLightStages add_real_light_stages(FrameGraph& graph, const RealLightSource& 
     extraction.calibration = probe_calibration(options);
   }
   // Without smoothing the extracted lights are the lights (for comparisons: the flicker it removes).
-  const lights::LightExtractionBuffers buffers{kProbe, options.smoothing ? lights::kLightsRaw : lights::kLights};
+  const lights::LightExtractionBuffers buffers{kProbe, options.smoothing ? lights::kLightsRaw : output};
   graph.add(lights::make_light_extraction_stage(per_pixel, context, extraction, buffers));
-  if (options.smoothing) graph.emplace<lights::LightSmoothingStage>();
+  if (options.smoothing)
+    graph.emplace<lights::LightSmoothingStage>(lights::LightSmoothingOptions{},
+                                               lights::LightSmoothingBuffers{lights::kLightsRaw, output});
   return stages;
 }
 

@@ -12,6 +12,7 @@
 #include "relight/brdf/light_estimation_stage.h"
 #include "relight/core/frame_graph.h"
 #include "relight/core/stage_backend.h"
+#include "relight/lights/buffers.h"
 #include "relight/lights/probe_geometry.h"
 #include "relight/lights/probe_stream_stage.h"
 
@@ -65,9 +66,11 @@ struct RealLightStages {
   brdf::LightEstimationStage* estimation = nullptr;
 };
 
-/// Adds the stages that write lights::kLights: a constant set from a lights file, or the probe
-/// stream (or the estimate's environment map) -> light_extraction -> light_smoothing.
+/// Adds the stages that write `output` (lights::kLights unless a tracked lamp joins them later,
+/// tracked_lamp_stage.h): a constant set from a lights file, or the probe stream (or the
+/// estimate's environment map) -> light_extraction -> light_smoothing.
 RealLightStages add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
-                                      const ProbeInputOptions& options, Backend per_pixel, vk::VulkanContext* context);
+                                      const ProbeInputOptions& options, Backend per_pixel, vk::VulkanContext* context,
+                                      BufferName<lights::LightSet> output = lights::kLights);
 
 }  // namespace relight::app

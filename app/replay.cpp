@@ -54,6 +54,7 @@
 #include "report.h"
 #include "report_collector_stage.h"
 #include "tone_map_json.h"
+#include "tracked_lamp_stage.h"
 #include "video_writer_stage.h"
 #include "view_stage.h"
 
@@ -193,8 +194,15 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   const bool lights_as_vpls = options.environment == render::EnvironmentLight::Vpls;
   ProbeInputOptions probe_input = options.probe_input;
   if (probe_input.lights == 0) probe_input.lights = lights_as_vpls ? 64 : 8;
-  const RealLightStages light_stages =
-      add_real_light_stages(graph, real_lights, probe_input, per_pixel, pipeline.vulkan.get());
+  // A tracked lamp joins the room's lights after their smoothing: it moves by hand, at once.
+  const bool lamp = !options.real_spot_tag.empty();
+  if (!lamp && !options.real_spot_tag_offset.empty()) throw Error("--real-spot-tag-offset needs --real-spot-tag");
+  const RealLightStages light_stages = add_real_light_stages(
+      graph, real_lights, probe_input, per_pixel, pipeline.vulkan.get(), lamp ? kRoomLights : lights::kLights);
+  if (lamp) {
+    pipeline.tracked_lamp =
+        &graph.emplace<TrackedLampStage>(parse_tracked_lamp(options.real_spot_tag, options.real_spot_tag_offset));
+  }
   pipeline.probe = light_stages.probe;
   if (real_lights.lights_file.empty()) pipeline.extracted_lights = probe_input.lights;
   pipeline.light_estimation = light_stages.estimation;
@@ -337,6 +345,13 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
   report["tracking"] = pipeline.trajectory->summary();
   if (pipeline.probe) report["probe"] = pipeline.probe->summary();
   if (pipeline.light_estimation) report["light_estimate"] = pipeline.light_estimation->summary();
+  if (pipeline.tracked_lamp) {
+    report["tracked_lamp"] = pipeline.tracked_lamp->summary();
+    if (pipeline.tracked_lamp->frames_seen() == 0) {
+      std::cerr << "relight: warning: the lamp's tag (tag36h11 id " << report["tracked_lamp"]["tag_id"].get<int>()
+                << ") was in no frame: the lamp did not light the scene\n";
+    }
+  }
   if (pipeline.renders) {
     report["environment"] = {{"mode", name_of(render::kEnvironmentLightNames, options.environment)},
                              {"extracted_lights", pipeline.extracted_lights}};

@@ -33,6 +33,7 @@ class LiveView;
 class ObjectPlacementStage;
 class ViewStage;
 class ReportCollectorStage;
+class TrackedLampStage;
 
 /// --geometry: method 1 (NormalsRawDepth on the raw depth) or method 2 (DepthWarpMerge, then
 /// the normals of `Method2Normals`).
@@ -86,6 +87,10 @@ struct ReplayOptions {
   std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]
   std::vector<std::string> virtual_spots;      ///< x,y,z,tx,ty,tz,angle,intensity[,r,g,b]
   std::vector<std::string> real_spots;         ///< the same, for lamps of the real scene
+  /// A tracked real lamp (tracked_lamp_stage.h): id,size,angle,intensity[,r,g,b] of its tag and
+  /// light, and the light's x,y,z[,ax,ay,az] in the tag's frame; empty: none.
+  std::string real_spot_tag;
+  std::string real_spot_tag_offset;
   int vpls = 64;                               ///< first-bounce light samples per frame
   /// How the real directional lights (a probe's, an estimate's, a lights file's) reach the scene.
   render::EnvironmentLight environment = render::EnvironmentLight::Directional;
@@ -138,6 +143,7 @@ struct ReplayPipeline {
   app::LatencyStage* latency = nullptr;           ///< capture to final picture, every frame
   lights::ProbeStreamStage* probe = nullptr;      ///< set when the real lights come from a probe
   brdf::LightEstimationStage* light_estimation = nullptr;  ///< set with --lights estimate
+  app::TrackedLampStage* tracked_lamp = nullptr;           ///< set with --real-spot-tag
   render::CompositeRule composite_rule = render::CompositeRule::Additive;  ///< as resolved for this run
   render::CameraLookStage* camera_look = nullptr;          ///< set with --camera-artefacts other than none
   colormap::ToneMapStage* tone_map = nullptr;              ///< set when the DIR stage is in the graph

@@ -103,7 +103,9 @@ void register_synth(CLI::App& app, Runners& runners) {
                     "Image size: 640x480 (Kinect v1) or 320x240 (its QVGA mode, the intrinsics halved)");
   add_choice_option(*synth, "--light-animation", options->light_animation.kind, synth::kLightAnimationNames,
                     "Real light that changes: the key light switches on or off at --light-event-frame, dims to "
-                    "--light-dim-to, or orbits by --light-orbit-degrees; writes probe.txt + probe/ (the probe "
+                    "--light-dim-to, or orbits by --light-orbit-degrees; or pocket-lamp: a hand-held spot lamp "
+                    "with a tag of its own (id 1) turns by --light-orbit-degrees (scene.json's pocket_lamp "
+                    "gives the --real-spot-tag options that track it); writes probe.txt + probe/ (the probe "
                     "of every frame) and gt/lights/ (the true lights of every frame)");
   synth
       ->add_option("--light-event-frame", options->light_animation.event_frame,
@@ -116,7 +118,8 @@ void register_synth(CLI::App& app, Runners& runners) {
       ->capture_default_str();
   synth
       ->add_option("--light-orbit-degrees", options->light_animation.orbit_degrees,
-                   "Turn of the light about the table's vertical axis over the sequence (--light-animation orbit)")
+                   "Turn of the light about the table's vertical axis (orbit), or of the pocket lamp about its own "
+                   "(pocket-lamp), over the sequence")
       ->capture_default_str();
   synth
       ->add_option("--probe-noise", options->probe_noise,

@@ -52,7 +52,10 @@ Vector3d incoming_radiance(const Scene& scene, const Ray& ray) {
       seen = &light;
     }
   }
-  if (seen) return seen->colour * (seen->intensity / (std::numbers::pi * seen->radius * seen->radius));
+  if (seen) {  // a lamp shows its emitter only to the directions it shines in
+    return seen->colour *
+           (seen->intensity * seen->falloff(-ray.direction) / (std::numbers::pi * seen->radius * seen->radius));
+  }
   if (!hit) return scene.environment;
   const Vector3d normal = hit->normal.dot(ray.direction) > 0.0 ? Vector3d(-hit->normal) : hit->normal;
   const Material& material = scene.materials[static_cast<std::size_t>(material_at(scene, *hit))];

@@ -181,8 +181,9 @@ Vector3d shade(const Scene& scene, const Vector3d& point, const Vector3d& normal
     const double distance2 = offset.squaredNorm();
     const Vector3d l = offset / std::sqrt(distance2);
     const double cosine = normal.dot(l);
-    if (cosine <= 0.0 || occluded(scene, origin, light.position)) continue;
-    const Vector3d irradiance = light.colour * (light.intensity * cosine / distance2);
+    const double falloff = light.falloff(-l);
+    if (cosine <= 0.0 || falloff <= 0.0 || occluded(scene, origin, light.position)) continue;
+    const Vector3d irradiance = light.colour * (light.intensity * falloff * cosine / distance2);
     const double specular = phong_specular(material.ks, material.n, phong_reflect(l, normal).dot(to_viewer));
     radiance += irradiance.cwiseProduct(material.kd / pi + Vector3d::Constant(specular));
   }

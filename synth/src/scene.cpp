@@ -113,11 +113,24 @@ int Scene::object_index(const std::string& name) const {
   throw Error("synthetic scene has no object named " + name);
 }
 
+double PointLight::falloff(const Eigen::Vector3d& from_light) const {
+  if (!spot()) return 1.0;
+  constexpr double kRadians = std::numbers::pi / 180.0;
+  const double cos_outer = std::cos(cone_degrees * kRadians), cos_inner = std::cos(inner_degrees * kRadians);
+  const double cosine = axis.dot(from_light);
+  if (cosine >= cos_inner) return 1.0;
+  if (cosine <= cos_outer) return 0.0;
+  const double x = (cosine - cos_outer) / (cos_inner - cos_outer);
+  return x * x * (3.0 - 2.0 * x);
+}
+
 Eigen::Vector3d unoccluded_irradiance(const Scene& scene, const Eigen::Vector3d& point, const Eigen::Vector3d& normal) {
   Eigen::Vector3d e = std::numbers::pi * scene.environment;
   for (const PointLight& light : scene.lights) {
     const Vector3d offset = light.position - point;
-    e += light.colour * (light.intensity * std::max(0.0, normal.dot(offset.normalized())) / offset.squaredNorm());
+    const Vector3d to_light = offset.normalized();
+    e += light.colour *
+         (light.intensity * light.falloff(-to_light) * std::max(0.0, normal.dot(to_light)) / offset.squaredNorm());
   }
   return e;
 }

@@ -66,15 +66,19 @@ Json objects_json(const Scene& scene) {
 Json lights_json(const Scene& scene) {
   Json lights = Json::array();
   for (const PointLight& l : scene.lights) {
-    lights.push_back({{"type", "point"},
-                      {"position", vec(l.position)},
-                      {"direction", nullptr},
-                      {"colour", vec(l.colour)},
-                      {"intensity", l.intensity},
-                      {"power", vec(l.colour * l.intensity)},
-                      {"units", "W/sr per unit colour; power = colour * intensity"},
-                      {"probe_radius", l.radius},
-                      {"real", true}});
+    Json light = {{"type", l.spot() ? "spot" : "point"},
+                  {"position", vec(l.position)},
+                  {"direction", nullptr},
+                  {"colour", vec(l.colour)},
+                  {"intensity", l.intensity},
+                  {"power", vec(l.colour * l.intensity)},
+                  {"units", l.spot() ? "W/sr per unit colour on the axis; power = colour * intensity"
+                                     : "W/sr per unit colour; power = colour * intensity"},
+                  {"probe_radius", l.radius},
+                  {"real", true}};
+    if (l.spot())
+      light.update({{"axis", vec(l.axis)}, {"cone_degrees", l.cone_degrees}, {"inner_degrees", l.inner_degrees}});
+    lights.push_back(light);
   }
   return lights;
 }
@@ -127,6 +131,29 @@ Json probe_json(const LightProbe& probe) {
           {"max_theta", c.max_theta}, {"width", c.width}, {"height", c.height},
           {"samples_per_axis", probe.samples_per_axis}, {"pose", pose_json(pose)},
           {"pose_convention", "probe-to-world; probe frame x right, y down in the image, z = optical axis"}};
+}
+
+// The lamp's calibration, and the replay options that give it to relight.
+Json pocket_lamp_json(const Scene& scene) {
+  const PocketLamp lamp = pocket_lamp(scene, 0.0);
+  const Eigen::Vector3d power = lamp.light.colour * lamp.light.intensity;
+  char options[256];
+  std::snprintf(options, sizeof options,
+                "--real-spot-tag %d,%g,%g,%g,%g,%g,%g --real-spot-tag-offset %g,%g,%g,%g,%g,%g", lamp.tag.id,
+                lamp.tag.size, lamp.light.cone_degrees, lamp.light.intensity, lamp.light.colour.x(),
+                lamp.light.colour.y(), lamp.light.colour.z(), lamp.position_in_tag.x(), lamp.position_in_tag.y(),
+                lamp.position_in_tag.z(), lamp.axis_in_tag.x(), lamp.axis_in_tag.y(), lamp.axis_in_tag.z());
+  return {{"tag_family", "tag36h11"},
+          {"tag_id", lamp.tag.id},
+          {"tag_size", lamp.tag.size},
+          {"position_in_tag", vec(lamp.position_in_tag)},
+          {"axis_in_tag", vec(lamp.axis_in_tag)},
+          {"cone_degrees", lamp.light.cone_degrees},
+          {"inner_degrees", lamp.light.inner_degrees},
+          {"power", vec(power)},
+          {"tag_frame", "x right, y down in the tag image, z into the tag"},
+          {"replay_options", options},
+          {"per_frame", "the lamp's light is the spot of gt/lights/<timestamp>.json"}};
 }
 
 Json intrinsics_json(const PinholeIntrinsics& k) {
@@ -183,6 +210,7 @@ std::string scene_json(const Scene& scene, const SynthOptions& options) {
                                {"probe_stream", "probe.txt"},
                                {"lights_per_frame", "gt/lights/<timestamp>.json"}};
   }
+  if (animation.kind == LightAnimation::PocketLamp) json["pocket_lamp"] = pocket_lamp_json(scene);
   json["ground_truth"] = {{"depth", "gt/depth/<timestamp>.exr"}, {"normals", "gt/normals/<timestamp>.exr"},
                           {"albedo", "gt/albedo/<timestamp>.png"}, {"material", "gt/material/<timestamp>.png"},
                           {"material_background", 0}};
@@ -190,7 +218,8 @@ std::string scene_json(const Scene& scene, const SynthOptions& options) {
 }
 
 std::string frame_lights_json(const Scene& scene) {
-  return Json{{"lights", lights_json(scene)}, {"units", "point lights: power = radiant intensity, W/sr per channel"}}
+  return Json{{"lights", lights_json(scene)},
+              {"units", "point and spot lights: power = radiant intensity (a spot's on its axis), W/sr per channel"}}
              .dump(2) +
          "\n";
 }

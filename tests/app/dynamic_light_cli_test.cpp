@@ -3,10 +3,13 @@
 // shadow on the real table follows it (Knecht 2010 §6: DIR follows dynamic real light).
 #include <gtest/gtest.h>
 
+#include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
+#include <numbers>
 
 #include "cli.h"
 #include "relight/core/atomic_file.h"
@@ -73,6 +76,41 @@ FrameLight frame_light(const std::filesystem::path& frames, int frame) {
   light.real_light /= count;
   light.camera /= count;
   return light;
+}
+
+// Relative error of DIR's differential light L_rv - L_r of `frame` against the path tracer's
+// (render-reference at half the resolution: `reference` holds L_rv, beside it .Lr.exr), summed
+// over the pixels the virtual object covers in none of the 2x2 replay pixels they average.
+double delta_error_against_reference(const std::filesystem::path& frames, int frame,
+                                     const std::filesystem::path& reference) {
+  const RadianceImage lrv = read_radiance(frame_file(frames, frame, "_L_rv.exr"));
+  const RadianceImage lr = read_radiance(frame_file(frames, frame, "_L_r.exr"));
+  const ColorImage coverage = read_color(frame_file(frames, frame, "_virtual_coverage.png"));
+  const RadianceImage truth_rv = read_radiance(reference);
+  auto truth_r_path = reference;
+  const RadianceImage truth_r = read_radiance(truth_r_path.replace_extension(".Lr.exr"));
+  EXPECT_EQ(truth_rv.width() * 2, lrv.width());
+  double error = 0.0, total = 0.0;
+  for (int row = 0; row < truth_rv.height(); ++row) {
+    for (int col = 0; col < truth_rv.width(); ++col) {
+      Eigen::Vector3d ours = Eigen::Vector3d::Zero();
+      bool covered = false;
+      for (int dy = 0; dy < 2; ++dy) {
+        for (int dx = 0; dx < 2; ++dx) {
+          const int r = 2 * row + dy, c = 2 * col + dx;
+          covered = covered || coverage(r, c).r != 0;
+          ours += 0.25 * (Eigen::Vector3d(lrv(r, c).x, lrv(r, c).y, lrv(r, c).z) -
+                          Eigen::Vector3d(lr(r, c).x, lr(r, c).y, lr(r, c).z));
+        }
+      }
+      if (covered) continue;
+      const Float3 a = truth_rv(row, col), b = truth_r(row, col);
+      const Eigen::Vector3d truth(a.x - b.x, a.y - b.y, a.z - b.z);
+      error += (ours - truth).cwiseAbs().sum();
+      total += truth.cwiseAbs().sum();
+    }
+  }
+  return total > 0.0 ? error / total : 1.0;
 }
 
 struct DynamicLightRun {
@@ -284,6 +322,86 @@ TEST(DynamicLightCli, ProbeInputErrorsAreOneLine) {
   expect_one_line_error(relight(replay + " --probe " + (dir.path() / "probe.txt").string()), 1);
   expect_one_line_error(relight(replay + " --probe-rotation 1,2"), 2);  // a usage error
   expect_one_line_error(relight(replay + " --probe-exposure 0"), 1);
+}
+
+// A hand-held lamp tracked through a tag of its own (dissertation §5.2.12): relight re-poses the
+// real spot every frame from the tag and the camera's pose. The lamp turns by 40 degrees from
+// beside the pebble (frame 0) onto it (the last frame): the pebble's shadow grows with it, and
+// is larger than without the lamp; the tracked light sits where the sequence's true lamp is.
+TEST(DynamicLightCli, ATrackedLampIsWhereItsTagSaysAndThePebblesShadowFollowsIt) {
+  test::TempDir dir;
+  constexpr int kLampFrames = 4;
+  const auto& sequence = cli_test::synthetic_sequence("--frames " + std::to_string(kLampFrames) +
+                                                      " --size 320x240 --trajectory static --light-animation "
+                                                      "pocket-lamp --light-orbit-degrees 40");
+  const auto scene = nlohmann::json::parse(read_text_file(sequence / "scene.json"));
+  ASSERT_TRUE(scene.contains("pocket_lamp"));
+  // The room's lights are the scene's; the lamp comes from its tag alone.
+  const std::string room = "--pose sequence --lights " + (sequence / "scene.json").string();
+  const auto run = [&](const std::string& name, const std::string& extra) {
+    const auto out = dir.path() / name;
+    const auto result = replay_pebble(sequence, out, room + " " + extra);
+    EXPECT_EQ(result.exit_code, 0) << result.err;
+    std::vector<FrameLight> frames;
+    for (int frame = 0; result.exit_code == 0 && frame < kLampFrames; ++frame)
+      frames.push_back(frame_light(out / "frames", frame));
+    return frames;
+  };
+  const auto with = run("lamp", scene["pocket_lamp"]["replay_options"].get<std::string>());
+  const auto without = run("room", "");
+  ASSERT_EQ(with.size(), static_cast<std::size_t>(kLampFrames));
+  ASSERT_EQ(without.size(), static_cast<std::size_t>(kLampFrames));
+  EXPECT_GT(with.back().shadow, 1.2 * with.front().shadow) << "the lamp turned onto the pebble";
+  // Against the path tracer's differential light of the last frame (the true lamp and room): the
+  // tracked lamp brings DIR's shadow closer to it than the room's lights alone.
+  const auto reference = dir.path() / "reference.exr";
+  const auto traced =
+      relight("render-reference --quiet --sequence " + sequence.string() + " --frame " +
+              std::to_string(kLampFrames - 1) + " --object " + (kData / "models" / "glossy_pebble.gltf").string() +
+              " --spp 64 --downsample 2 --out " + reference.string());
+  ASSERT_EQ(traced.exit_code, 0) << traced.err;
+  const double error_with = delta_error_against_reference(dir.path() / "lamp" / "frames", kLampFrames - 1, reference);
+  const double error_without =
+      delta_error_against_reference(dir.path() / "room" / "frames", kLampFrames - 1, reference);
+  std::cerr << "DeltaL relative error against the path tracer: " << error_with << " with the lamp, " << error_without
+            << " without\n";
+  EXPECT_LT(error_with, 0.85 * error_without);
+
+  const auto report = nlohmann::json::parse(read_text_file(dir.path() / "lamp" / "report.json"));
+  const auto& lamp = report["tracked_lamp"];
+  EXPECT_EQ(lamp["frames_seen"], kLampFrames) << lamp.dump();
+  // The last frame's true lamp: the spot of its gt/lights file.
+  std::vector<std::filesystem::path> truths;
+  for (const auto& entry : std::filesystem::directory_iterator(sequence / "gt" / "lights"))
+    truths.push_back(entry.path());
+  ASSERT_EQ(truths.size(), static_cast<std::size_t>(kLampFrames));
+  const auto truth =
+      nlohmann::json::parse(read_text_file(*std::max_element(truths.begin(), truths.end())))["lights"].back();
+  ASSERT_EQ(truth["type"], "spot");
+  const auto vec = [](const nlohmann::json& v) { return Eigen::Vector3d(v[0], v[1], v[2]); };
+  EXPECT_LT((vec(lamp["last_position"]) - vec(truth["position"])).norm(), 0.02) << lamp.dump();
+  EXPECT_GT(vec(lamp["last_axis"]).dot(vec(truth["axis"])), std::cos(3.0 * std::numbers::pi / 180.0)) << lamp.dump();
+}
+
+TEST(DynamicLightCli, TrackedLampErrorsAreOneLineAndAnUnseenTagIsAWarning) {
+  test::TempDir dir;
+  const auto& sequence = cli_test::synthetic_sequence("--frames 2 --size 320x240 --trajectory static --no-gt");
+  const std::string replay = "replay --quiet " + sequence.string() + " --object " +
+                             (kData / "models" / "glossy_pebble.gltf").string() + " --no-video --out " +
+                             (dir.path() / "out").string();
+  expect_one_line_error(relight(replay + " --real-spot-tag 1,0.16,25"), 1);
+  expect_one_line_error(relight(replay + " --real-spot-tag 1.5,0.16,25,3"), 1);
+  expect_one_line_error(relight(replay + " --real-spot-tag 1,0,25,3"), 1);
+  expect_one_line_error(relight(replay + " --real-spot-tag 1,0.16,95,3"), 1);
+  expect_one_line_error(relight(replay + " --real-spot-tag 1,0.16,25,3 --real-spot-tag-offset 0,0,0,0,0,0"), 1);
+  expect_one_line_error(relight(replay + " --real-spot-tag-offset 0,0.1,0"), 1);
+  // This sequence has no lamp: the run goes on with the room's lights and says so once.
+  const auto result = relight(replay + " --real-spot-tag 1,0.16,25,3");
+  EXPECT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.err.find("was in no frame"), std::string::npos) << result.err;
+  const auto report = nlohmann::json::parse(read_text_file(dir.path() / "out" / "report.json"));
+  EXPECT_EQ(report["tracked_lamp"]["frames_seen"], 0);
+  EXPECT_EQ(report["tracked_lamp"]["frames_before_first_sighting"], 2);
 }
 
 }  // namespace

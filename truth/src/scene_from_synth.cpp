@@ -41,6 +41,12 @@ render::MrScene scene_from_synth(const synth::Scene& scene, const render::Tessel
     out.meshes.push_back(std::move(mesh));
   }
   for (const synth::PointLight& light : scene.lights) {
+    if (light.spot()) {
+      out.lights.push_back(
+          render::spot_light(to_float(light.position), to_float(light.axis), static_cast<float>(light.cone_degrees),
+                             static_cast<float>(light.inner_degrees), to_float(light.colour * light.intensity), true));
+      continue;
+    }
     render::MrLight l;
     l.kind = render::LightKind::Point;
     l.position = to_float(light.position);

@@ -9,6 +9,12 @@
 //                orbit_degrees * i / (n - 1) (height and distance kept)
 // k = `event_frame`, by default n / 2. A light that is off is left out of the frame's lights
 // (the probe shows no emitter there; the rest of the scene is unchanged).
+//   pocket-lamp  a real spot light added to the scene's lights: a hand-held lamp (dissertation
+//                §5.2.12, Knecht 2010 §6) above the far side of the table, tracked through a
+//                tag36h11 tag of its own (id 1) on a card the lamp is fixed to. Lamp and card
+//                turn together about the vertical through the card by orbit_degrees over the
+//                sequence (from -orbit/2 at frame 0 to +orbit/2 at the last), so the lamp's
+//                light sweeps across the table; the card faces the default camera path.
 #include <array>
 
 #include "relight/core/named_values.h"
@@ -16,21 +22,38 @@
 
 namespace relight::synth {
 
-enum class LightAnimation { None, SwitchOn, SwitchOff, Dim, Orbit };
-inline constexpr std::array<NamedValue<LightAnimation>, 5> kLightAnimationNames{
+enum class LightAnimation { None, SwitchOn, SwitchOff, Dim, Orbit, PocketLamp };
+inline constexpr std::array<NamedValue<LightAnimation>, 6> kLightAnimationNames{
     {{"none", LightAnimation::None},
      {"switch-on", LightAnimation::SwitchOn},
      {"switch-off", LightAnimation::SwitchOff},
      {"dim", LightAnimation::Dim},
-     {"orbit", LightAnimation::Orbit}}};
+     {"orbit", LightAnimation::Orbit},
+     {"pocket-lamp", LightAnimation::PocketLamp}}};
 
 struct LightAnimationOptions {
   LightAnimation kind = LightAnimation::None;
   int light = 0;              ///< index into Scene::lights
   int event_frame = -1;       ///< switch-on/off frame k; < 0: frames / 2
   double dim_to = 0.25;       ///< dim: the last frame's intensity factor
-  double orbit_degrees = 90;  ///< orbit: the turn over the whole sequence
+  double orbit_degrees = 90;  ///< orbit, pocket-lamp: the turn over the whole sequence
 };
+
+/// The hand-held lamp of the pocket-lamp animation: its light is rigidly fixed to the tag, so
+/// the light's position and axis in the tag's frame (x right, y down in the tag image, z into
+/// the tag) are the lamp's calibration - what `relight replay --real-spot-tag` is given.
+struct PocketLamp {
+  TagDecal tag;      ///< id 1; `object` is the card's index once added to a scene
+  Rect card;         ///< the card the tag is printed on (its white margin and a border)
+  PointLight light;  ///< the spot light
+  Eigen::Vector3d position_in_tag;
+  Eigen::Vector3d axis_in_tag;
+};
+
+/// The pocket lamp of `scene` turned by `degrees` about the vertical through its card (0: aimed
+/// at the scene's table tag). The calibration (position_in_tag, axis_in_tag) is the same at
+/// every angle.
+[[nodiscard]] PocketLamp pocket_lamp(const Scene& scene, double degrees);
 
 /// The scene as frame `frame` of `frames` sees it. Throws relight::Error on options that name
 /// no light of the scene or make no sense (dim_to outside [0, 1], a switch frame past the end).

@@ -66,11 +66,22 @@ struct Object {
 /// Point light: radiant intensity colour * intensity (W/sr per channel) from `position`. It is a
 /// point for shading and shadows; the light probe shows it as a sphere of `radius` whose
 /// radiance colour * intensity / (pi radius^2) carries the same intensity.
+/// With cone_degrees > 0 it is a spot light (a lamp): that intensity along `axis` and within
+/// inner_degrees of it, fading to zero at cone_degrees with the smoothstep of the cosine, the
+/// falloff relight's lights use (lights/light_set.h), so the ground truth and the renderer mean
+/// the same lamp.
 struct PointLight {
   Eigen::Vector3d position;
   Eigen::Vector3d colour{1, 1, 1};
   double intensity = 1.0;
   double radius = 0.04;
+  Eigen::Vector3d axis{0, 0, -1};  ///< spot: unit, the direction it shines along
+  double cone_degrees = 0.0;       ///< spot: half-angle where its light ends; 0: a point light
+  double inner_degrees = 0.0;      ///< spot: half-angle of full intensity, (0, cone_degrees]
+
+  [[nodiscard]] bool spot() const { return cone_degrees > 0.0; }
+  /// The share of the intensity sent along unit direction `from_light` (1 for a point light).
+  [[nodiscard]] double falloff(const Eigen::Vector3d& from_light) const;
 };
 
 /// An AprilTag printed onto a planar face of an object (a decal: it changes the material only).

@@ -1,0 +1,88 @@
+#pragma once
+// A tracked real lamp (dissertation §5.2.12, Knecht 2010 §6: a pocket lamp carrying a marker): a
+// real spot light whose pose comes from an AprilTag of its own, re-posed every frame. The tag's
+// pose in the camera (PnP on its four corners with the distance refined from depth, as the
+// camera's marker pose does: capture/marker_pose.h) and the camera's tracked pose in the world
+// give the tag's pose in the world; the lamp's calibration - where its light sits in the tag's
+// frame and where it shines - places the light:
+//   tag_to_world = camera_to_world * inverse(camera_to_tag)
+//   position = tag_to_world * position_in_tag,  axis = R(tag_to_world) * axis_in_tag
+//
+// Stage TrackedLampStage ("tracked_lamp")
+//   reads:  "color" (ColorImage), "depth" (DepthMap), "frame" (FrameInfo: the intrinsics and the
+//           tracked camera_to_world), "room_lights" (LightSet: the other real lights)
+//   writes: "lights" (LightSet): the room's lights and the lamp, a real spot light. While the
+//           tag is out of view, or the camera has no pose, the lamp stays where it was last seen
+//           (a lamp does not vanish when its marker turns away); before its first sighting it is
+//           left out.
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "relight/capture/tag_detector.h"
+#include "relight/capture/tag_layout.h"
+#include "relight/core/buffers.h"
+#include "relight/core/frame_graph.h"
+#include "relight/core/pose.h"
+#include "relight/core/rgbd_frame.h"
+#include "relight/lights/buffers.h"
+#include "relight/lights/light_set.h"
+
+namespace relight::app {
+
+/// The real lights before the tracked lamp joins them.
+inline constexpr BufferName<lights::LightSet> kRoomLights{"room_lights"};
+
+/// A lamp and its tag: the light's position (metres) and axis in the tag's frame (x right, y down
+/// in the tag image, z into the tag), its cone and its radiant intensity on the axis.
+struct TrackedLamp {
+  int tag_id = 0;
+  double tag_size = 0.0;  ///< metres, the edge of the tag's black square
+  Eigen::Vector3d position_in_tag = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis_in_tag = Eigen::Vector3d::UnitZ();  ///< default: it shines where the tag faces away from
+  double cone_degrees = 30.0;
+  double inner_degrees = 24.0;
+  Eigen::Vector3d power = Eigen::Vector3d::Ones();  ///< W/sr per channel on the axis
+};
+
+/// Parses `--real-spot-tag ID,SIZE,ANGLE,INTENSITY[,R,G,B]` (the tag's id and black-square edge
+/// in metres, the cone's half-angle in degrees, the radiant intensity times the colour) and
+/// `--real-spot-tag-offset X,Y,Z[,AX,AY,AZ]` (the light's position and axis in the tag's frame;
+/// empty: at the tag's centre, shining along +z). Throws relight::Error naming the option.
+[[nodiscard]] TrackedLamp parse_tracked_lamp(const std::string& tag, const std::string& offset);
+
+/// The lamp's real spot light for the tag's pose in the world.
+[[nodiscard]] lights::Light lamp_light(const TrackedLamp& lamp, const Pose& tag_to_world);
+
+class TrackedLampStage final : public Stage {
+ public:
+  explicit TrackedLampStage(TrackedLamp lamp, const capture::TagDetectorOptions& detector = {});
+  [[nodiscard]] std::string name() const override { return "tracked_lamp"; }
+  void declare(StageBuilder& builder) override;
+  void run(StageContext& context) override;
+
+  /// The tag's pose in the world this frame; nullopt when the tag is not seen (or the camera has no pose).
+  [[nodiscard]] const std::optional<Pose>& seen_this_frame() const { return seen_; }
+  [[nodiscard]] int frames_seen() const { return frames_seen_; }
+  /// {"tag_id", "frames", "frames_seen", "frames_held", "frames_before_first_sighting",
+  ///  "last_position", "last_axis"} for report.json.
+  [[nodiscard]] nlohmann::ordered_json summary() const;
+
+ private:
+  TrackedLamp lamp_;
+  capture::TagLayout tag_alone_;  ///< the lamp's tag as a layout of its own frame
+  capture::TagDetector detector_;
+  std::optional<Pose> seen_;
+  std::optional<lights::Light> last_;
+  int frames_ = 0;
+  int frames_seen_ = 0;
+  int frames_held_ = 0;
+  Read<ColorImage> color_;
+  Read<DepthMap> depth_;
+  Read<FrameInfo> frame_;
+  Read<lights::LightSet> room_;
+  Write<lights::LightSet> lights_;
+};
+
+}  // namespace relight::app

@@ -1,0 +1,52 @@
+// The tracked lamp's calibration (--real-spot-tag, --real-spot-tag-offset) and how a tag pose
+// places its light; the stage itself runs through `relight replay` in dynamic_light_cli_test.cpp.
+#include "tracked_lamp_stage.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include "relight/core/error.h"
+
+namespace relight::app {
+namespace {
+
+TEST(TrackedLamp, ParsesTheTagTheConeTheIntensityAndTheOffset) {
+  const TrackedLamp plain = parse_tracked_lamp("3,0.1,30,2", "");
+  EXPECT_EQ(plain.tag_id, 3);
+  EXPECT_DOUBLE_EQ(plain.tag_size, 0.1);
+  EXPECT_DOUBLE_EQ(plain.cone_degrees, 30.0);
+  EXPECT_DOUBLE_EQ(plain.inner_degrees, 24.0);
+  EXPECT_EQ(plain.power, Eigen::Vector3d::Constant(2.0));
+  EXPECT_EQ(plain.position_in_tag, Eigen::Vector3d::Zero());
+  EXPECT_EQ(plain.axis_in_tag, Eigen::Vector3d::UnitZ());
+  const TrackedLamp full = parse_tracked_lamp("0,0.16,25,3,1,0.5,0.25", "0,0.1,0,0,3,4");
+  EXPECT_EQ(full.power, Eigen::Vector3d(3.0, 1.5, 0.75));
+  EXPECT_EQ(full.position_in_tag, Eigen::Vector3d(0, 0.1, 0));
+  EXPECT_NEAR((full.axis_in_tag - Eigen::Vector3d(0, 0.6, 0.8)).norm(), 0.0, 1e-12);
+  for (const char* bad :
+       {"", "1,0.1,30", "1,0.1,30,2,1", "-1,0.1,30,2", "1,-0.1,30,2", "1,0.1,0,2", "1,0.1,30,-2", "x,0.1,30,2"}) {
+    EXPECT_THROW((void)parse_tracked_lamp(bad, ""), Error) << bad;
+  }
+  for (const char* bad : {"0,0", "0,0,0,1", "0,0,0,0,0,0", "0,0,nan"}) {
+    EXPECT_THROW((void)parse_tracked_lamp("1,0.1,30,2", bad), Error) << bad;
+  }
+}
+
+TEST(TrackedLamp, TheTagsPoseCarriesTheLightsPositionAndAxis) {
+  const TrackedLamp lamp = parse_tracked_lamp("1,0.16,25,3", "0,0.12,0,0,0,1");
+  Pose tag_to_world = Pose::Identity();
+  tag_to_world.linear() = Eigen::AngleAxisd(0.5 * EIGEN_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  tag_to_world.translation() = Eigen::Vector3d(1, 2, 3);
+  const lights::Light light = lamp_light(lamp, tag_to_world);
+  EXPECT_EQ(light.kind, lights::LightKind::Spot);
+  EXPECT_TRUE(light.real);
+  // Tag y (0.12 m) turns into world z; tag z into world -y.
+  EXPECT_NEAR((light.position - Eigen::Vector3d(1, 2, 3.12)).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((light.axis - Eigen::Vector3d(0, -1, 0)).norm(), 0.0, 1e-12);
+  EXPECT_DOUBLE_EQ(light.cone_degrees, 25.0);
+  EXPECT_DOUBLE_EQ(light.inner_degrees, 20.0);
+}
+
+}  // namespace
+}  // namespace relight::app
