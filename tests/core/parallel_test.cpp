@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 namespace relight {
@@ -90,6 +92,37 @@ TEST(WorkerPool, RethrowsTheFirstFailureAndStaysUsable) {
   pool.for_ranges(
       17, [&](int begin, int end) { covered += end - begin; }, 4);
   EXPECT_EQ(covered.load(), 17);
+}
+
+}  // namespace
+}  // namespace relight
+
+namespace relight {
+namespace {
+
+// parallel_rows runs on the calling thread's pools, one per thread count, made once: a pool
+// (a TBB arena) per call piled up TBB's memory on a starved machine (parallel.cpp).
+TEST(ParallelRows, EachCallingThreadKeepsOnePoolPerThreadCount) {
+  WorkerPool& two = pool_for(2);
+  EXPECT_EQ(&pool_for(2), &two);
+  EXPECT_EQ(two.threads(), 2);
+  EXPECT_NE(&pool_for(3), &two);
+  EXPECT_EQ(pool_for(3).threads(), 3);
+  const WorkerPool* other_thread = nullptr;
+  std::thread([&] { other_thread = &pool_for(2); }).join();
+  EXPECT_NE(other_thread, &two);
+  // Still correct after a loop that threw.
+  EXPECT_THROW(parallel_rows(
+                   64, 2, [](int, int) { throw std::runtime_error("stop"); }, 8),
+               std::runtime_error);
+  std::vector<int> seen(64, 0);
+  parallel_rows(
+      64, 2,
+      [&](int begin, int end) {
+        for (int row = begin; row < end; ++row) ++seen[static_cast<std::size_t>(row)];
+      },
+      8);
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), 64);
 }
 
 }  // namespace

@@ -40,4 +40,8 @@ class WorkerPool {
   std::unique_ptr<Arena> arena_;
 };
 
+/// The calling thread's pool of `threads` workers, made on its first use and kept for the
+/// thread's life: what parallel_rows (parallel.h) runs on.
+[[nodiscard]] WorkerPool& pool_for(int threads);
+
 }  // namespace relight
