@@ -24,20 +24,6 @@ bool is_synthetic(const fs::path& sequence) {
   return json.value("generator", std::string()) == "relight synth";
 }
 
-namespace {
-
-/// intensity x (r, g, b) from v[first] and, when present, v[first + 1 .. first + 3].
-Eigen::Vector3f parse_intensity(const char* option, const std::string& text, const std::vector<float>& v,
-                                std::size_t first) {
-  const Eigen::Vector3f colour =
-      v.size() == first + 4 ? Eigen::Vector3f(v[first + 1], v[first + 2], v[first + 3]) : Eigen::Vector3f::Ones();
-  if (v[first] < 0.f || colour.minCoeff() < 0.f)
-    throw Error(std::string(option) + " '" + text + "': intensity and colour must not be negative");
-  return v[first] * colour;
-}
-
-}  // namespace
-
 render::MrLight parse_virtual_light(const std::string& text) {
   const std::vector<float> v = parse_number_list<float>("--virtual-light", text);
   if (v.size() != 4 && v.size() != 7) throw Error("--virtual-light '" + text + "' needs x,y,z,intensity[,r,g,b]");

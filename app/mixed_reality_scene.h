@@ -2,11 +2,14 @@
 // What the commands that render virtual objects into a sequence share (render-reference,
 // replay, live): telling a synthetic sequence from a recorded one, the real lights of each, and
 // the virtual objects and lights given on the command line.
+#include <Eigen/Core>
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "relight/core/error.h"
 #include "relight/lights/light_set.h"
 #include "relight/render/scene/mr_scene.h"
 #include "relight/render/scene/virtual_model.h"
@@ -22,6 +25,19 @@ inline constexpr const char* kDefaultSynthPlacement = "0.35,-0.2,0.75,30";
 
 /// "x,y,z,intensity[,r,g,b]": a virtual point light of radiant intensity intensity * (r,g,b) W/sr.
 [[nodiscard]] render::MrLight parse_virtual_light(const std::string& text);
+
+/// intensity x (r, g, b) from v[first] and, when present, v[first + 1 .. first + 3] (the
+/// "intensity[,r,g,b]" tail of a light option's numbers). Throws relight::Error naming `option`
+/// and `text` when either is negative.
+template <class T>
+[[nodiscard]] Eigen::Matrix<T, 3, 1> parse_intensity(const char* option, const std::string& text,
+                                                     const std::vector<T>& v, std::size_t first) {
+  using Vec = Eigen::Matrix<T, 3, 1>;
+  const Vec colour = v.size() == first + 4 ? Vec(v[first + 1], v[first + 2], v[first + 3]) : Vec::Ones();
+  if (v[first] < T(0) || colour.minCoeff() < T(0))
+    throw Error(std::string(option) + " '" + text + "': intensity and colour must not be negative");
+  return v[first] * colour;
+}
 
 /// A spot's light fades out between this fraction of its angle and the whole angle.
 inline constexpr float kSpotInnerFraction = 0.8f;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "mixed_reality_scene.h"
 #include "number_list.h"
 #include "relight/capture/marker_pose.h"
 #include "relight/core/error.h"
@@ -25,10 +26,8 @@ TrackedLamp parse_tracked_lamp(const std::string& tag, const std::string& offset
   lamp.tag_size = v[1];
   if (!(v[2] > 0.0 && v[2] < 90.0)) throw Error(what + ": the angle must be in (0, 90) degrees");
   lamp.cone_degrees = v[2];
-  lamp.inner_degrees = 0.8 * v[2];  // as --real-spot (mixed_reality_scene.h, kSpotInnerFraction)
-  const Eigen::Vector3d colour = v.size() == 7 ? Eigen::Vector3d(v[4], v[5], v[6]) : Eigen::Vector3d::Ones();
-  if (v[3] < 0.0 || colour.minCoeff() < 0.0) throw Error(what + ": intensity and colour must not be negative");
-  lamp.power = v[3] * colour;
+  lamp.inner_degrees = static_cast<double>(kSpotInnerFraction * static_cast<float>(v[2]));  // as --real-spot
+  lamp.power = parse_intensity("--real-spot-tag", tag, v, 3);
   if (offset.empty()) return lamp;
   const std::vector<double> o = parse_number_list<double>("--real-spot-tag-offset", offset);
   if (o.size() != 3 && o.size() != 6)
@@ -76,7 +75,7 @@ void TrackedLampStage::declare(StageBuilder& builder) {
 
 void TrackedLampStage::run(StageContext& context) {
   ++frames_;
-  seen_.reset();
+  std::optional<Pose> seen;  // the tag's pose in the world this frame
   const FrameInfo& frame = context.get(frame_);
   if (frame.camera_to_world) {
     const auto detections = detector_.detect(context.get(color_));
@@ -84,12 +83,12 @@ void TrackedLampStage::run(StageContext& context) {
     if (camera_to_tag) {
       camera_to_tag =
           capture::refine_with_depth(*camera_to_tag, detections, tag_alone_, frame.intrinsics, context.get(depth_));
-      seen_ = Pose(*frame.camera_to_world * camera_to_tag->camera_to_world.inverse());
+      seen = Pose(*frame.camera_to_world * camera_to_tag->camera_to_world.inverse());
     }
   }
-  if (seen_) {
+  if (seen) {
     ++frames_seen_;
-    last_ = lamp_light(lamp_, *seen_);
+    last_ = lamp_light(lamp_, *seen);
   } else if (last_) {
     ++frames_held_;
   }

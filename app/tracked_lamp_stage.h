@@ -62,8 +62,6 @@ class TrackedLampStage final : public Stage {
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
-  /// The tag's pose in the world this frame; nullopt when the tag is not seen (or the camera has no pose).
-  [[nodiscard]] const std::optional<Pose>& seen_this_frame() const { return seen_; }
   [[nodiscard]] int frames_seen() const { return frames_seen_; }
   /// {"tag_id", "frames", "frames_seen", "frames_held", "frames_before_first_sighting",
   ///  "last_position", "last_axis"} for report.json.
@@ -73,7 +71,6 @@ class TrackedLampStage final : public Stage {
   TrackedLamp lamp_;
   capture::TagLayout tag_alone_;  ///< the lamp's tag as a layout of its own frame
   capture::TagDetector detector_;
-  std::optional<Pose> seen_;
   std::optional<lights::Light> last_;
   int frames_ = 0;
   int frames_seen_ = 0;
