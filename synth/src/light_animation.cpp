@@ -55,13 +55,12 @@ PocketLamp pocket_lamp(const Scene& scene, double degrees) {
   lamp.tag.y_axis = z.cross(lamp.tag.x_axis);
   lamp.tag.black_material = scene.material_index("tag_black");
   lamp.tag.white_material = scene.material_index("tag_white");
-  // The light hangs 12 cm below the tag's centre (beneath the card's lower edge), aimed at the table tag.
-  lamp.position_in_tag = Vector3d(0.0, 0.12, 0.0);
-  const Vector3d light_world = pivot + 0.12 * lamp.tag.y_axis;
-  const Vector3d axis_world = (aim_at - light_world).normalized();
   Eigen::Matrix3d tag_to_world;
   tag_to_world << lamp.tag.x_axis, lamp.tag.y_axis, lamp.tag.z_axis();
-  lamp.axis_in_tag = tag_to_world.transpose() * axis_world;
+  // The light hangs 12 cm below the tag's centre (beneath the card's lower edge), aimed at the table tag.
+  lamp.position_in_tag = Vector3d(0.0, 0.12, 0.0);
+  const Vector3d light_world = pivot + tag_to_world * lamp.position_in_tag;
+  lamp.axis_in_tag = tag_to_world.transpose() * (aim_at - light_world).normalized();
   // Turned about the vertical through the card's centre.
   const Eigen::Matrix3d turn = Eigen::AngleAxisd(degrees * std::numbers::pi / 180.0, world_up()).toRotationMatrix();
   lamp.tag.x_axis = turn * lamp.tag.x_axis;
