@@ -31,6 +31,7 @@
 #include "relight/capture/prefetch_source.h"
 #include "relight/capture/range_source.h"
 #include "relight/capture/source_stage.h"
+#include "relight/capture/tag_detection_stage.h"
 #include "relight/capture/tum_sequence.h"
 #include "relight/colormap/colormap_stages.h"
 #include "relight/colormap/tone_map_stage.h"
@@ -262,8 +263,10 @@ void add_camera_pose(ReplayPipeline& pipeline, const ReplayOptions& options) {
   tracking.source = options.pose;
   auto layout = marker_layout(options);
   tracking.has_marker_layout = layout.has_value();
+  // The tags of each frame for the marker pose and a tracked lamp alike (culled when neither runs).
+  pipeline.graph->emplace<capture::TagDetectionStage>();
   if (layout) {
-    pipeline.graph->emplace<capture::MarkerPoseStage>(std::move(*layout), capture::TagDetectorOptions{}, kSourceFrame);
+    pipeline.graph->emplace<capture::MarkerPoseStage>(std::move(*layout), kSourceFrame);
     pipeline.markers =
         &pipeline.graph->emplace<MarkerTrajectoryStage>(options.out / "marker_trajectory.txt", marker_layout_name(options));
   }

@@ -53,8 +53,7 @@ lights::Light lamp_light(const TrackedLamp& lamp, const Pose& tag_to_world) {
   return light;
 }
 
-TrackedLampStage::TrackedLampStage(TrackedLamp lamp, const capture::TagDetectorOptions& detector)
-    : lamp_(std::move(lamp)), detector_(detector) {
+TrackedLampStage::TrackedLampStage(TrackedLamp lamp) : lamp_(std::move(lamp)) {
   // The tag alone, in its own frame: the "camera pose" PnP finds against it is camera-to-tag.
   capture::TagLayout::Tag tag;
   tag.id = lamp_.tag_id;
@@ -66,7 +65,7 @@ TrackedLampStage::TrackedLampStage(TrackedLamp lamp, const capture::TagDetectorO
 }
 
 void TrackedLampStage::declare(StageBuilder& builder) {
-  color_ = builder.read(kColor);
+  detections_ = builder.read(capture::kTagDetections);
   depth_ = builder.read(kDepth);
   frame_ = builder.read(kFrame);
   room_ = builder.read(kRoomLights);
@@ -78,7 +77,7 @@ void TrackedLampStage::run(StageContext& context) {
   std::optional<Pose> seen;  // the tag's pose in the world this frame
   const FrameInfo& frame = context.get(frame_);
   if (frame.camera_to_world) {
-    const auto detections = detector_.detect(context.get(color_));
+    const std::vector<capture::TagDetection>& detections = context.get(detections_).tags;
     auto camera_to_tag = capture::estimate_camera_pose(detections, tag_alone_, frame.intrinsics);
     if (camera_to_tag) {
       camera_to_tag =

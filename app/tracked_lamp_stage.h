@@ -9,8 +9,9 @@
 //   position = tag_to_world * position_in_tag,  axis = R(tag_to_world) * axis_in_tag
 //
 // Stage TrackedLampStage ("tracked_lamp")
-//   reads:  "color" (ColorImage), "depth" (DepthMap), "frame" (FrameInfo: the intrinsics and the
-//           tracked camera_to_world), "room_lights" (LightSet: the other real lights)
+//   reads:  "tag_detections" (TagDetections, capture/tag_detection_stage.h: shared with the
+//           marker pose), "depth" (DepthMap), "frame" (FrameInfo: the intrinsics and the tracked
+//           camera_to_world), "room_lights" (LightSet: the other real lights)
 //   writes: "lights" (LightSet): the room's lights and the lamp, a real spot light. While the
 //           tag is out of view, or the camera has no pose, the lamp stays where it was last seen
 //           (a lamp does not vanish when its marker turns away); before its first sighting it is
@@ -20,7 +21,7 @@
 #include <optional>
 #include <string>
 
-#include "relight/capture/tag_detector.h"
+#include "relight/capture/tag_detection_stage.h"
 #include "relight/capture/tag_layout.h"
 #include "relight/core/buffers.h"
 #include "relight/core/frame_graph.h"
@@ -57,7 +58,7 @@ struct TrackedLamp {
 
 class TrackedLampStage final : public Stage {
  public:
-  explicit TrackedLampStage(TrackedLamp lamp, const capture::TagDetectorOptions& detector = {});
+  explicit TrackedLampStage(TrackedLamp lamp);
   [[nodiscard]] std::string name() const override { return "tracked_lamp"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
@@ -70,12 +71,11 @@ class TrackedLampStage final : public Stage {
  private:
   TrackedLamp lamp_;
   capture::TagLayout tag_alone_;  ///< the lamp's tag as a layout of its own frame
-  capture::TagDetector detector_;
   std::optional<lights::Light> last_;
   int frames_ = 0;
   int frames_seen_ = 0;
   int frames_held_ = 0;
-  Read<ColorImage> color_;
+  Read<capture::TagDetections> detections_;
   Read<DepthMap> depth_;
   Read<FrameInfo> frame_;
   Read<lights::LightSet> room_;

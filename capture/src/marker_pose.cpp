@@ -133,14 +133,14 @@ MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetect
 }
 
 void MarkerPoseStage::declare(StageBuilder& builder) {
-  color_ = builder.read(kColor);
+  detections_ = builder.read(kTagDetections);
   depth_ = builder.read(kDepth);
   frame_ = builder.read(frame_buffer_);
   pose_ = builder.write(kMarkerPose);
 }
 
 void MarkerPoseStage::run(StageContext& context) {
-  const auto detections = detector_.detect(context.get(color_));
+  const std::vector<TagDetection>& detections = context.get(detections_).tags;
   const PinholeIntrinsics& intrinsics = context.get(frame_).intrinsics;
   auto estimate = estimate_camera_pose(detections, layout_, intrinsics);
   if (estimate) estimate = refine_with_depth(*estimate, detections, layout_, intrinsics, context.get(depth_));

@@ -148,6 +148,7 @@ TEST(MarkerPoseStage, HoldsTheLastPoseWhenTheTagIsLost) {
   const ColorImage blank(640, 480, Rgb8{128, 128, 128});
   FrameGraph graph;
   graph.emplace<PoseFrameSource>(std::vector<ColorImage>{blank, tagged, blank});
+  graph.emplace<TagDetectionStage>();
   graph.emplace<MarkerPoseStage>(truth::tag_layout(scene));
   graph.keep("marker_pose");
   std::vector<CameraPose> poses;

@@ -9,7 +9,8 @@
 // measured to predicted depth over the tag's face scales the camera-to-tag vector.
 //
 // Stage MarkerPoseStage
-//   reads:  "color" (ColorImage), "depth" (DepthMap, for the refinement), "frame" (FrameInfo: intrinsics)
+//   reads:  "tag_detections" (TagDetections, tag_detection_stage.h), "depth" (DepthMap, for the
+//           refinement), "frame" (FrameInfo: intrinsics)
 //   writes: "marker_pose" (CameraPose): camera-to-world; when no known tag is visible the last
 //           pose is held and flagged (held = true), before the first detection valid = false.
 //   The frame buffer it reads is "frame" by default; in replay/live, where the camera tracking
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "relight/capture/camera_pose.h"
+#include "relight/capture/tag_detection_stage.h"
 #include "relight/capture/tag_detector.h"
 #include "relight/capture/tag_layout.h"
 #include "relight/core/buffers.h"
@@ -47,18 +49,17 @@ struct MarkerPose {
 
 class MarkerPoseStage final : public Stage {
  public:
-  MarkerPoseStage(TagLayout layout, const TagDetectorOptions& options = {}, BufferName<FrameInfo> frame_buffer = kFrame)
-      : layout_(std::move(layout)), detector_(options), frame_buffer_(frame_buffer) {}
+  explicit MarkerPoseStage(TagLayout layout, BufferName<FrameInfo> frame_buffer = kFrame)
+      : layout_(std::move(layout)), frame_buffer_(frame_buffer) {}
   [[nodiscard]] std::string name() const override { return "marker_pose"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
  private:
   TagLayout layout_;
-  TagDetector detector_;
   BufferName<FrameInfo> frame_buffer_;
   std::optional<MarkerPose> last_;
-  Read<ColorImage> color_;
+  Read<TagDetections> detections_;
   Read<DepthMap> depth_;
   Read<FrameInfo> frame_;
   Write<CameraPose> pose_;
