@@ -122,6 +122,11 @@ void register_synth(CLI::App& app, Runners& runners) {
                    "(pocket-lamp), over the sequence")
       ->capture_default_str();
   synth
+      ->add_option("--light-orbit-height", options->light_animation.orbit_height,
+                   "The orbiting light's height above the floor in metres (orbit; the table top is at 0.75; "
+                   "default: the key light's own, 2.2): a low light casts long shadows")
+      ->check(CLI::PositiveNumber);
+  synth
       ->add_option("--probe-noise", options->probe_noise,
                    "The probe camera's sensor noise: relative standard deviation per pixel, new every frame "
                    "(writes probe.txt + probe/ with each frame's probe)")

@@ -28,6 +28,7 @@ SequenceLightAnimation light_animation_of_scene_json(const std::string& text, co
     out.animation.event_frame = section.at("event_frame").get<int>();
     out.animation.dim_to = section.at("dim_to").get<double>();
     out.animation.orbit_degrees = section.at("orbit_degrees").get<double>();
+    out.animation.orbit_height = section.value("orbit_height", 0.0);
   } catch (const nlohmann::json::exception& error) {
     throw Error(source + ": light_animation: " + error.what());
   } catch (const Error& error) {
@@ -97,6 +98,8 @@ Scene scene_at_frame(const Scene& scene, const LightAnimationOptions& animation,
   }
   if (!(animation.dim_to >= 0.0 && animation.dim_to <= 1.0))
     throw Error("synth: light animation: dim_to must be in [0, 1]");
+  if (!(animation.orbit_height >= 0.0 && std::isfinite(animation.orbit_height)))
+    throw Error("synth: light animation: the orbit height must be a finite height above the floor");
   const int event = light_event_frame(animation, frames);
   if (event >= frames && (animation.kind == LightAnimation::SwitchOn || animation.kind == LightAnimation::SwitchOff)) {
     throw Error("synth: light animation: the switch frame " + std::to_string(event) + " is past the last frame");
@@ -113,6 +116,7 @@ Scene scene_at_frame(const Scene& scene, const LightAnimationOptions& animation,
     case LightAnimation::Dim: light.intensity *= 1.0 + (animation.dim_to - 1.0) * t; break;
     case LightAnimation::Orbit: {
       const double angle = animation.orbit_degrees * t * std::numbers::pi / 180.0;
+      if (animation.orbit_height > 0.0) light.position.z() = animation.orbit_height;
       const Eigen::Vector3d axis_point(scene.look_at.x(), scene.look_at.y(), light.position.z());
       light.position = axis_point + Eigen::AngleAxisd(angle, world_up()) * (light.position - axis_point);
       break;

@@ -207,6 +207,7 @@ std::string scene_json(const Scene& scene, const SynthOptions& options) {
                                {"event_frame", light_event_frame(animation, options.frames)},
                                {"dim_to", animation.dim_to},
                                {"orbit_degrees", animation.orbit_degrees},
+                               {"orbit_height", animation.orbit_height},
                                {"probe_stream", "probe.txt"},
                                {"lights_per_frame", "gt/lights/<timestamp>.json"}};
   }

@@ -57,6 +57,13 @@ TEST(LightAnimation, OrbitKeepsHeightAndDistanceAndTurnsByTheAngle) {
   const double turn = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b)) * 180.0 / std::numbers::pi;
   EXPECT_NEAR(turn, 60.0, 1e-9);  // counter-clockwise seen from above
   EXPECT_EQ(scene_at_frame(scene, orbit, 0, 5).lights[0].position, first.position);
+  // A lower orbit: the same turn and horizontal distance at the height asked for.
+  LightAnimationOptions low = orbit;
+  low.orbit_height = 1.2;
+  const Scene lowered_scene = scene_at_frame(scene, low, 4, 5);
+  const PointLight& lowered = lowered_scene.lights[0];
+  EXPECT_DOUBLE_EQ(lowered.position.z(), 1.2);
+  EXPECT_NEAR((lowered.position.head<2>() - last.position.head<2>()).norm(), 0.0, 1e-12);
 }
 
 TEST(LightAnimation, DimScalesTheIntensityLinearly) {
@@ -70,6 +77,7 @@ TEST(LightAnimation, DimScalesTheIntensityLinearly) {
 
 TEST(LightAnimation, BadOptionsAreErrors) {
   const Scene scene = default_indoor_scene();
+  EXPECT_THROW((void)scene_at_frame(scene, {.kind = LightAnimation::Orbit, .orbit_height = -1.0}, 0, 3), Error);
   EXPECT_THROW((void)scene_at_frame(scene, {.kind = LightAnimation::Dim, .light = 5}, 0, 4), Error);
   EXPECT_THROW((void)scene_at_frame(scene, {.kind = LightAnimation::Dim, .dim_to = 2}, 0, 4), Error);
   EXPECT_THROW((void)scene_at_frame(scene, {.kind = LightAnimation::SwitchOn, .event_frame = 4}, 0, 4), Error);

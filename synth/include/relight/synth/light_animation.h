@@ -6,7 +6,9 @@
 //   switch-off   as in the scene before frame k, off from frame k on
 //   dim          intensity scaled linearly from 1 at frame 0 to `dim_to` at the last frame
 //   orbit        position turned about the vertical axis through Scene::look_at by
-//                orbit_degrees * i / (n - 1) (height and distance kept)
+//                orbit_degrees * i / (n - 1) (horizontal distance kept; the height too unless
+//                orbit_height says otherwise: a low light casts long shadows, whose
+//                direction a test can read)
 // k = `event_frame`, by default n / 2. A light that is off is left out of the frame's lights
 // (the probe shows no emitter there; the rest of the scene is unchanged).
 //   pocket-lamp  a real spot light added to the scene's lights: a hand-held lamp (dissertation
@@ -37,6 +39,7 @@ struct LightAnimationOptions {
   int event_frame = -1;       ///< switch-on/off frame k; < 0: frames / 2
   double dim_to = 0.25;       ///< dim: the last frame's intensity factor
   double orbit_degrees = 90;  ///< orbit, pocket-lamp: the turn over the whole sequence
+  double orbit_height = 0;    ///< orbit: the light's height above the floor in metres; 0 keeps the scene's
 };
 
 /// The hand-held lamp of the pocket-lamp animation: its light is rigidly fixed to the tag, so
