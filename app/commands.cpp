@@ -158,8 +158,16 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
   add_choice_option(command, "--bounce-method", options.bounce_method, render::kBounceMethodNames,
-                    "How bounces after the first find their surface: rays (ray traced) or cone (the nearest of "
-                    "the surface points within 5 degrees of the sampled direction, no ray tracing)");
+                    "How bounces after the first find their surface: rays (ray traced), cone (the nearest of "
+                    "the surface points within 5 degrees of the sampled direction, no ray tracing), or "
+                    "previous-frame (the multiple-bounce light source: --bounce-share of the --vpls samples "
+                    "continue the previous frame's VPLs, so the bounces build up over frames at a fixed cost)");
+  command
+      .add_option("--bounce-share", options.bounce_share,
+                  "--bounce-method previous-frame: the share of the --vpls light samples that continue the "
+                  "previous frame's VPLs")
+      ->check(CLI::Range(0.01, 0.99))
+      ->capture_default_str();
   add_choice_option(command, "--vpl-source", options.vpl_source, render::kVplSourceNames,
                     "Where a spot light's first VPLs come from: rays (traced from the light) or rsm (importance-"
                     "sampled texels of its reflective shadow maps, rasterised on the Vulkan device)");

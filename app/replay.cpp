@@ -217,6 +217,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.vpls.light_weights = options.vpl_weights;
   dir.vpls.bounces = options.vpl_bounces;
   dir.vpls.bounce_method = options.bounce_method;
+  dir.vpls.bounce_share = options.bounce_share;
   dir.vpls.source = options.vpl_source;
   dir.coarse_mesh_stride = options.coarse_mesh_stride;
   dir.tone_map = {.op = options.tone_map,
@@ -243,6 +244,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
       render::add_dir_stages(graph, rendering, pipeline.vulkan.get(), std::move(content), dir);
   pipeline.camera_look = stages.camera_look;
   pipeline.tone_map = stages.tone_map;
+  pipeline.vpls = stages.vpls;
   graph.keep(kComposite);
   pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, look.artefacts.any());
   if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", pipeline.final_composite);
@@ -336,6 +338,26 @@ nlohmann::ordered_json camera_look_json(const render::CameraLookSummary& summary
           {"noise", std::move(noise)}};
 }
 
+// The VPLs of the run: options and mean counts per frame by bounce.
+nlohmann::ordered_json vpl_json(const render::VplStage& stage) {
+  const render::VplOptions& options = stage.options();
+  const render::VplStage::Summary summary = stage.summary();
+  nlohmann::ordered_json per_bounce = nlohmann::ordered_json::object();
+  for (std::size_t bounce = 0; bounce < summary.mean_by_bounce.size(); ++bounce) {
+    if (summary.mean_by_bounce[bounce] <= 0.0) continue;
+    per_bounce[bounce == 0 ? std::string("emitters") : "bounce_" + std::to_string(bounce)] =
+        summary.mean_by_bounce[bounce];
+  }
+  nlohmann::ordered_json json{{"light_samples", options.count},
+                              {"bounces", options.bounces},
+                              {"bounce_method", name_of(render::kBounceMethodNames, options.bounce_method)},
+                              {"source", name_of(render::kVplSourceNames, options.source)},
+                              {"mean_per_frame", std::move(per_bounce)},
+                              {"first_frame_later_bounces", summary.first_frame_later_bounces}};
+  if (options.bounce_method == render::BounceMethod::PreviousFrame) json["bounce_share"] = options.bounce_share;
+  return json;
+}
+
 }  // namespace
 
 void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline& pipeline,
@@ -360,6 +382,7 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
                              {"extracted_lights", pipeline.extracted_lights}};
     report["composite"] = {{"rule", name_of(render::kCompositeRuleNames, pipeline.composite_rule)}};
   }
+  if (pipeline.vpls) report["vpls"] = vpl_json(*pipeline.vpls);
   if (pipeline.camera_look) report["camera_look"] = camera_look_json(pipeline.camera_look->summary());
   if (pipeline.tone_map) report["tone_map"] = tone_map_json(pipeline.tone_map->options(), pipeline.tone_map->last());
   report["latency_ms"] = pipeline.latency->summary();

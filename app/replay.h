@@ -101,6 +101,7 @@ struct ReplayOptions {
   /// 640 across (render/dir/dir_stage.h's DirStageOptions::coarse_mesh_stride); 2 or less: none.
   int coarse_mesh_stride = render::DirStageOptions{}.coarse_mesh_stride;
   render::BounceMethod bounce_method = render::BounceMethod::RayTraced;  ///< how bounces >= 2 find surfaces
+  float bounce_share = render::VplOptions{}.bounce_share;  ///< BounceMethod::PreviousFrame's share of --vpls
   render::VplSource vpl_source = render::VplSource::RayTraced;           ///< where spot lights' first VPLs come from
   RealAlbedo real_albedo = RealAlbedo::Pixel;
   float exposure = 1.f;  ///< tone mapping of the rendered light (exposure operator)
@@ -147,6 +148,7 @@ struct ReplayPipeline {
   render::CompositeRule composite_rule = render::CompositeRule::Additive;  ///< as resolved for this run
   render::CameraLookStage* camera_look = nullptr;          ///< set with --camera-artefacts other than none
   colormap::ToneMapStage* tone_map = nullptr;              ///< set when the DIR stage is in the graph
+  render::VplStage* vpls = nullptr;                        ///< set when the DIR stage is in the graph
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
   int extracted_lights = 0;                       ///< lights extracted per frame (probe or estimate); 0: none

@@ -18,7 +18,8 @@
 // dir/two_bounces_vs_reference: the same comparison at 160x120 against a path tracer with two
 // indirect bounces, for DIR (Vulkan, 256 light samples) with one bounce, with two whose second
 // bounce is ray traced, and with two found by the point-cone method (vpl.h), its search on the
-// CPU and on Vulkan (cone_search_vk.h); median of 3 runs.
+// CPU and on Vulkan (cone_search_vk.h), and with two from the multiple-bounce light source
+// (BounceMethod::PreviousFrame; each run is the next frame of the static scene); median of 3 runs.
 // dir/environment_vpls_vs_directional: the room as replay reconstructs it (its depth mesh) with
 // the pebble, under a uniform sky (no lamps), the path tracer its truth; DIR lights it with the sky importance-sampled
 // into directional lights, 64 reaching the scene as emitter VPLs shadowed by their ISMs (ours, vpl.h) against 8
@@ -191,21 +192,36 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
   bench::Json json{{"renderer", "dir_vulkan"}, {"device", context->device_info().name}, {"light_samples", 256},
                    {"reference_spp", kReferenceSpp}, {"reference_bounces", 2}};
   render::ConeSearchVk cone_search(*context);
-  const auto run = [&](int bounces, render::BounceMethod method, render::ConeSearchVk* gpu = nullptr) {
+  const auto run = [&](int bounces, render::BounceMethod method, render::ConeSearchVk* gpu = nullptr,
+                       int light_samples = 256) {
     render::VplOptions vpl_options;
-    vpl_options.count = 256;
+    vpl_options.count = light_samples;
     vpl_options.bounces = bounces;
     vpl_options.bounce_method = method;
     std::vector<double> ms, vpl_ms;
     Errors errors;
     std::size_t vpl_count = 0;
+    // The multiple-bounce light source continues the previous frame's VPLs: a first frame to
+    // continue, then every repetition is the next frame of the static scene.
+    std::vector<render::Vpl> previous;
+    std::vector<Phong> previous_surfaces;
+    if (method == render::BounceMethod::PreviousFrame) {
+      previous = render::generate_vpls(scene, tracer, vpl_options);
+      previous_surfaces = render::vpl_surfaces(scene, previous);
+    }
     for (int repetition = 0; repetition < 3; ++repetition) {
+      vpl_options.previous_vpls = previous;
+      vpl_options.previous_surfaces = previous_surfaces;
       const auto start = Clock::now();
-      const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options, {.cone_search = gpu});
+      std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options, {.cone_search = gpu});
       vpl_ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
       errors = compare(renderer.render(camera, vpls, vk_options), reference);
       ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
       vpl_count = vpls.size();
+      if (method == render::BounceMethod::PreviousFrame) {
+        previous_surfaces = render::vpl_surfaces(scene, vpls);
+        previous = std::move(vpls);
+      }
     }
     std::sort(ms.begin(), ms.end());
     std::sort(vpl_ms.begin(), vpl_ms.end());
@@ -216,6 +232,10 @@ bench::Json two_bounces_vs_reference(const bench::Options&) {
   json["two_bounces_rays"] = run(2, render::BounceMethod::RayTraced);
   json["two_bounces_cone"] = run(2, render::BounceMethod::PointCone);
   json["two_bounces_cone_search_on_vulkan"] = run(2, render::BounceMethod::PointCone, &cone_search);
+  // The multiple-bounce light source (vpl.h): a quarter of the 256 samples continue the previous
+  // frame's VPLs; and with as many first-bounce samples as the others (341 in all).
+  json["two_bounces_previous_frame"] = run(2, render::BounceMethod::PreviousFrame);
+  json["two_bounces_previous_frame_341"] = run(2, render::BounceMethod::PreviousFrame, nullptr, 341);
   json["ms"] = json["two_bounces_cone_search_on_vulkan"]["ms"];
   return json;
 }

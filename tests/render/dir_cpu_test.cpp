@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <numbers>
 #include <random>
 #include <tuple>
@@ -29,12 +30,36 @@ struct Rendered {
   std::vector<Vpl> vpls;
 };
 
+/// The multiple-bounce light source's next frame (BounceMethod::PreviousFrame) after `previous`.
+std::vector<Vpl> frame_after(const MrScene& scene, const RayTracer& tracer, VplOptions options,
+                             const std::vector<Vpl>& previous) {
+  const std::vector<Phong> surfaces = vpl_surfaces(scene, previous);
+  options.bounce_method = BounceMethod::PreviousFrame;
+  options.previous_vpls = previous;
+  options.previous_surfaces = surfaces;
+  return generate_vpls(scene, tracer, options);
+}
+
+/// Red flux of the VPLs `counts` accepts.
+double red_flux(const std::vector<Vpl>& vpls, const std::function<bool(const Vpl&)>& counts) {
+  double sum = 0.0;
+  for (const Vpl& vpl : vpls) sum += counts(vpl) ? static_cast<double>(vpl.flux.x()) : 0.0;
+  return sum;
+}
+
+std::function<bool(const Vpl&)> of_bounce(int bounce) {
+  return [bounce](const Vpl& vpl) { return vpl.bounce == bounce; };
+}
+
 Rendered render_dir(const MrScene& scene, const MrCamera& camera, int vpl_count, DirOptions options = {},
                     VplOptions vpl_options = {}) {
   const RayTracer tracer(scene);
   vpl_options.count = vpl_count;
   Rendered out;
   out.vpls = generate_vpls(scene, tracer, vpl_options);
+  // The multiple-bounce light source continues the previous frame's VPLs: a second frame.
+  if (vpl_options.bounce_method == BounceMethod::PreviousFrame)
+    out.vpls = frame_after(scene, tracer, vpl_options, out.vpls);
   out.images = shade_instant_radiosity(scene, tracer, camera, out.vpls, options);
   return out;
 }
@@ -363,11 +388,9 @@ TEST(DirCpu, DifferentialAgreesWithThePathTracerInShadowAndBleedingRegions) {
       << "bleeding region";
 }
 
-// The point-cone continuation (BounceMethod::PointCone, vpl.h) against rays, VPL by VPL: in a
-// closed box the same random numbers sample the same directions, so the second-bounce VPLs pair
-// up, land where the rays do, and carry the same flux; a path ends only where a short hop's cone
-// holds no point (1 of 400 here).
-TEST(Vpls, ConeBounceLandsNearTheRayTracedHit) {
+/// A closed 2 m box of white (k_d 0.5) walls around a point light off its centre: every light
+/// path bounces on and on, and each bounce keeps half of the energy.
+MrScene closed_white_box() {
   MrScene scene;
   const std::uint32_t white = scene.add_material(diffuse(Eigen::Vector3f::Constant(0.5f)));
   scene.meshes.push_back(truth::tessellate(synth::Box{{-1, -1, -1}, {1, 1, 1}}, white));
@@ -375,6 +398,15 @@ TEST(Vpls, ConeBounceLandsNearTheRayTracedHit) {
   light.position = {0.3f, -0.2f, 0.1f};
   light.intensity = Eigen::Vector3f::Constant(1.f);
   scene.lights = {light};
+  return scene;
+}
+
+// The point-cone continuation (BounceMethod::PointCone, vpl.h) against rays, VPL by VPL: in a
+// closed box the same random numbers sample the same directions, so the second-bounce VPLs pair
+// up, land where the rays do, and carry the same flux; a path ends only where a short hop's cone
+// holds no point (1 of 400 here).
+TEST(Vpls, ConeBounceLandsNearTheRayTracedHit) {
+  const MrScene scene = closed_white_box();
   const RayTracer tracer(scene);
   VplOptions options;
   options.count = 400;
@@ -437,9 +469,107 @@ TEST(Vpls, ConeBounceLandsNearTheRayTracedHit) {
   EXPECT_THROW((void)generate_vpls(scene, tracer, options), Error);
 }
 
-// Two indirect bounces against the path tracer with two, in the regions where the virtual cube
-// changes the floor (its shadow and its red bleeding), for both continuations. Measured: rays
-// 0.010 (shadow) and 0.054 (bleeding), point cone 0.007 and 0.114.
+// The multiple-bounce light source (BounceMethod::PreviousFrame): on the first frame every sample
+// goes to the light; on the next, a quarter of them continue the previous frame's VPLs, and the
+// second bounce they carry has the energy of the ray-traced continuation of every path (same
+// BRDF sampling, sources chosen by flux); a third frame adds a third bounce when asked for.
+TEST(Vpls, PreviousFrameBouncesCarryTheEnergyOfTheRayTracedOnes) {
+  const MrScene scene = closed_white_box();
+  const RayTracer tracer(scene);
+  VplOptions options;
+  options.count = 4000;
+  options.bounces = 2;
+  const std::vector<Vpl> rays = generate_vpls(scene, tracer, options);
+  options.bounce_method = BounceMethod::PreviousFrame;
+  const std::vector<Vpl> first = generate_vpls(scene, tracer, options);
+  EXPECT_EQ(first.size(), 4000u) << "the first frame has no VPLs to continue: every sample goes to the light";
+  EXPECT_EQ(red_flux(first, of_bounce(2)), 0.0);
+  const std::vector<Vpl> second = frame_after(scene, tracer, options, first);
+  EXPECT_EQ(std::count_if(second.begin(), second.end(), of_bounce(1)), 3000);
+  EXPECT_EQ(std::count_if(second.begin(), second.end(), of_bounce(2)), 1000);
+  const double ray_flux = red_flux(rays, of_bounce(2)), continued_flux = red_flux(second, of_bounce(2));
+  std::printf("second-bounce flux: rays %.4f, previous frame %.4f; first bounce %.4f and %.4f\n", ray_flux,
+              continued_flux, red_flux(rays, of_bounce(1)), red_flux(second, of_bounce(1)));
+  EXPECT_NEAR(continued_flux / ray_flux, 1.0, 0.05);
+  EXPECT_NEAR(red_flux(second, of_bounce(1)) / red_flux(rays, of_bounce(1)), 1.0, 0.01) << "fewer, same energy";
+  for (const Vpl& vpl : second) EXPECT_GT(vpl.normal.dot(vpl.incident), 0.f);
+  // The second frame's VPLs of bounce 2 are sources in turn when three bounces are asked for.
+  EXPECT_EQ(red_flux(frame_after(scene, tracer, options, second), of_bounce(3)), 0.0);
+  options.bounces = 3;
+  const std::vector<Vpl> third = frame_after(scene, tracer, options, second);
+  EXPECT_GT(red_flux(third, of_bounce(3)), 0.1 * red_flux(third, of_bounce(2)));
+  options.bounce_share = 1.f;
+  EXPECT_THROW((void)generate_vpls(scene, tracer, options), Error);
+  options.bounce_share = 0.25f;
+  const std::vector<Phong> surfaces = vpl_surfaces(scene, second);
+  options.previous_vpls = second;
+  options.previous_surfaces = std::span(surfaces).first(10);  // fewer than the VPLs
+  EXPECT_THROW((void)generate_vpls(scene, tracer, options), Error);
+}
+
+// With a virtual box in the room, each world's second bounce keeps its energy (the sources on
+// the box and behind it are a stratum of their own, picked uniformly).
+TEST(Vpls, PreviousFrameBouncesKeepEachWorldsEnergy) {
+  MrScene scene = closed_white_box();
+  test::add_virtual_box(scene, synth::Box{{-0.3, -0.3, -1.0}, {0.1, 0.1, -0.5}}, diffuse({0.9f, 0.2f, 0.1f}, "box"));
+  const RayTracer tracer(scene);
+  VplOptions options;
+  options.count = 20000;
+  options.bounces = 2;
+  const std::vector<Vpl> rays = generate_vpls(scene, tracer, options);
+  options.bounce_method = BounceMethod::PreviousFrame;
+  const std::vector<Vpl> second = frame_after(scene, tracer, options, generate_vpls(scene, tracer, options));
+  for (const bool real : {true, false}) {
+    const auto second_bounce_in_world = [real](const Vpl& vpl) {
+      return vpl.bounce == 2 && (real ? vpl.in_real : vpl.in_real_virtual);
+    };
+    const double by_rays = red_flux(rays, second_bounce_in_world), continued = red_flux(second, second_bounce_in_world);
+    std::printf("%s world, second-bounce flux: rays %.4f, previous frame %.4f\n", real ? "real" : "real+virtual",
+                by_rays, continued);
+    EXPECT_NEAR(continued / by_rays, 1.0, 0.05);
+  }
+}
+
+// The multiple-bounce light source converges to the path tracer's two bounces as samples grow
+// (the second frame of a static scene: a quarter of the samples continue the first frame's
+// VPLs, the first-bounce samples as many as the others'). Means over six seeds, since one seed's
+// error in the bleeding region varies several-fold for every method here (rays: 0.04-0.30 at
+// 1024 samples). Measured: shadow 0.010 and 0.011, bleeding 0.401 and 0.112 at 1365 and 5460
+// samples (rays at 1024 and 4096: 0.008 and 0.014, 0.147 and 0.068). On this open floor few
+// continued paths meet anything, so a quarter of the samples buys less than continuing every
+// path does; dir/two_bounces_vs_reference compares them in a room.
+TEST(DirCpu, PreviousFrameBouncesConvergeToThePathTracer) {
+  const MrScene scene = cube_scene();
+  const MrCamera camera = test::comparison_camera();
+  const DifferentialImages pt = test::reference_images(scene, camera, 2);
+  DirOptions options;
+  options.min_distance = 0.02f;
+  constexpr int kSeeds = 6;
+  const auto mean_errors = [&](int count) {
+    double shadow = 0.0, bleeding = 0.0;
+    for (std::uint64_t seed = 1; seed <= kSeeds; ++seed) {
+      VplOptions vpl_options;
+      vpl_options.bounces = 2;
+      vpl_options.seed = seed;
+      vpl_options.bounce_method = BounceMethod::PreviousFrame;
+      const Rendered dir = render_dir(scene, camera, count, options, vpl_options);
+      EXPECT_GT(std::count_if(dir.vpls.begin(), dir.vpls.end(), [](const Vpl& v) { return v.bounce == 2; }), 0);
+      shadow += test::delta_error_on_floor(scene, camera, pt, dir.images, test::kShadowLo, test::kShadowHi) / kSeeds;
+      bleeding +=
+          test::delta_error_on_floor(scene, camera, pt, dir.images, test::kBleedingLo, test::kBleedingHi) / kSeeds;
+    }
+    std::printf("previous-frame bounces, %d samples: mean delta-L error %.3f in the shadow, %.3f in the bleeding\n",
+                count, shadow, bleeding);
+    return std::pair{shadow, bleeding};
+  };
+  const auto [shadow, bleeding] = mean_errors(1365);
+  const auto [shadow_4x, bleeding_4x] = mean_errors(4 * 1365);
+  EXPECT_LT(shadow, 0.05);
+  EXPECT_LT(shadow_4x, 0.05);
+  EXPECT_LT(bleeding_4x, 0.5 * bleeding) << "the error falls with the samples";
+  EXPECT_LT(bleeding_4x, 0.2);
+}
+
 TEST(DirCpu, TwoBouncesAgreeWithThePathTracer) {
   const MrScene scene = cube_scene();
   const MrCamera camera = test::comparison_camera();
@@ -454,7 +584,7 @@ TEST(DirCpu, TwoBouncesAgreeWithThePathTracer) {
     const double shadow = test::delta_error_on_floor(scene, camera, pt, dir.images, test::kShadowLo, test::kShadowHi);
     const double bleeding =
         test::delta_error_on_floor(scene, camera, pt, dir.images, test::kBleedingLo, test::kBleedingHi);
-    const char* name = method == BounceMethod::RayTraced ? "rays" : "point cone";
+    const char* name = name_of(kBounceMethodNames, method);
     std::printf("two bounces, %s: delta-L error %.3f in the shadow, %.3f in the bleeding region\n", name, shadow,
                 bleeding);
     EXPECT_LT(shadow, 0.15) << name;

@@ -50,12 +50,12 @@ MrCamera frame_camera(const FrameInfo& frame, int width, int height) {
 DirStages add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* given_context, DirSceneContent content,
                          const DirStageOptions& options) {
   vk::VulkanContext* context = context_for_backend(backend, given_context, "add_dir_stages");
+  DirStages stages;
   graph.emplace<MrSceneStage>(std::move(content), options);
-  graph.emplace<VplStage>(options.vpls, context);
+  stages.vpls = &graph.emplace<VplStage>(options.vpls, context);
   graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffers, options.edge_samples);
   graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
   const bool camera_look = options.camera_look && options.camera_look->artefacts.any();
-  DirStages stages;
   if (camera_look) stages.camera_look = &graph.emplace<CameraLookStage>(*options.camera_look);
   stages.tone_map = &graph.emplace<colormap::ToneMapStage>(options.tone_map);
   graph.emplace<DifferentialCompositeStage>(camera_look, options.composite);
@@ -157,27 +157,49 @@ VplStage::~VplStage() = default;
 
 void VplStage::declare(StageBuilder& builder) {
   scene_ = builder.read(kMrScene);
-  if (options_.budget == VplBudget::ByPreviousFlux) previous_ = builder.read_previous(kVpls);
+  if (options_.budget == VplBudget::ByPreviousFlux || continues_previous_vpls())
+    previous_ = builder.read_previous(kVpls);
   vpls_ = builder.write(kVpls);
 }
 
 void VplStage::run(StageContext& context) {
   const MrScene& scene = context.get(scene_);
-  if (options_.budget == VplBudget::ByPreviousFlux) {
-    const VplSet* previous = context.get(previous_);
+  const VplSet* previous =
+      options_.budget == VplBudget::ByPreviousFlux || continues_previous_vpls() ? context.get(previous_) : nullptr;
+  if (options_.budget == VplBudget::ByPreviousFlux)
     options_.previous_flux = previous ? vpl_flux_per_light(previous->vpls, scene.lights.size()) : std::vector<double>{};
+  if (continues_previous_vpls()) {
+    options_.previous_vpls = previous ? std::span<const Vpl>(previous->vpls) : std::span<const Vpl>{};
+    options_.previous_surfaces = previous ? std::span<const Phong>(previous->surfaces) : std::span<const Phong>{};
   }
   if (reflective_shadow_maps_) reflective_shadow_maps_->set_scene(scene);
   // Onto the coarse copy of the reconstruction when there is one: its BVH builds in a quarter of
   // the time, and a VPL lands on the same surface within a few millimetres.
   const RayTracer tracer(scene.coarse_real_meshes.empty() ? scene : coarse_scene(scene), RayTracer::Build::Fast);
-  context.get(vpls_).vpls =
+  VplSet& out = context.get(vpls_);
+  out.vpls =
       generate_vpls(scene, tracer, options_,
                     {.cone_search = cone_search_.get(), .reflective_shadow_maps = reflective_shadow_maps_.get()});
+  out.surfaces = vpl_surfaces(scene, out.vpls);
+  for (const Vpl& vpl : out.vpls) {
+    const auto bounce = static_cast<std::size_t>(std::max(vpl.bounce, 0));
+    if (count_by_bounce_.size() <= bounce) count_by_bounce_.resize(bounce + 1, 0.0);
+    count_by_bounce_[bounce] += 1.0;
+    if (frames_ == 0 && vpl.bounce >= 2) ++first_frame_later_bounces_;
+  }
+  ++frames_;
+  options_.previous_vpls = {};  // they belong to the history buffer, which the graph may reuse
+  options_.previous_surfaces = {};
   // The GPU time of this frame's searches and RSM passes (the helpers count since the last take).
   const double gpu_ms = (cone_search_ ? cone_search_->take_gpu_ms() : 0.0) +
                         (reflective_shadow_maps_ ? reflective_shadow_maps_->take_gpu_ms() : 0.0);
   if (gpu_ms > 0.0) context.report_device_ms(gpu_ms);
+}
+
+VplStage::Summary VplStage::summary() const {
+  Summary summary{frames_, count_by_bounce_, first_frame_later_bounces_};
+  for (double& count : summary.mean_by_bounce) count /= std::max(frames_, 1);
+  return summary;
 }
 
 // ---- dir ---------------------------------------------------------------------------------------

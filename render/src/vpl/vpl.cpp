@@ -127,6 +127,7 @@ void add_emitters(const MrScene& scene, const BoundingSphere& bounds, std::vecto
     Vpl emitter;
     emitter.position = bounds.centre + kEmitterDistance * radius * towards_light;
     emitter.normal = -towards_light;
+    emitter.geometric_normal = emitter.normal;
     emitter.incident = towards_light;
     emitter.flux = light.intensity;
     emitter.on_real_surface = light.real;
@@ -138,7 +139,93 @@ void add_emitters(const MrScene& scene, const BoundingSphere& bounds, std::vecto
   }
 }
 
+/// Sources of the multiple-bounce light source: picked in proportion to their flux's luminance,
+/// or uniformly.
+class SourceStratum {
+ public:
+  explicit SourceStratum(bool by_flux) : by_flux_(by_flux) {}
+  void add(std::size_t index, double luminance) {
+    if (!(luminance > 0.0)) return;
+    total_ += by_flux_ ? luminance : 1.0;
+    indices_.push_back(index);
+    cumulative_.push_back(total_);
+  }
+  [[nodiscard]] std::size_t size() const { return indices_.size(); }
+  /// The source at u in [0, 1) and the probability it had.
+  [[nodiscard]] std::pair<std::size_t, double> pick(double u) const {
+    const auto found = static_cast<std::size_t>(std::upper_bound(cumulative_.begin(), cumulative_.end(), u * total_) -
+                                                cumulative_.begin());
+    const std::size_t k = std::min(found, indices_.size() - 1);
+    return {indices_[k], (cumulative_[k] - (k > 0 ? cumulative_[k - 1] : 0.0)) / total_};
+  }
+
+ private:
+  bool by_flux_;
+  std::vector<std::size_t> indices_;
+  std::vector<double> cumulative_;
+  double total_ = 0.0;
+};
+
+/// The multiple-bounce light source (vpl.h): `n` segments continuing the paths of the previous
+/// frame's VPLs of bounce below options.bounces, in directions sampled from the sources' BRDFs.
+/// Two strata cover every source once:
+///   differential  VPLs on virtual objects or in one world only: the virtual objects' own
+///                 bounces, the part of the light the composite shows. Most carry little flux
+///                 (the virtual-focus samples of their light), so flux-proportional picking would
+///                 give each continuation the stratum's mean flux: a few bright VPLs beside the
+///                 object, and blotches. They are picked uniformly instead, each continuation
+///                 keeping its source's flux (times count / samples), and get up to
+///                 `virtual_share` of the samples - no more than there are of them;
+///   rest          the others, picked by flux, stratified: their bounces are mostly real light,
+///                 which the differential image only sees where a virtual object blocks it.
+void emit_from_previous_vpls(int n, const VplOptions& options, VplTracer& tracer) {
+  const std::span<const Vpl> sources = options.previous_vpls;
+  SourceStratum differential(false), rest(true);
+  for (std::size_t i = 0; i < sources.size(); ++i) {
+    const Vpl& source = sources[i];
+    if (source.emitter() || source.bounce >= options.bounces) continue;
+    const bool differs = !source.on_real_surface || source.in_real != source.in_real_virtual;
+    (differs ? differential : rest).add(i, static_cast<double>(luminance(source.flux)));
+  }
+  if (n <= 0 || differential.size() + rest.size() == 0) return;
+  int n_differential = 0;
+  if (rest.size() == 0) {
+    n_differential = n;
+  } else if (differential.size() > 0) {
+    const auto wanted = static_cast<int>(std::lround(options.virtual_share * n));
+    n_differential = std::min(std::max(wanted, 1), static_cast<int>(differential.size()));
+    if (n >= 2) n_differential = std::min(n_differential, n - 1);
+  }
+  for (int i = 0; i < n; ++i) {
+    // A stream of its own: light indices never reach 2^32 - 1.
+    Pcg32 rng = Pcg32::for_sample(options.seed, 0xffffffffu, static_cast<std::uint64_t>(i));
+    const bool in_differential = i < n_differential;
+    const int stratum_count = in_differential ? n_differential : n - n_differential;
+    const int j = in_differential ? i : i - n_differential;
+    const auto [index, probability] =
+        (in_differential ? differential : rest).pick((j + rng.uniform()) / static_cast<double>(stratum_count));
+    if (!(probability > 0.0)) continue;
+    const Vpl& source = sources[index];
+    const float u1 = rng.uniform(), u2 = rng.uniform();
+    const auto sample = sample_phong(options.previous_surfaces[index], source.normal, source.incident, u1, u2);
+    // As a path continued in its own frame (vpl_tracer.h): above the geometric surface only.
+    if (!sample || sample->wi.dot(source.geometric_normal) <= 0.f) continue;
+    const Vec3 flux = source.flux.cwiseProduct(sample->weight) / static_cast<float>(probability * stratum_count);
+    const float offset = 1e-4f * (1.f + source.position.cwiseAbs().maxCoeff());
+    tracer.set_light(source.light);
+    tracer.emit(source.position + offset * source.geometric_normal, sample->wi, flux, source.in_real_virtual,
+                source.in_real, source.bounce + 1, rng);
+  }
+}
+
 }  // namespace
+
+std::vector<Phong> vpl_surfaces(const MrScene& scene, std::span<const Vpl> vpls) {
+  std::vector<Phong> surfaces;
+  surfaces.reserve(vpls.size());
+  for (const Vpl& vpl : vpls) surfaces.push_back(vpl.emitter() ? Phong{} : vpl_phong(scene, vpl));
+  return surfaces;
+}
 
 std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, const VplOptions& options,
                                const VplGpu& gpu) {
@@ -151,11 +238,21 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
   if (options.source == VplSource::ReflectiveShadowMaps &&
       (options.rsm_size < 1 || options.rsm_size > 4096 || !std::has_single_bit(static_cast<unsigned>(options.rsm_size))))
     throw Error("the RSM size must be a power of two in [1, 4096]");
+  const bool from_previous = options.bounce_method == BounceMethod::PreviousFrame;
+  if (from_previous && !(options.bounce_share > 0.f && options.bounce_share < 1.f))
+    throw Error("the share of VPLs that continue the previous frame's must be in (0, 1)");
+  if (options.previous_surfaces.size() != options.previous_vpls.size())
+    throw Error("the previous frame's VPLs and their surfaces differ in number");
   std::vector<Vpl> vpls;
   VplTracer vpl_tracer(scene, tracer, options, vpls, gpu.cone_search);
   if (options.virtual_share < 0.f || options.virtual_share >= 1.f) throw Error("the virtual VPL share must be in [0, 1)");
   const BoundingSphere bounds = bounding_sphere(scene);
-  const std::vector<int> budget = light_budget(scene, bounds, options);
+  // The multiple-bounce light source's share of the samples, once there are VPLs to continue.
+  const bool continues = from_previous && options.bounces > 1 && !options.previous_vpls.empty();
+  const int continued = continues ? static_cast<int>(std::lround(options.bounce_share * options.count)) : 0;
+  VplOptions primary = options;
+  primary.count = options.count - continued;
+  const std::vector<int> budget = light_budget(scene, bounds, primary);
   const BoundingSphere virtual_sphere = virtual_bounds(scene);
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     const MrLight& light = scene.lights[l];
@@ -190,6 +287,7 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
                       light.real, 1, rng);
     }
   }
+  emit_from_previous_vpls(continued, options, vpl_tracer);
   vpl_tracer.finish();
   add_emitters(scene, bounds, vpls);
   return vpls;

@@ -147,6 +147,7 @@ class VplTracer {
     const Vec3 geometric = hit.geometric_normal.dot(vpl.incident) < 0.f ? Vec3(-hit.geometric_normal) : hit.geometric_normal;
     vpl.normal = hit.shading_normal.dot(geometric) < 0.f ? Vec3(-hit.shading_normal) : hit.shading_normal;
     if (vpl.normal.dot(vpl.incident) <= 0.f) vpl.normal = geometric;
+    vpl.geometric_normal = geometric;
     vpl.flux = flux;
     vpl.material = hit.material;
     vpl.kd_texture = base_color_at(scene_, hit);
@@ -159,7 +160,8 @@ class VplTracer {
     vpl.parent = parent;
     const auto index = static_cast<std::uint32_t>(out_.size());
     out_.push_back(vpl);
-    if (bounce >= options_.bounces) return;
+    // The multiple-bounce light source continues this path next frame, not now (vpl.h).
+    if (bounce >= options_.bounces || options_.bounce_method == BounceMethod::PreviousFrame) return;
     // Continue the light path by sampling the VPL's BRDF (reciprocity: wo = where light came from).
     const float u1 = rng.uniform(), u2 = rng.uniform();
     const auto sample = sample_phong(vpl_phong(scene_, vpl), vpl.normal, vpl.incident, u1, u2);

@@ -15,8 +15,10 @@
 //                                   buffer when set, none while it is unresolved); with
 //                                   EnvironmentLight::Vpls every directional light reaches the
 //                                   scene through its emitter VPL (MrLight::through_vpl)
-//   vpls                     reads  MrScene "mr_scene"; with VplBudget::ByPreviousFlux also the
-//                                   previous frame's VplSet "vpls" (its flux per light)
+//   vpls                     reads  MrScene "mr_scene"; with VplBudget::ByPreviousFlux or
+//                                   BounceMethod::PreviousFrame also the previous frame's VplSet
+//                                   "vpls" (its flux per light; the VPLs the multiple-bounce light
+//                                   source continues, Knecht 2010 §4.3)
 //                            writes VplSet "vpls" (vpl.h), traced onto MrScene::coarse_real_meshes
 //                                   in place of the real meshes when the scene has them
 //   dir                      reads  FrameInfo "frame", ColorImage "color" and PositionMap
@@ -87,6 +89,8 @@ class ToneMapStage;
 
 namespace relight::render {
 
+class VplStage;
+
 /// How the directional lights of the environment (the probe's lights) light the scene:
 ///   Directional  through the direct pass, each with two orthographic shadow maps (real and
 ///                virtual layer) rasterised every frame;
@@ -154,6 +158,7 @@ struct DirSceneContent {
 
 /// The stages of add_dir_stages whose summaries the report shows.
 struct DirStages {
+  VplStage* vpls = nullptr;
   CameraLookStage* camera_look = nullptr;  ///< none without DirStageOptions::camera_look
   colormap::ToneMapStage* tone_map = nullptr;
 };
@@ -204,13 +209,31 @@ class VplStage final : public Stage {
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
+  /// What the frames' VPLs were: frames, the mean count per frame by bounce (index 0 = emitters,
+  /// 1 = first bounce, ...), and the first frame's count of bounces >= 2 (zero for the
+  /// multiple-bounce light source, which has nothing to continue yet).
+  struct Summary {
+    int frames = 0;
+    std::vector<double> mean_by_bounce;
+    int first_frame_later_bounces = 0;
+  };
+  [[nodiscard]] Summary summary() const;
+  [[nodiscard]] const VplOptions& options() const { return options_; }
+
  private:
+  /// The multiple-bounce light source (vpl.h) reads the previous frame's VPLs.
+  [[nodiscard]] bool continues_previous_vpls() const {
+    return options_.bounces > 1 && options_.bounce_method == BounceMethod::PreviousFrame;
+  }
   VplOptions options_;
   std::unique_ptr<ConeSearchVk> cone_search_;
   std::unique_ptr<ReflectiveShadowMapsVk> reflective_shadow_maps_;
   Read<MrScene> scene_;
   ReadPrevious<VplSet> previous_;
   Write<VplSet> vpls_;
+  int frames_ = 0;
+  std::vector<double> count_by_bounce_;  ///< summed over the frames
+  int first_frame_later_bounces_ = 0;
 };
 
 /// Steps 3-4 (G-buffer, shadow maps, ISMs, one-pass shading of L_rv and L_r).

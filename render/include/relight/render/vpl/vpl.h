@@ -29,6 +29,22 @@
 // so sparse points lose energy: the pool must hold enough points that a cone's footprint at the
 // scene's distances covers several.
 //
+// The multiple-bounce light source (BounceMethod::PreviousFrame; Knecht et al. 2010 §4.3 and
+// §5.2, the dissertation's first method of §5.2.7): a share of each frame's light samples
+// (`bounce_share`) continues the paths of the previous frame's VPLs instead of following this
+// frame's in turn. Each sample picks a source VPL with probability proportional to its flux's
+// luminance (stratified over the samples), samples a direction from the source's BRDF and traces
+// it through both layers as any bounce (flags multiply as above), so the new VPL carries
+// flux / (p N_bounce) times the BRDF sample's weight. A source of bounce k gives a VPL of bounce
+// k + 1, up to `bounces`: the bounces build up over frames at the cost of one segment per
+// sample. Where the paper renders the scene's point cloud into the slots and keeps, per slot,
+// the point that the source lights most (its depth test; it notes itself that choosing by
+// probability would be better) with visibility from the previous frame's ISMs, we trace the
+// sampled direction: the estimate is unbiased for a static scene and the visibility exact. The
+// price is the paper's too: the light of the previous frame's VPLs lags one frame behind a
+// change (a switched lamp's second bounce lingers for a frame, the third for two). The first
+// frame, without a previous one, gives every sample to the primary lights.
+//
 // Mirrors and glass (specular_material.h) hold no VPL: a path that meets one goes on in the
 // mirrored or refracted direction (chosen in proportion to Fresnel; Beer-Lambert inside) to the
 // diffuse surface it reaches, where the VPL is left - the caustic VPLs of Knecht et al., TVCG 2013
@@ -74,6 +90,9 @@ namespace relight::render {
 struct Vpl {
   Eigen::Vector3f position;
   Eigen::Vector3f normal;    ///< unit, on the side the light arrived from
+  /// The surface's geometric normal on that side: a continued path leaves above it (the shading
+  /// normal may tilt below the surface, where no light goes).
+  Eigen::Vector3f geometric_normal = Eigen::Vector3f::UnitZ();
   Eigen::Vector3f incident;  ///< unit, from the VPL towards where its light came from
   Eigen::Vector3f flux;
   std::uint32_t material = 0;
@@ -138,10 +157,14 @@ enum class VplSource { RayTraced, ReflectiveShadowMaps };
 inline constexpr std::array<NamedValue<VplSource>, 2> kVplSourceNames{
     {{"rays", VplSource::RayTraced}, {"rsm", VplSource::ReflectiveShadowMaps}}};
 
-/// How a VPL's continued light path finds its next surface (bounces ≥ 2; see the header comment).
-enum class BounceMethod { RayTraced, PointCone };
-inline constexpr std::array<NamedValue<BounceMethod>, 2> kBounceMethodNames{
-    {{"rays", BounceMethod::RayTraced}, {"cone", BounceMethod::PointCone}}};
+/// How a VPL's continued light path finds its next surface (bounces ≥ 2; see the header comment):
+/// within the frame by a ray or a point-cone search, or a frame later from the previous frame's
+/// VPLs (the multiple-bounce light source).
+enum class BounceMethod { RayTraced, PointCone, PreviousFrame };
+inline constexpr std::array<NamedValue<BounceMethod>, 3> kBounceMethodNames{
+    {{"rays", BounceMethod::RayTraced},
+     {"cone", BounceMethod::PointCone},
+     {"previous-frame", BounceMethod::PreviousFrame}}};
 
 struct VplOptions {
   int count = 256;      ///< first-bounce light samples (each may yield two VPLs, see above)
@@ -156,13 +179,25 @@ struct VplOptions {
   BounceMethod bounce_method = BounceMethod::RayTraced;
   float cone_half_angle_deg = 5.f;  ///< BounceMethod::PointCone: the dissertation's 5 degrees
   int cone_points = 16384;          ///< BounceMethod::PointCone: candidate points per layer (<= 65536)
+  /// BounceMethod::PreviousFrame: the share of `count` that continues the previous frame's VPLs,
+  /// in (0, 1), and those VPLs with the Phong parameters of their surfaces (VplSet); empty on
+  /// the first frame.
+  float bounce_share = 0.25f;
+  std::span<const Vpl> previous_vpls{};
+  std::span<const Phong> previous_surfaces{};
 };
 
-/// One frame's VPLs, as a frame-graph buffer.
+/// One frame's VPLs, as a frame-graph buffer, with the Phong parameters of each one's surface
+/// (vpl_phong when it was made): the next frame's scene has materials of its own, so the
+/// multiple-bounce light source continues a previous VPL's path with these.
 struct VplSet {
   std::vector<Vpl> vpls;
+  std::vector<Phong> surfaces;  ///< one per VPL
   static constexpr const char* type_name = "VplSet";
 };
+
+/// vpl_phong of every VPL: VplSet::surfaces.
+[[nodiscard]] std::vector<Phong> vpl_surfaces(const MrScene& scene, std::span<const Vpl> vpls);
 
 class ConeSearchVk;
 class ReflectiveShadowMapsVk;
