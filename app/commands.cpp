@@ -88,6 +88,12 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                   "along world +z with its image x along world x")
       ->expected(3)
       ->delimiter(',');
+  command
+      .add_option("--probe-position", probe.position,
+                  "Where the probe camera sits, x,y,z in world metres (default: the world origin, the markers'); "
+                  "a tracked lamp (--real-spot-tag) that the probe sees is taken out of the probe's lights there")
+      ->expected(3)
+      ->delimiter(',');
   add_choice_option(command, "--probe-projection", probe.projection, kProbeProjectionNames,
                     "The probe's projection: auto (lat-long when twice as wide as tall, else an equidistant fisheye "
                     "whose image circle touches the borders), fisheye, latlong");

@@ -1,6 +1,7 @@
 #include "probe_input.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -67,6 +68,14 @@ lights::ProbeStreamStage& add_probe_stream_stage(FrameGraph& graph, const RealLi
   return graph.emplace<lights::ProbeStreamStage>(open_probe_input(source.probe, response), matching);
 }
 }  // namespace
+
+Eigen::Vector3d probe_position(const ProbeInputOptions& options) {
+  if (options.position.empty()) return Eigen::Vector3d::Zero();
+  if (options.position.size() != 3 ||
+      !std::all_of(options.position.begin(), options.position.end(), [](double v) { return std::isfinite(v); }))
+    throw Error("--probe-position needs three finite coordinates x,y,z in metres");
+  return {options.position[0], options.position[1], options.position[2]};
+}
 
 RealLightStages add_real_light_stages(FrameGraph& graph, const RealLightSource& source,
                                       const ProbeInputOptions& options, Backend per_pixel, vk::VulkanContext* context,

@@ -4,6 +4,7 @@
 //   probe_stream (lights/probe_stream_stage.h) -> light_extraction -> light_smoothing -> "lights"
 // (Knecht 2010 §6, dissertation §4.2: the lights follow a probe camera; the smoothing keeps a
 // static probe's lights identical and lets a switched lamp through at once).
+#include <Eigen/Core>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -28,6 +29,10 @@ struct ProbeInputOptions {
   /// Probe-to-world rotation, degrees about x, then y, then z (world = Rz Ry Rx probe); empty:
   /// identity (a fisheye looking up along world +z with image x = world x, as `relight synth`'s).
   std::vector<double> rotation_degrees;
+  /// Where the probe camera sits in the world (metres); empty: at the world's origin (the marker
+  /// layout's, which a probe beside the virtual objects is near). Only a tracked lamp needs it:
+  /// to find the lamp in the probe's lights (tracked_lamp_stage.h).
+  std::vector<double> position;
   lights::ProbeProjection projection = lights::ProbeProjection::FromAspect;
   double fov_degrees = 180.0;      ///< fisheye: the image circle's full field of view
   std::filesystem::path response;  ///< 8-bit probes: response curve file (empty: sRGB)
@@ -39,6 +44,10 @@ struct ProbeInputOptions {
   int lights = 0;
   bool smoothing = true;           ///< light_smoothing between extraction and the lights
 };
+
+/// --probe-position as a point (the origin when not given); throws relight::Error unless it is
+/// three finite numbers.
+[[nodiscard]] Eigen::Vector3d probe_position(const ProbeInputOptions& options);
 
 /// The calibration the options describe; throws relight::Error on a bad rotation or field of view.
 [[nodiscard]] lights::ProbeCalibration probe_calibration(const ProbeInputOptions& options);

@@ -201,8 +201,11 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   const RealLightStages light_stages = add_real_light_stages(
       graph, real_lights, probe_input, per_pixel, pipeline.vulkan.get(), lamp ? kRoomLights : lights::kLights);
   if (lamp) {
-    pipeline.tracked_lamp =
-        &graph.emplace<TrackedLampStage>(parse_tracked_lamp(options.real_spot_tag, options.real_spot_tag_offset));
+    // A probe the lamp shines on holds it too; the lamp stage takes it out there.
+    const bool from_probe = real_lights.lights_file.empty() && !real_lights.estimate;
+    pipeline.tracked_lamp = &graph.emplace<TrackedLampStage>(
+        parse_tracked_lamp(options.real_spot_tag, options.real_spot_tag_offset),
+        from_probe ? std::optional<Eigen::Vector3d>(probe_position(probe_input)) : std::nullopt);
   }
   pipeline.probe = light_stages.probe;
   if (real_lights.lights_file.empty()) pipeline.extracted_lights = probe_input.lights;

@@ -1,6 +1,7 @@
 #include "tracked_lamp_stage.h"
 
 #include <cmath>
+#include <numbers>
 #include <vector>
 
 #include "mixed_reality_scene.h"
@@ -53,7 +54,33 @@ lights::Light lamp_light(const TrackedLamp& lamp, const Pose& tag_to_world) {
   return light;
 }
 
-TrackedLampStage::TrackedLampStage(TrackedLamp lamp) : lamp_(std::move(lamp)) {
+double lamp_irradiance_at(const lights::Light& lamp, const Eigen::Vector3d& point) {
+  const Eigen::Vector3d to_point = point - lamp.position;
+  if (!(to_point.squaredNorm() > 0.0)) return 0.0;
+  return lights::luminance(lamp.power) * lights::spot_falloff(lamp, to_point.normalized()) / to_point.squaredNorm();
+}
+
+lights::LightSet without_lamp_in_probe(const lights::LightSet& room, const lights::Light& lamp,
+                                       const Eigen::Vector3d& probe_position, Eigen::Vector3d& removed) {
+  removed.setZero();
+  // A spot shows in the probe only when the probe is inside its cone.
+  if (!(lamp_irradiance_at(lamp, probe_position) > 0.0)) return room;
+  const Eigen::Vector3d to_lamp = lamp.position - probe_position;
+  const double cos_limit = std::cos(kLampInProbeDegrees * std::numbers::pi / 180.0);
+  lights::LightSet out;
+  for (const lights::Light& light : room.lights) {
+    const bool lamps = light.real && light.kind == lights::LightKind::Directional &&
+                       light.direction.normalized().dot(to_lamp.normalized()) >= cos_limit;
+    if (lamps)
+      removed += light.power;
+    else
+      out.lights.push_back(light);
+  }
+  return out;
+}
+
+TrackedLampStage::TrackedLampStage(TrackedLamp lamp, std::optional<Eigen::Vector3d> probe_position)
+    : lamp_(std::move(lamp)), probe_position_(std::move(probe_position)) {
   // The tag alone, in its own frame: the "camera pose" PnP finds against it is camera-to-tag.
   capture::TagLayout::Tag tag;
   tag.id = lamp_.tag_id;
@@ -93,7 +120,17 @@ void TrackedLampStage::run(StageContext& context) {
   }
   lights::LightSet& out = context.get(lights_);
   out = context.get(room_);
-  if (last_) out.lights.push_back(*last_);
+  if (!last_) return;
+  if (probe_position_ && lamp_irradiance_at(*last_, *probe_position_) > 0.0) {
+    Eigen::Vector3d removed;
+    const std::size_t before = out.lights.size();
+    out = without_lamp_in_probe(out, *last_, *probe_position_, removed);
+    ++frames_lamp_in_probe_;
+    lights_taken_out_ += static_cast<int>(before - out.lights.size());
+    taken_out_irradiance_ += lights::luminance(removed);
+    lamp_irradiance_ += lamp_irradiance_at(*last_, *probe_position_);
+  }
+  out.lights.push_back(*last_);
 }
 
 nlohmann::ordered_json TrackedLampStage::summary() const {
@@ -105,6 +142,13 @@ nlohmann::ordered_json TrackedLampStage::summary() const {
   if (last_) {
     json["last_position"] = vec(last_->position);
     json["last_axis"] = vec(last_->axis);
+  }
+  if (probe_position_) {
+    json["probe"] = {{"position", vec(*probe_position_)},
+                     {"frames_lamp_in_probe", frames_lamp_in_probe_},
+                     {"lights_taken_out", lights_taken_out_},
+                     {"taken_out_irradiance", taken_out_irradiance_},
+                     {"lamp_irradiance", lamp_irradiance_}};
   }
   return json;
 }

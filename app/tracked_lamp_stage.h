@@ -16,6 +16,11 @@
 //           tag is out of view, or the camera has no pose, the lamp stays where it was last seen
 //           (a lamp does not vanish when its marker turns away); before its first sighting it is
 //           left out.
+// When the room's lights come from a light probe that the lamp shines on, the probe saw the lamp
+// too, and its lights hold it a second time: the directional lights within kLampInProbeDegrees of
+// the lamp as seen from the probe (`probe_position`) are taken out - the lamp's own samples of
+// the probe (importance sampling puts the light of a bright spot into the samples that land on
+// it), whose light the tracked lamp now brings, posed and shaped.
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -56,25 +61,46 @@ struct TrackedLamp {
 /// The lamp's real spot light for the tag's pose in the world.
 [[nodiscard]] lights::Light lamp_light(const TrackedLamp& lamp, const Pose& tag_to_world);
 
+/// How far (degrees) from the lamp's direction, seen from the probe, a probe light is the lamp's:
+/// the lamp's few pixels, a probe pixel's width and what the light smoothing moves a light by.
+inline constexpr double kLampInProbeDegrees = 6.0;
+
+/// The luminance of the irradiance `lamp` delivers at `point` (normal incidence; 0 outside its cone).
+[[nodiscard]] double lamp_irradiance_at(const lights::Light& lamp, const Eigen::Vector3d& point);
+
+/// The lights of `room` without the probe's samples of a lamp at `lamp` as a probe at
+/// `probe_position` sees it (none when the probe is outside the lamp's cone); `removed` gets the
+/// irradiance (RGB, normal incidence) of what was taken out.
+[[nodiscard]] lights::LightSet without_lamp_in_probe(const lights::LightSet& room, const lights::Light& lamp,
+                                                     const Eigen::Vector3d& probe_position, Eigen::Vector3d& removed);
+
 class TrackedLampStage final : public Stage {
  public:
-  explicit TrackedLampStage(TrackedLamp lamp);
+  /// `probe_position`: where the probe sits when the room's lights come from one (else none).
+  explicit TrackedLampStage(TrackedLamp lamp, std::optional<Eigen::Vector3d> probe_position = std::nullopt);
   [[nodiscard]] std::string name() const override { return "tracked_lamp"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
 
   [[nodiscard]] int frames_seen() const { return frames_seen_; }
   /// {"tag_id", "frames", "frames_seen", "frames_held", "frames_before_first_sighting",
-  ///  "last_position", "last_axis"} for report.json.
+  ///  "last_position", "last_axis"} for report.json, and with a probe "probe": {"position",
+  ///  "frames_lamp_in_probe", "lights_taken_out", "taken_out_irradiance" and
+  ///  "lamp_irradiance" (luminance at the probe, summed over those frames)}.
   [[nodiscard]] nlohmann::ordered_json summary() const;
 
  private:
   TrackedLamp lamp_;
+  std::optional<Eigen::Vector3d> probe_position_;
   capture::TagLayout tag_alone_;  ///< the lamp's tag as a layout of its own frame
   std::optional<lights::Light> last_;
   int frames_ = 0;
   int frames_seen_ = 0;
   int frames_held_ = 0;
+  int frames_lamp_in_probe_ = 0;
+  int lights_taken_out_ = 0;
+  double taken_out_irradiance_ = 0.0;  ///< luminance
+  double lamp_irradiance_ = 0.0;       ///< luminance of the lamp's irradiance at the probe
   Read<capture::TagDetections> detections_;
   Read<DepthMap> depth_;
   Read<FrameInfo> frame_;

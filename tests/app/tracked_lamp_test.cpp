@@ -48,5 +48,42 @@ TEST(TrackedLamp, TheTagsPoseCarriesTheLightsPositionAndAxis) {
   EXPECT_DOUBLE_EQ(light.inner_degrees, 20.0);
 }
 
+// A probe inside the lamp's cone saw the lamp: the probe's lights towards it (within
+// kLampInProbeDegrees) are the lamp's and are taken out, with their irradiance; others stay.
+// Outside the cone the probe saw no lamp and keeps every light.
+TEST(TrackedLamp, TheProbesLightsTowardsTheLampAreTakenOutWhereTheLampShinesOnTheProbe) {
+  lights::Light lamp;
+  lamp.kind = lights::LightKind::Spot;
+  lamp.position = Eigen::Vector3d(0, 0, 1);
+  lamp.axis = Eigen::Vector3d(0, 0, -1);
+  lamp.cone_degrees = 25.0;
+  lamp.inner_degrees = 20.0;
+  lamp.power = Eigen::Vector3d::Constant(4.0);
+  const auto directional = [](const Eigen::Vector3d& direction, double power) {
+    lights::Light light;
+    light.direction = direction.normalized();
+    light.power = Eigen::Vector3d::Constant(power);
+    return light;
+  };
+  lights::LightSet room;
+  room.lights = {directional({0.0, 0.0, 1.0}, 3.0),     // the lamp, straight above the probe
+                 directional({0.05, 0.0, 1.0}, 1.0),    // 2.9 degrees off: the lamp's too
+                 directional({0.3, 0.0, 1.0}, 0.5),     // 16.7 degrees off: the room's
+                 directional({-1.0, 0.0, 0.2}, 0.25)};  // a window
+  lights::Light virtual_light = directional({0.0, 0.0, 1.0}, 2.0);
+  virtual_light.real = false;  // a virtual light is not in the probe
+  room.lights.push_back(virtual_light);
+  Eigen::Vector3d removed;
+  const lights::LightSet kept = without_lamp_in_probe(room, lamp, Eigen::Vector3d::Zero(), removed);
+  ASSERT_EQ(kept.lights.size(), 3u);
+  EXPECT_EQ(removed, Eigen::Vector3d::Constant(4.0));
+  EXPECT_DOUBLE_EQ(lamp_irradiance_at(lamp, Eigen::Vector3d::Zero()), 4.0);  // 4 W/sr at 1 m, on the axis
+  // A probe 1 m to the side, 45 degrees off the lamp's axis: outside the 25-degree cone.
+  const lights::LightSet all = without_lamp_in_probe(room, lamp, Eigen::Vector3d(1, 0, 0), removed);
+  EXPECT_EQ(all.lights.size(), room.lights.size());
+  EXPECT_EQ(removed, Eigen::Vector3d::Zero());
+  EXPECT_DOUBLE_EQ(lamp_irradiance_at(lamp, Eigen::Vector3d(1, 0, 0)), 0.0);
+}
+
 }  // namespace
 }  // namespace relight::app
