@@ -107,8 +107,10 @@ void TrackedLampStage::run(StageContext& context) {
     const std::vector<capture::TagDetection>& detections = context.get(detections_).tags;
     auto camera_to_tag = capture::estimate_camera_pose(detections, tag_alone_, frame.intrinsics);
     if (camera_to_tag) {
-      camera_to_tag =
-          capture::refine_with_depth(*camera_to_tag, detections, tag_alone_, frame.intrinsics, context.get(depth_));
+      const DepthMap& depth = context.get(depth_);
+      // Tilt first (the face's plane), then the distance along the ray.
+      camera_to_tag = capture::refine_tilt_with_depth(*camera_to_tag, detections, tag_alone_, frame.intrinsics, depth);
+      camera_to_tag = capture::refine_with_depth(*camera_to_tag, detections, tag_alone_, frame.intrinsics, depth);
       seen = Pose(*frame.camera_to_world * camera_to_tag->camera_to_world.inverse());
     }
   }

@@ -2,6 +2,8 @@
 #include "relight/capture/buffers.h"
 #include "relight/core/buffers.h"
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <opencv2/calib3d.hpp>
@@ -127,6 +129,99 @@ MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetect
   Pose refined = world_to_camera;
   const Eigen::Vector3d centre_camera = world_to_camera * centre_world;
   refined.translation() += (scale - 1.0) * centre_camera;
+  MarkerPose result = pose;
+  result.camera_to_world = refined.inverse();
+  return result;
+}
+
+namespace {
+
+/// The measured camera-frame points on a tag's face, inset by 15 % from its edges: the pixels
+/// whose ray meets the face (as `world_to_camera` places it) within the inset square.
+std::vector<Eigen::Vector3d> face_points(const TagLayout::Tag& tag, const Pose& world_to_camera,
+                                         const PinholeIntrinsics& intrinsics, const DepthMap& depth) {
+  const auto corner = [&](std::size_t k) { return world_to_camera * tag.corners_world[k]; };
+  const Eigen::Vector3d origin = corner(0), u_axis = corner(1) - origin, v_axis = corner(3) - origin;
+  const Eigen::Vector3d normal = u_axis.cross(v_axis).normalized();
+  Eigen::AlignedBox2d bounds;
+  for (std::size_t k = 0; k < 4; ++k) bounds.extend(intrinsics.project(corner(k)));
+  std::vector<Eigen::Vector3d> points;
+  const int first_row = std::max(0, static_cast<int>(bounds.min().y()));
+  const int last_row = std::min(depth.height() - 1, static_cast<int>(bounds.max().y()));
+  const int first_col = std::max(0, static_cast<int>(bounds.min().x()));
+  const int last_col = std::min(depth.width() - 1, static_cast<int>(bounds.max().x()));
+  for (int row = first_row; row <= last_row; ++row) {
+    for (int col = first_col; col <= last_col; ++col) {
+      if (!is_valid_depth(depth(row, col))) continue;
+      const Eigen::Vector3d ray = intrinsics.ray(col, row);
+      const double along = normal.dot(origin) / normal.dot(ray);
+      if (!(along > 0.0)) continue;
+      const Eigen::Vector3d on_face = along * ray - origin;
+      const double a = on_face.dot(u_axis) / u_axis.squaredNorm(), b = on_face.dot(v_axis) / v_axis.squaredNorm();
+      if (a >= 0.15 && a <= 0.85 && b >= 0.15 && b <= 0.85)
+        points.push_back(intrinsics.unproject(col, row, depth(row, col)));
+    }
+  }
+  return points;
+}
+
+/// The least-squares plane's normal (the direction of least spread).
+Eigen::Vector3d plane_normal(const std::vector<Eigen::Vector3d>& points, Eigen::Vector3d& centre) {
+  centre = Eigen::Vector3d::Zero();
+  for (const auto& x : points) centre += x / static_cast<double>(points.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const auto& x : points) scatter += (x - centre) * (x - centre).transpose();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+}
+
+/// plane_normal again without the points more than three median distances off the first fit;
+/// none when fewer than `min_points` remain.
+std::optional<Eigen::Vector3d> robust_plane_normal(const std::vector<Eigen::Vector3d>& points, int min_points) {
+  if (static_cast<int>(points.size()) < min_points) return std::nullopt;
+  Eigen::Vector3d centre;
+  const Eigen::Vector3d first = plane_normal(points, centre);
+  std::vector<double> distances;
+  distances.reserve(points.size());
+  for (const auto& x : points) distances.push_back(std::abs((x - centre).dot(first)));
+  std::vector<double> sorted = distances;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(sorted.size() / 2), sorted.end());
+  const double limit = 3.0 * std::max(sorted[sorted.size() / 2], 1e-6);
+  std::vector<Eigen::Vector3d> inliers;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (distances[i] <= limit) inliers.push_back(points[i]);
+  if (static_cast<int>(inliers.size()) < min_points) return std::nullopt;
+  return plane_normal(inliers, centre);
+}
+
+}  // namespace
+
+MarkerPose refine_tilt_with_depth(const MarkerPose& pose, const std::vector<TagDetection>& detections,
+                                  const TagLayout& layout, const PinholeIntrinsics& intrinsics, const DepthMap& depth,
+                                  int min_points) {
+  const TagLayout::Tag* tag = nullptr;
+  for (const auto& detection : detections) {
+    const TagLayout::Tag* known = layout.find(detection.id);
+    if (!known) continue;
+    if (tag) return pose;  // several tags pin the tilt themselves
+    tag = known;
+  }
+  if (!tag) return pose;
+  const Pose world_to_camera = pose.camera_to_world.inverse();
+  const auto measured = robust_plane_normal(face_points(*tag, world_to_camera, intrinsics, depth), min_points);
+  if (!measured) return pose;
+  const Eigen::Vector3d normal =
+      world_to_camera.linear() *
+      (tag->corners_world[1] - tag->corners_world[0]).cross(tag->corners_world[3] - tag->corners_world[0]).normalized();
+  const Eigen::Vector3d facing = measured->dot(normal) < 0.0 ? Eigen::Vector3d(-*measured) : *measured;
+  if (facing.dot(normal) < std::cos(30.0 * EIGEN_PI / 180.0)) return pose;  // the depth is not the tag's
+  // Turn the tag about its centre so that its face normal becomes the measured one.
+  const Eigen::Vector3d tag_centre =
+      world_to_camera *
+      (0.25 * (tag->corners_world[0] + tag->corners_world[1] + tag->corners_world[2] + tag->corners_world[3]));
+  const Eigen::Matrix3d turn = Eigen::Quaterniond::FromTwoVectors(normal, facing).toRotationMatrix();
+  Pose refined = world_to_camera;
+  refined.linear() = turn * world_to_camera.linear();
+  refined.translation() = tag_centre + turn * (world_to_camera.translation() - tag_centre);
   MarkerPose result = pose;
   result.camera_to_world = refined.inverse();
   return result;

@@ -413,8 +413,11 @@ TEST(DynamicLightCli, ATrackedLampIsWhereItsTagSaysAndThePebblesShadowFollowsIt)
 
 // The sequence's probe sees the pocket lamp whenever it stands in the lamp's cone: without a
 // lights file the room's lights come from that probe and hold the lamp a second time. The lamp
-// stage takes the probe's lights towards the lamp out, and what it takes out is the lamp's
-// irradiance at the probe (measured: 9 of 24 lights over 3 frames, 11.19 against 11.53).
+// stage takes the probe's lights towards the lamp out: measured, 9 of 24 lights over 3 frames,
+// each within 1 degree of the lamp, 11.19 of the lamp's 16.72 (the tracked lamp's irradiance at
+// the probe; the true lamp's is 16.76). The probe's eight equal-energy samples gave the lamp
+// three, 37.5 % of its light where the lamp's share is 56 %: taken out is all the probe had of
+// it, and no more than the lamp.
 TEST(DynamicLightCli, AProbeThatSeesTheTrackedLampDoesNotCountItTwice) {
   test::TempDir dir;
   const auto& sequence = cli_test::synthetic_sequence(
@@ -432,9 +435,10 @@ TEST(DynamicLightCli, AProbeThatSeesTheTrackedLampDoesNotCountItTwice) {
   ASSERT_TRUE(seen.contains("frames_lamp_in_probe")) << seen.dump();
   EXPECT_GE(seen["frames_lamp_in_probe"].get<int>(), 2) << seen.dump();
   EXPECT_GE(seen["lights_taken_out"].get<int>(), seen["frames_lamp_in_probe"].get<int>()) << seen.dump();
-  EXPECT_NEAR(seen["taken_out_irradiance"].get<double>(), seen["lamp_irradiance"].get<double>(),
-              0.15 * seen["lamp_irradiance"].get<double>())
-      << seen.dump();
+  const double taken_out = seen["taken_out_irradiance"].get<double>(),
+               lamp_light = seen["lamp_irradiance"].get<double>();
+  EXPECT_GT(taken_out, 0.5 * lamp_light) << seen.dump();
+  EXPECT_LT(taken_out, 1.1 * lamp_light) << seen.dump();
   // A probe where the lamp does not shine (under the floor) saw no lamp: nothing is taken out.
   const auto unseen = probe_summary("below", "0,0,-10");
   EXPECT_EQ(unseen["frames_lamp_in_probe"], 0) << unseen.dump();
@@ -450,11 +454,11 @@ TEST(DynamicLightCli, AProbeThatSeesTheTrackedLampDoesNotCountItTwice) {
 // (relight://tum/...), the camera posed by its markers and odometry (no true poses live). The
 // lamp's light stands still while it turns about the vertical through its card, so wherever the
 // looping device is, its position and its axis's elevation are the sequence's and its axis's
-// azimuth lies within the sequence's turn. The lamp's tag is about 20 pixels wide at 320x240:
-// frame by frame (replay, true camera poses) the lamp is 0.2-0.4 cm and 1-1.4 degrees of
-// elevation off on frames 0 and 3, but 2.5 cm and 10 degrees on frames 1 and 2, and which frame
-// a live run ends on depends on its pace; the bounds hold for all four. (Not the planar-pose
-// ambiguity: of IPPE's two poses, the one chosen also agrees better with the depth.)
+// azimuth lies within the sequence's turn. The lamp's tag is about 20 pixels wide at 320x240 and
+// nearly head-on on the middle frames, where its corners leave the tilt loose: the depth of its
+// face sets it (capture::refine_tilt_with_depth). Measured frame by frame in replay: 0.1-0.2 cm
+// and about 1 degree of elevation off on every frame (without the depth's plane 2.5 cm and 10
+// degrees on frames 1 and 2).
 TEST(DynamicLightCli, ALiveRunTracksTheLampFromItsTag) {
   test::TempDir dir;
   const auto& sequence = cli_test::synthetic_sequence(
@@ -479,16 +483,16 @@ TEST(DynamicLightCli, ALiveRunTracksTheLampFromItsTag) {
     const auto truth = nlohmann::json::parse(read_text_file(entry.path()))["lights"].back();
     nearest = std::min(nearest, (position - vec(truth["position"])).norm());
     true_elevation = elevation(vec(truth["axis"]));  // the same in every frame
-    EXPECT_NEAR(elevation(axis), true_elevation, 12.0) << lamp.dump();
+    EXPECT_NEAR(elevation(axis), true_elevation, 3.0) << lamp.dump();
     lowest = std::min(lowest, azimuth(vec(truth["axis"])));
     highest = std::max(highest, azimuth(vec(truth["axis"])));
   }
   std::cout << "live lamp: " << 100.0 * nearest << " cm from the true light, axis elevation " << elevation(axis)
             << " (true " << true_elevation << "), azimuth " << azimuth(axis) << " (the sequence turns from " << lowest
             << " to " << highest << ")\n";
-  EXPECT_LT(nearest, 0.04) << lamp.dump();
-  EXPECT_GT(azimuth(axis), lowest - 10.0) << lamp.dump();
-  EXPECT_LT(azimuth(axis), highest + 10.0) << lamp.dump();
+  EXPECT_LT(nearest, 0.01) << lamp.dump();
+  EXPECT_GT(azimuth(axis), lowest - 4.0) << lamp.dump();
+  EXPECT_LT(azimuth(axis), highest + 4.0) << lamp.dump();
 }
 
 TEST(DynamicLightCli, TrackedLampErrorsAreOneLineAndAnUnseenTagIsAWarning) {

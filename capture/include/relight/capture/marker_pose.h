@@ -41,6 +41,18 @@ struct MarkerPose {
                                                             const TagLayout& layout,
                                                             const PinholeIntrinsics& intrinsics);
 
+/// Tilt refinement from registered depth for one tag: a small tag seen nearly head-on pins its
+/// in-plane rotation well but its tilt poorly (its corners move little as it tilts), while the
+/// depth of its face gives the face's plane. The points measured inside the tag (inset from its
+/// edges) are fitted with a plane (least squares, then again without the points more than three
+/// median deviations off it), and the pose is turned about the tag's centre by the smallest
+/// rotation that takes its face normal onto the plane's. Returns the pose unchanged when the
+/// layout does not know exactly one detected tag, fewer than `min_points` depth samples fall on
+/// it, or the two normals are more than 30 degrees apart (the depth is not the tag's).
+[[nodiscard]] MarkerPose refine_tilt_with_depth(const MarkerPose& pose, const std::vector<TagDetection>& detections,
+                                                const TagLayout& layout, const PinholeIntrinsics& intrinsics,
+                                                const DepthMap& depth, int min_points = 30);
+
 /// Distance refinement from registered depth (see above); returns the pose unchanged when fewer
 /// than 10 valid depth samples fall on the tags.
 [[nodiscard]] MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetection>& detections,
