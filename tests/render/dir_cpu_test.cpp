@@ -493,6 +493,10 @@ TEST(Vpls, PreviousFrameBouncesCarryTheEnergyOfTheRayTracedOnes) {
   EXPECT_NEAR(continued_flux / ray_flux, 1.0, 0.05);
   EXPECT_NEAR(red_flux(second, of_bounce(1)) / red_flux(rays, of_bounce(1)), 1.0, 0.01) << "fewer, same energy";
   for (const Vpl& vpl : second) EXPECT_GT(vpl.normal.dot(vpl.incident), 0.f);
+  // With one bounce asked for, nothing continues: every sample goes to the light.
+  VplOptions one_bounce = options;
+  one_bounce.bounces = 1;
+  EXPECT_EQ(frame_after(scene, tracer, one_bounce, first).size(), 4000u);
   // The second frame's VPLs of bounce 2 are sources in turn when three bounces are asked for.
   EXPECT_EQ(red_flux(frame_after(scene, tracer, options, second), of_bounce(3)), 0.0);
   options.bounces = 3;

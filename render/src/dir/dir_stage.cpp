@@ -157,15 +157,13 @@ VplStage::~VplStage() = default;
 
 void VplStage::declare(StageBuilder& builder) {
   scene_ = builder.read(kMrScene);
-  if (options_.budget == VplBudget::ByPreviousFlux || continues_previous_vpls())
-    previous_ = builder.read_previous(kVpls);
+  if (reads_previous_vpls()) previous_ = builder.read_previous(kVpls);
   vpls_ = builder.write(kVpls);
 }
 
 void VplStage::run(StageContext& context) {
   const MrScene& scene = context.get(scene_);
-  const VplSet* previous =
-      options_.budget == VplBudget::ByPreviousFlux || continues_previous_vpls() ? context.get(previous_) : nullptr;
+  const VplSet* previous = reads_previous_vpls() ? context.get(previous_) : nullptr;
   if (options_.budget == VplBudget::ByPreviousFlux)
     options_.previous_flux = previous ? vpl_flux_per_light(previous->vpls, scene.lights.size()) : std::vector<double>{};
   if (continues_previous_vpls()) {

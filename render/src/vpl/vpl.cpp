@@ -178,12 +178,16 @@ class SourceStratum {
 ///                 `virtual_share` of the samples - no more than there are of them;
 ///   rest          the others, picked by flux, stratified: their bounces are mostly real light,
 ///                 which the differential image only sees where a virtual object blocks it.
+bool continues_path(const Vpl& source, const VplOptions& options) {
+  return !source.emitter() && source.bounce < options.bounces && luminance(source.flux) > 0.f;
+}
+
 void emit_from_previous_vpls(int n, const VplOptions& options, VplTracer& tracer) {
   const std::span<const Vpl> sources = options.previous_vpls;
   SourceStratum differential(false), rest(true);
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const Vpl& source = sources[i];
-    if (source.emitter() || source.bounce >= options.bounces) continue;
+    if (!continues_path(source, options)) continue;
     const bool differs = !source.on_real_surface || source.in_real != source.in_real_virtual;
     (differs ? differential : rest).add(i, static_cast<double>(luminance(source.flux)));
   }
@@ -248,7 +252,8 @@ std::vector<Vpl> generate_vpls(const MrScene& scene, const RayTracer& tracer, co
   if (options.virtual_share < 0.f || options.virtual_share >= 1.f) throw Error("the virtual VPL share must be in [0, 1)");
   const BoundingSphere bounds = bounding_sphere(scene);
   // The multiple-bounce light source's share of the samples, once there are VPLs to continue.
-  const bool continues = from_previous && options.bounces > 1 && !options.previous_vpls.empty();
+  const bool continues = from_previous && std::any_of(options.previous_vpls.begin(), options.previous_vpls.end(),
+                                                      [&](const Vpl& v) { return continues_path(v, options); });
   const int continued = continues ? static_cast<int>(std::lround(options.bounce_share * options.count)) : 0;
   VplOptions primary = options;
   primary.count = options.count - continued;

@@ -225,6 +225,10 @@ class VplStage final : public Stage {
   [[nodiscard]] bool continues_previous_vpls() const {
     return options_.bounces > 1 && options_.bounce_method == BounceMethod::PreviousFrame;
   }
+  /// The flux budget and the multiple-bounce light source read the previous frame's VPLs.
+  [[nodiscard]] bool reads_previous_vpls() const {
+    return options_.budget == VplBudget::ByPreviousFlux || continues_previous_vpls();
+  }
   VplOptions options_;
   std::unique_ptr<ConeSearchVk> cone_search_;
   std::unique_ptr<ReflectiveShadowMapsVk> reflective_shadow_maps_;
