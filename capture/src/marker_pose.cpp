@@ -197,7 +197,7 @@ std::optional<Eigen::Vector3d> robust_plane_normal(const std::vector<Eigen::Vect
 
 MarkerPose refine_tilt_with_depth(const MarkerPose& pose, const std::vector<TagDetection>& detections,
                                   const TagLayout& layout, const PinholeIntrinsics& intrinsics, const DepthMap& depth,
-                                  int min_points) {
+                                  double max_view_angle_degrees, int min_points) {
   const TagLayout::Tag* tag = nullptr;
   for (const auto& detection : detections) {
     const TagLayout::Tag* known = layout.find(detection.id);
@@ -207,17 +207,19 @@ MarkerPose refine_tilt_with_depth(const MarkerPose& pose, const std::vector<TagD
   }
   if (!tag) return pose;
   const Pose world_to_camera = pose.camera_to_world.inverse();
-  const auto measured = robust_plane_normal(face_points(*tag, world_to_camera, intrinsics, depth), min_points);
-  if (!measured) return pose;
   const Eigen::Vector3d normal =
       world_to_camera.linear() *
       (tag->corners_world[1] - tag->corners_world[0]).cross(tag->corners_world[3] - tag->corners_world[0]).normalized();
-  const Eigen::Vector3d facing = measured->dot(normal) < 0.0 ? Eigen::Vector3d(-*measured) : *measured;
-  if (facing.dot(normal) < std::cos(30.0 * EIGEN_PI / 180.0)) return pose;  // the depth is not the tag's
-  // Turn the tag about its centre so that its face normal becomes the measured one.
   const Eigen::Vector3d tag_centre =
       world_to_camera *
       (0.25 * (tag->corners_world[0] + tag->corners_world[1] + tag->corners_world[2] + tag->corners_world[3]));
+  // Seen obliquely, the corners pin the tilt themselves.
+  if (std::abs(normal.dot(tag_centre.normalized())) < std::cos(max_view_angle_degrees * EIGEN_PI / 180.0)) return pose;
+  const auto measured = robust_plane_normal(face_points(*tag, world_to_camera, intrinsics, depth), min_points);
+  if (!measured) return pose;
+  const Eigen::Vector3d facing = measured->dot(normal) < 0.0 ? Eigen::Vector3d(-*measured) : *measured;
+  if (facing.dot(normal) < std::cos(30.0 * EIGEN_PI / 180.0)) return pose;  // the depth is not the tag's
+  // Turn the tag about its centre so that its face normal becomes the measured one.
   const Eigen::Matrix3d turn = Eigen::Quaterniond::FromTwoVectors(normal, facing).toRotationMatrix();
   Pose refined = world_to_camera;
   refined.linear() = turn * world_to_camera.linear();
@@ -238,7 +240,11 @@ void MarkerPoseStage::run(StageContext& context) {
   const std::vector<TagDetection>& detections = context.get(detections_).tags;
   const PinholeIntrinsics& intrinsics = context.get(frame_).intrinsics;
   auto estimate = estimate_camera_pose(detections, layout_, intrinsics);
-  if (estimate) estimate = refine_with_depth(*estimate, detections, layout_, intrinsics, context.get(depth_));
+  if (estimate) {
+    const DepthMap& depth = context.get(depth_);
+    estimate = refine_tilt_with_depth(*estimate, detections, layout_, intrinsics, depth, kMarkerHeadOnDegrees);
+    estimate = refine_with_depth(*estimate, detections, layout_, intrinsics, depth);
+  }
   CameraPose& out = context.get(pose_);
   if (estimate) last_ = estimate;
   out.valid = last_.has_value();

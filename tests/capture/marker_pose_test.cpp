@@ -126,6 +126,19 @@ TEST(MarkerPose, DepthPinsTheTiltOfASmallTagSeenHeadOn) {
     EXPECT_LT(after, before) << degrees;
     EXPECT_LT(centre_cm, 1.0) << degrees;
   }
+  // The camera's marker pose refines only near head-on (kMarkerHeadOnDegrees): an oblique view
+  // of the same tag, whose corners pin the tilt, keeps its colour-only rotation.
+  {
+    const Pose oblique = synth::look_at(tag + Eigen::Vector3d(0.9, -0.6, 0.9), tag, {0, 0, 1});
+    const synth::RenderedFrame frame = synth::render_frame(scene, intrinsics, oblique);
+    const auto seen = detector.detect(render_antialiased(scene, intrinsics, oblique));
+    ASSERT_EQ(seen.size(), 1u);
+    const auto colour_only = estimate_camera_pose(seen, layout, intrinsics);
+    ASSERT_TRUE(colour_only.has_value());
+    const DepthMap depth = synth::apply_kinect_noise(frame.depth, frame.normals, intrinsics, {}, 7, 0);
+    const MarkerPose kept = refine_tilt_with_depth(*colour_only, seen, layout, intrinsics, depth, kMarkerHeadOnDegrees);
+    EXPECT_TRUE(kept.camera_to_world.isApprox(colour_only->camera_to_world));
+  }
   // Without depth on the tag the pose stays as it is.
   const auto detections = detector.detect(
       render_antialiased(scene, intrinsics, synth::look_at(tag + Eigen::Vector3d(0, 0, 2), tag, {0, 1, 0})));

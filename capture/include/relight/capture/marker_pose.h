@@ -6,7 +6,9 @@
 // with solvePnPRefineLM in both cases. A small tag far away pins the rotation well but the
 // distance poorly (a corner error of 0.3 px moves a 16 cm tag at 2 m by ~1.5 cm along the
 // ray); refine_with_depth() corrects that distance from the depth map: the median ratio of
-// measured to predicted depth over the tag's face scales the camera-to-tag vector.
+// measured to predicted depth over the tag's face scales the camera-to-tag vector. A single tag
+// seen nearly head-on pins its tilt poorly too; within kMarkerHeadOnDegrees of head-on the stage
+// takes the tilt from the depth of the tag's face first (refine_tilt_with_depth).
 //
 // Stage MarkerPoseStage
 //   reads:  "tag_detections" (TagDetections, tag_detection_stage.h), "depth" (DepthMap, for the
@@ -47,11 +49,17 @@ struct MarkerPose {
 /// edges) are fitted with a plane (least squares, then again without the points more than three
 /// median deviations off it), and the pose is turned about the tag's centre by the smallest
 /// rotation that takes its face normal onto the plane's. Returns the pose unchanged when the
-/// layout does not know exactly one detected tag, fewer than `min_points` depth samples fall on
-/// it, or the two normals are more than 30 degrees apart (the depth is not the tag's).
+/// layout does not know exactly one detected tag, the tag is seen more than
+/// `max_view_angle_degrees` off head-on (its face normal against the ray to its centre; seen
+/// obliquely, the corners pin the tilt themselves), fewer than `min_points` depth samples fall
+/// on it, or the two normals are more than 30 degrees apart (the depth is not the tag's).
 [[nodiscard]] MarkerPose refine_tilt_with_depth(const MarkerPose& pose, const std::vector<TagDetection>& detections,
                                                 const TagLayout& layout, const PinholeIntrinsics& intrinsics,
-                                                const DepthMap& depth, int min_points = 30);
+                                                const DepthMap& depth, double max_view_angle_degrees = 90.0,
+                                                int min_points = 30);
+
+/// The camera's marker pose refines a single tag's tilt from depth within this angle of head-on.
+inline constexpr double kMarkerHeadOnDegrees = 25.0;
 
 /// Distance refinement from registered depth (see above); returns the pose unchanged when fewer
 /// than 10 valid depth samples fall on the tags.
