@@ -105,14 +105,10 @@ void TrackedLampStage::run(StageContext& context) {
   const FrameInfo& frame = context.get(frame_);
   if (frame.camera_to_world) {
     const std::vector<capture::TagDetection>& detections = context.get(detections_).tags;
-    auto camera_to_tag = capture::estimate_camera_pose(detections, tag_alone_, frame.intrinsics);
-    if (camera_to_tag) {
-      const DepthMap& depth = context.get(depth_);
-      // Tilt first (the face's plane), then the distance along the ray.
-      camera_to_tag = capture::refine_tilt_with_depth(*camera_to_tag, detections, tag_alone_, frame.intrinsics, depth);
-      camera_to_tag = capture::refine_with_depth(*camera_to_tag, detections, tag_alone_, frame.intrinsics, depth);
-      seen = Pose(*frame.camera_to_world * camera_to_tag->camera_to_world.inverse());
-    }
+    // A hand-held lamp's small tag is often seen head-on: its tilt always comes from its depth.
+    const auto camera_to_tag =
+        capture::estimate_camera_pose(detections, tag_alone_, frame.intrinsics, context.get(depth_), 90.0);
+    if (camera_to_tag) seen = Pose(*frame.camera_to_world * camera_to_tag->camera_to_world.inverse());
   }
   if (seen) {
     ++frames_seen_;
@@ -123,14 +119,15 @@ void TrackedLampStage::run(StageContext& context) {
   lights::LightSet& out = context.get(lights_);
   out = context.get(room_);
   if (!last_) return;
-  if (probe_position_ && lamp_irradiance_at(*last_, *probe_position_) > 0.0) {
+  const double at_probe = probe_position_ ? lamp_irradiance_at(*last_, *probe_position_) : 0.0;
+  if (at_probe > 0.0) {
     Eigen::Vector3d removed;
     const std::size_t before = out.lights.size();
     out = without_lamp_in_probe(out, *last_, *probe_position_, removed);
     ++frames_lamp_in_probe_;
     lights_taken_out_ += static_cast<int>(before - out.lights.size());
     taken_out_irradiance_ += lights::luminance(removed);
-    lamp_irradiance_ += lamp_irradiance_at(*last_, *probe_position_);
+    lamp_irradiance_ += at_probe;
   }
   out.lights.push_back(*last_);
 }

@@ -79,6 +79,10 @@ std::optional<MarkerPose> estimate_camera_pose(const std::vector<TagDetection>& 
 
 namespace {
 
+/// The share of a tag's edge left out on each side where its face's depth is read: near the
+/// edges the depth is unreliable (mixed with what lies behind).
+constexpr double kFaceInset = 0.15;
+
 // Depth ratios measured / predicted at a grid of points on one tag's face (inset from the edges,
 // where depth is unreliable).
 void collect_depth_ratios(const TagLayout::Tag& tag, const Pose& world_to_camera, const PinholeIntrinsics& k,
@@ -86,7 +90,8 @@ void collect_depth_ratios(const TagLayout::Tag& tag, const Pose& world_to_camera
   constexpr int kGrid = 9;
   for (int i = 0; i < kGrid; ++i) {
     for (int j = 0; j < kGrid; ++j) {
-      const double a = 0.15 + 0.7 * i / (kGrid - 1), b = 0.15 + 0.7 * j / (kGrid - 1);
+      const double span = 1.0 - 2.0 * kFaceInset;
+      const double a = kFaceInset + span * i / (kGrid - 1), b = kFaceInset + span * j / (kGrid - 1);
       const Eigen::Vector3d on_tag = tag.corners_world[0] + a * (tag.corners_world[1] - tag.corners_world[0]) +
                                      b * (tag.corners_world[3] - tag.corners_world[0]);
       const Eigen::Vector3d camera = world_to_camera * on_tag;
@@ -95,8 +100,7 @@ void collect_depth_ratios(const TagLayout::Tag& tag, const Pose& world_to_camera
       const int col = static_cast<int>(std::lround(pixel.x())), row = static_cast<int>(std::lround(pixel.y()));
       if (!depth.in_bounds(row, col) || !is_valid_depth(depth(row, col))) continue;
       // The predicted depth at the rounded pixel: intersect its ray with the tag plane.
-      const Eigen::Vector3d normal = world_to_camera.linear() * (tag.corners_world[1] - tag.corners_world[0])
-                                                                   .cross(tag.corners_world[3] - tag.corners_world[0]);
+      const Eigen::Vector3d normal = world_to_camera.linear() * tag.normal();
       const Eigen::Vector3d ray = k.ray(col, row);
       const double denominator = normal.dot(ray);
       if (std::abs(denominator) < 1e-9) continue;
@@ -118,7 +122,7 @@ MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetect
     const TagLayout::Tag* tag = layout.find(detection.id);
     if (!tag) continue;
     collect_depth_ratios(*tag, world_to_camera, intrinsics, depth, ratios);
-    for (const auto& corner : tag->corners_world) centre_world += corner / 4.0;
+    centre_world += tag->centre();
     ++tags;
   }
   if (ratios.size() < 10 || tags == 0) return pose;
@@ -136,7 +140,7 @@ MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetect
 
 namespace {
 
-/// The measured camera-frame points on a tag's face, inset by 15 % from its edges: the pixels
+/// The measured camera-frame points on a tag's face, inset by kFaceInset from its edges: the pixels
 /// whose ray meets the face (as `world_to_camera` places it) within the inset square.
 std::vector<Eigen::Vector3d> face_points(const TagLayout::Tag& tag, const Pose& world_to_camera,
                                          const PinholeIntrinsics& intrinsics, const DepthMap& depth) {
@@ -158,8 +162,8 @@ std::vector<Eigen::Vector3d> face_points(const TagLayout::Tag& tag, const Pose& 
       if (!(along > 0.0)) continue;
       const Eigen::Vector3d on_face = along * ray - origin;
       const double a = on_face.dot(u_axis) / u_axis.squaredNorm(), b = on_face.dot(v_axis) / v_axis.squaredNorm();
-      if (a >= 0.15 && a <= 0.85 && b >= 0.15 && b <= 0.85)
-        points.push_back(intrinsics.unproject(col, row, depth(row, col)));
+      const auto inside = [](double x) { return x >= kFaceInset && x <= 1.0 - kFaceInset; };
+      if (inside(a) && inside(b)) points.push_back(intrinsics.unproject(col, row, depth(row, col)));
     }
   }
   return points;
@@ -207,12 +211,8 @@ MarkerPose refine_tilt_with_depth(const MarkerPose& pose, const std::vector<TagD
   }
   if (!tag) return pose;
   const Pose world_to_camera = pose.camera_to_world.inverse();
-  const Eigen::Vector3d normal =
-      world_to_camera.linear() *
-      (tag->corners_world[1] - tag->corners_world[0]).cross(tag->corners_world[3] - tag->corners_world[0]).normalized();
-  const Eigen::Vector3d tag_centre =
-      world_to_camera *
-      (0.25 * (tag->corners_world[0] + tag->corners_world[1] + tag->corners_world[2] + tag->corners_world[3]));
+  const Eigen::Vector3d normal = world_to_camera.linear() * tag->normal();
+  const Eigen::Vector3d tag_centre = world_to_camera * tag->centre();
   // Seen obliquely, the corners pin the tilt themselves.
   if (std::abs(normal.dot(tag_centre.normalized())) < std::cos(max_view_angle_degrees * EIGEN_PI / 180.0)) return pose;
   const auto measured = robust_plane_normal(face_points(*tag, world_to_camera, intrinsics, depth), min_points);
@@ -229,6 +229,16 @@ MarkerPose refine_tilt_with_depth(const MarkerPose& pose, const std::vector<TagD
   return result;
 }
 
+std::optional<MarkerPose> estimate_camera_pose(const std::vector<TagDetection>& detections, const TagLayout& layout,
+                                               const PinholeIntrinsics& intrinsics, const DepthMap& depth,
+                                               double head_on_degrees) {
+  const auto estimate = estimate_camera_pose(detections, layout, intrinsics);
+  if (!estimate) return std::nullopt;
+  // Tilt first (the face's plane), then the distance along the ray.
+  const MarkerPose tilted = refine_tilt_with_depth(*estimate, detections, layout, intrinsics, depth, head_on_degrees);
+  return refine_with_depth(tilted, detections, layout, intrinsics, depth);
+}
+
 void MarkerPoseStage::declare(StageBuilder& builder) {
   detections_ = builder.read(kTagDetections);
   depth_ = builder.read(kDepth);
@@ -239,12 +249,7 @@ void MarkerPoseStage::declare(StageBuilder& builder) {
 void MarkerPoseStage::run(StageContext& context) {
   const std::vector<TagDetection>& detections = context.get(detections_).tags;
   const PinholeIntrinsics& intrinsics = context.get(frame_).intrinsics;
-  auto estimate = estimate_camera_pose(detections, layout_, intrinsics);
-  if (estimate) {
-    const DepthMap& depth = context.get(depth_);
-    estimate = refine_tilt_with_depth(*estimate, detections, layout_, intrinsics, depth, kMarkerHeadOnDegrees);
-    estimate = refine_with_depth(*estimate, detections, layout_, intrinsics, depth);
-  }
+  const auto estimate = estimate_camera_pose(detections, layout_, intrinsics, context.get(depth_));
   CameraPose& out = context.get(pose_);
   if (estimate) last_ = estimate;
   out.valid = last_.has_value();

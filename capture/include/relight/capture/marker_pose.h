@@ -61,6 +61,14 @@ struct MarkerPose {
 /// The camera's marker pose refines a single tag's tilt from depth within this angle of head-on.
 inline constexpr double kMarkerHeadOnDegrees = 25.0;
 
+/// The pose from colour and depth, as MarkerPoseStage and a tracked lamp find it:
+/// estimate_camera_pose, then refine_tilt_with_depth within `head_on_degrees` of head-on, then
+/// refine_with_depth. None when no tag of the layout was detected.
+[[nodiscard]] std::optional<MarkerPose> estimate_camera_pose(const std::vector<TagDetection>& detections,
+                                                             const TagLayout& layout,
+                                                             const PinholeIntrinsics& intrinsics, const DepthMap& depth,
+                                                             double head_on_degrees = kMarkerHeadOnDegrees);
+
 /// Distance refinement from registered depth (see above); returns the pose unchanged when fewer
 /// than 10 valid depth samples fall on the tags.
 [[nodiscard]] MarkerPose refine_with_depth(const MarkerPose& pose, const std::vector<TagDetection>& detections,

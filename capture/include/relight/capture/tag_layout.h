@@ -22,6 +22,14 @@ struct TagLayout {
     double size = 0.0;  ///< metres, edge of the black square
     std::array<Eigen::Vector3d, 4> corners_world{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                                                  Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    /// The centre of the black square, world frame.
+    [[nodiscard]] Eigen::Vector3d centre() const {
+      return 0.25 * (corners_world[0] + corners_world[1] + corners_world[2] + corners_world[3]);
+    }
+    /// The unit normal of its face, (corner 1 - corner 0) x (corner 3 - corner 0), world frame.
+    [[nodiscard]] Eigen::Vector3d normal() const {
+      return (corners_world[1] - corners_world[0]).cross(corners_world[3] - corners_world[0]).normalized();
+    }
   };
   std::string family = "tag36h11";
   std::vector<Tag> tags;
