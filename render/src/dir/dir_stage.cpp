@@ -178,7 +178,8 @@ void VplStage::run(StageContext& context) {
   out.vpls =
       generate_vpls(scene, tracer, options_,
                     {.cone_search = cone_search_.get(), .reflective_shadow_maps = reflective_shadow_maps_.get()});
-  out.surfaces = vpl_surfaces(scene, out.vpls);
+  // Only the multiple-bounce light source reads them, next frame.
+  if (continues_previous_vpls()) out.surfaces = vpl_surfaces(scene, out.vpls);
   for (const Vpl& vpl : out.vpls) {
     const auto bounce = static_cast<std::size_t>(std::max(vpl.bounce, 0));
     if (count_by_bounce_.size() <= bounce) count_by_bounce_.resize(bounce + 1, 0.0);

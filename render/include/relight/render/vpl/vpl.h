@@ -192,7 +192,7 @@ struct VplOptions {
 /// multiple-bounce light source continues a previous VPL's path with these.
 struct VplSet {
   std::vector<Vpl> vpls;
-  std::vector<Phong> surfaces;  ///< one per VPL
+  std::vector<Phong> surfaces;  ///< one per VPL where the next frame continues them, else empty
   static constexpr const char* type_name = "VplSet";
 };
 
