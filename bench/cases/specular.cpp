@@ -6,7 +6,9 @@
 // the baseline the same frame without them ("dir_without_specular_objects"), interleaved;
 // stages_ms per step (specular: the caustic photons traced and gathered, the secondary
 // G-buffers traced and shaded, on the CPU); by_photon_count: the caustic error for 1k to 64k
-// photons per light.
+// photons per light; by_vpl_photon_count: caustic_region_error_without_caustics and the
+// specular step's ms for 0 to 64k photons from the VPLs (the indirect light that mirrors and
+// glass pass on, caustic_photons.h).
 // Errors against the path tracer (1 bounce, caustics on, kReferenceSpp samples per pixel):
 //   specular_delta_rel_error: sum |TM(L_rv) - TM(L_rv_ref)| / sum |TM(L_rv_ref)| over the
 //     pixels inside the mirror and glass (what they show where the camera image cannot be
@@ -18,8 +20,10 @@
 //     floor that the reference's noise sets under caustic_delta_rel_error;
 //   caustic_energy_ratio: what our caustics add to DeltaL over that region (64k photons per
 //     light, our frame with and without them) over what the reference's add (1 = as much);
-//   caustic_region_error_without_caustics: the same region's error of our frame without
-//     photons against the reference without caustic paths (DIR's shadows, VPLs there);
+//   caustic_region_error_without_caustics: the same region's error of our frame without the
+//     lights' photons against the reference without caustic paths (DIR's shadows and VPLs
+//     there, and the VPLs' photons: light from a diffuse surface through a mirror or glass is a
+//     camera path's, L D S D E, not a caustic);
 //   composite_rmse: as dir/vs_reference.
 #include <chrono>
 
@@ -185,6 +189,7 @@ bench::Json specular_640x480(const bench::Options& options) {
       caustic_error(path_traced(ours.scene, view, 2.0, 7), reference, without_caustics).first;
   json["composite_rmse"] = bench::compare(ours.images, reference).composite_rmse;
   json["caustic_photons_per_light"] = dir_options.caustics.photons_per_light;
+  json["caustic_vpl_photons"] = dir_options.caustics.vpl_photons;
   // The caustic error against the photon count (the VPL count stays at 256).
   bench::Json by_photons = bench::Json::array();
   for (const int photons : {1024, 4096, 16384, 65536}) {
@@ -206,6 +211,17 @@ bench::Json specular_640x480(const bench::Options& options) {
     json["caustic_energy_ratio"] = caustic_energy_ratio(with_photons, ours.images, reference, without_caustics);
     json["caustic_region_error_without_caustics"] =
         caustic_error(ours.images, reference, without_caustics, &without_caustics).first;
+    bench::Json by_vpl_photons = bench::Json::array();
+    for (const int photons : {0, 16384, 65536}) {
+      render::DirRenderOptions variant = none;
+      variant.caustics.vpl_photons = photons;
+      ours.draw(view, variant);
+      by_vpl_photons.push_back({{"vpl_photons", photons},
+                                {"caustic_region_error_without_caustics",
+                                 caustic_error(ours.images, reference, without_caustics, &without_caustics).first},
+                                {"specular_ms", ours.renderer.last_timings().specular_ms}});
+    }
+    json["by_vpl_photon_count"] = by_vpl_photons;
   }
   json["width"] = width;
   json["height"] = height;

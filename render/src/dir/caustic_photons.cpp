@@ -5,6 +5,8 @@
 #include <numbers>
 
 #include "relight/core/parallel.h"
+#include "relight/render/scene/discrete_sampler.h"
+#include "relight/render/scene/luminance.h"
 #include "relight/render/scene/phong_brdf.h"
 #include "relight/render/scene/sampler.h"
 #include "relight/render/scene/specular_bsdf.h"
@@ -16,8 +18,10 @@ namespace {
 
 using Vec3 = Eigen::Vector3f;
 
-/// Mixed into the seed so that photons draw other numbers than the VPLs.
+/// Mixed into the seed so that photons draw other numbers than the VPLs, and the VPLs' photons
+/// other numbers than the lights'.
 constexpr std::uint64_t kPhotonSeed = 0x3d9f2a61c4b8e057ull;
+constexpr std::uint64_t kVplPhotonSeed = 0x8b51c0e7a4f3d926ull;
 /// Photon paths per parallel work item, merged in order: the result does not depend on threads.
 constexpr int kPathsPerChunk = 1024;
 
@@ -49,10 +53,50 @@ std::optional<CausticPhoton> follow(const RayTracer& tracer, const detail::Emiss
   }
 }
 
+/// Where a photon path starts and in which worlds it is traced.
+struct PhotonSource {
+  detail::Emission emission;
+  bool in_real_virtual = true;
+  bool in_real = true;
+};
+
+/// `total` photon paths, path i started by emit(i, rng) (nullopt: none), each traced in the worlds
+/// of its source with the same random numbers: where the path meets only real surfaces, the two
+/// photons are the same and cancel in L_rv - L_r. Chunks are merged in order, so the result
+/// does not depend on the thread count.
+template <class Emit>
+std::vector<CausticPhoton> trace_paths(const RayTracer& tracer, std::size_t total, std::uint64_t seed, int max_vertices,
+                                       int threads, const Emit& emit) {
+  const auto chunks = static_cast<int>((total + kPathsPerChunk - 1) / kPathsPerChunk);
+  std::vector<std::vector<CausticPhoton>> found(static_cast<std::size_t>(chunks));
+  parallel_rows(
+      chunks, threads,
+      [&](int begin, int end) {
+        for (int chunk = begin; chunk < end; ++chunk) {
+          const std::size_t first = static_cast<std::size_t>(chunk) * kPathsPerChunk;
+          const std::size_t last = std::min(total, first + kPathsPerChunk);
+          for (std::size_t i = first; i < last; ++i) {
+            Pcg32 rng = Pcg32::for_sample(seed, i, 0);
+            const std::optional<PhotonSource> source = emit(i, rng);
+            if (!source) continue;
+            for (const bool real_world : {false, true}) {
+              if (!(real_world ? source->in_real : source->in_real_virtual)) continue;
+              if (auto photon = follow(tracer, source->emission, real_world, rng, max_vertices))
+                found[static_cast<std::size_t>(chunk)].push_back(*photon);
+            }
+          }
+        }
+      },
+      1);
+  std::vector<CausticPhoton> photons;
+  for (std::vector<CausticPhoton>& chunk : found) photons.insert(photons.end(), chunk.begin(), chunk.end());
+  return photons;
+}
+
 }  // namespace
 
-CausticPhotons::CausticPhotons(std::vector<CausticPhoton> photons, float radius)
-    : photons_(std::move(photons)), radius_(radius) {
+CausticPhotons::CausticPhotons(std::vector<CausticPhoton> photons, float radius, bool indirect)
+    : photons_(std::move(photons)), radius_(radius), indirect_(indirect) {
   for (std::size_t i = 0; i < photons_.size(); ++i) {
     const Eigen::Vector3i cell = (photons_[i].position / radius_).array().floor().cast<int>();
     cells_[key(cell.x(), cell.y(), cell.z())].push_back(static_cast<std::uint32_t>(i));
@@ -71,37 +115,64 @@ CausticPhotons trace_caustic_photons(const RayTracer& tracer, const CausticOptio
   if (options.photons_per_light <= 0 || target.radius <= 0.f || scene.lights.empty()) return {};
   const BoundingSphere whole = bounding_sphere(scene, SceneMeshes::All);
   const auto per_light = static_cast<std::size_t>(options.photons_per_light);
-  const std::size_t total = per_light * scene.lights.size();
-  const auto chunks = static_cast<int>((total + kPathsPerChunk - 1) / kPathsPerChunk);
-  std::vector<std::vector<CausticPhoton>> found(static_cast<std::size_t>(chunks));
   const float inv_paths = 1.f / static_cast<float>(per_light);
-  parallel_rows(
-      chunks, threads,
-      [&](int begin, int end) {
-        for (int chunk = begin; chunk < end; ++chunk) {
-          const std::size_t first = static_cast<std::size_t>(chunk) * kPathsPerChunk;
-          const std::size_t last = std::min(total, first + kPathsPerChunk);
-          for (std::size_t i = first; i < last; ++i) {
-            const MrLight& light = scene.lights[i / per_light];
-            Pcg32 rng = Pcg32::for_sample(options.seed ^ kPhotonSeed, i, 0);
-            const float u1 = rng.uniform(), u2 = rng.uniform();
-            std::optional<detail::Emission> emission = detail::emit_towards(light, target, whole, u1, u2);
-            if (!emission) continue;
-            emission->beta *= inv_paths;
-            // Both worlds with the same numbers: where the path meets only real surfaces, the
-            // two photons are the same and cancel in L_rv - L_r.
-            for (const bool real_world : {false, true}) {
-              if (real_world && !light.real) continue;
-              if (auto photon = follow(tracer, *emission, real_world, rng, options.max_vertices))
-                found[static_cast<std::size_t>(chunk)].push_back(*photon);
-            }
-          }
-        }
-      },
-      1);
-  std::vector<CausticPhoton> photons;
-  for (std::vector<CausticPhoton>& chunk : found) photons.insert(photons.end(), chunk.begin(), chunk.end());
-  return {std::move(photons), options.radius};
+  return {
+      trace_paths(tracer, per_light * scene.lights.size(), options.seed ^ kPhotonSeed, options.max_vertices, threads,
+                  [&](std::size_t i, Pcg32& rng) -> std::optional<PhotonSource> {
+                    const MrLight& light = scene.lights[i / per_light];
+                    const float u1 = rng.uniform(), u2 = rng.uniform();
+                    std::optional<detail::Emission> emission = detail::emit_towards(light, target, whole, u1, u2);
+                    if (!emission) return std::nullopt;
+                    emission->beta *= inv_paths;
+                    return PhotonSource{*emission, true, light.real};
+                  }),
+      options.radius};
+}
+
+CausticPhotons trace_vpl_caustic_photons(const RayTracer& tracer, std::span<const Vpl> vpls,
+                                         const CausticOptions& options, int threads) {
+  const MrScene& scene = tracer.scene();
+  const BoundingSphere target = bounding_sphere(scene, SceneMeshes::Specular);
+  if (options.vpl_photons <= 0 || target.radius <= 0.f) return {};
+  // Each VPL's share: the luminance of its flux times the solid angle of the cone around the
+  // specular objects and the largest cosine to its normal inside that cone.
+  DiscreteSampler sources;
+  for (std::size_t v = 0; v < vpls.size(); ++v) {
+    const Vpl& vpl = vpls[v];
+    if (vpl.emitter()) continue;
+    const Vec3 to_target = target.centre - vpl.position;
+    const float distance = to_target.norm();
+    double share = 4.0 * std::numbers::pi;
+    if (distance > target.radius) {
+      const float sin_max = target.radius / distance;
+      const float cos_max = std::sqrt(std::max(0.f, 1.f - sin_max * sin_max));
+      const float facing = std::min(1.f, vpl.normal.dot(to_target / distance) + sin_max);
+      share = 2.0 * std::numbers::pi * (1.0 - cos_max) * std::max(0.f, facing);
+    }
+    sources.add(v, share * static_cast<double>(luminance(vpl.flux)));
+  }
+  if (sources.size() == 0) return {};
+  const auto total = static_cast<std::size_t>(options.vpl_photons);
+  return {trace_paths(tracer, total, options.seed ^ kVplPhotonSeed, options.max_vertices, threads,
+                      [&](std::size_t i, Pcg32& rng) -> std::optional<PhotonSource> {
+                        const auto [index, probability] =
+                            sources.pick((static_cast<double>(i) + rng.uniform()) / static_cast<double>(total));
+                        const Vpl& vpl = vpls[index];
+                        const float u1 = rng.uniform(), u2 = rng.uniform();
+                        const auto [direction, pdf] = detail::sample_cone_towards(vpl.position, target, u1, u2);
+                        const float cos_y = direction.dot(vpl.normal);
+                        if (cos_y <= 0.f || direction.dot(vpl.geometric_normal) <= 0.f || !(pdf > 0.f))
+                          return std::nullopt;
+                        const Vec3 f = phong_brdf(vpl_phong(scene, vpl), vpl.normal, vpl.incident, direction);
+                        const float scale =
+                            cos_y / (pdf * static_cast<float>(probability * static_cast<double>(total)));
+                        const float offset = 1e-4f * (1.f + vpl.position.cwiseAbs().maxCoeff());
+                        return PhotonSource{
+                            {vpl.position + offset * vpl.geometric_normal, direction, vpl.flux.cwiseProduct(f) * scale},
+                            vpl.in_real_virtual,
+                            vpl.in_real};
+                      }),
+          options.vpl_radius, true};
 }
 
 void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const MrScene& scene,
@@ -113,6 +184,8 @@ void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const
   const float r = photons.radius();
   const float kernel = 3.f / (std::numbers::pi_v<float> * r * r);
   const int width = gbuffer.distance.width();
+  const bool indirect = photons.indirect() && images.indirect_real_virtual.same_shape(images.real_virtual) &&
+                        images.indirect_real.same_shape(images.real);
   const auto vec = [](const Float3& f) { return Vec3(f.x, f.y, f.z); };
   parallel_rows(
       gbuffer.distance.height(), threads,
@@ -143,8 +216,14 @@ void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const
               }
             });
             const Vec3 scale = vec(w);
-            images.real_virtual(y, x) += Float3{rv.x() * scale.x(), rv.y() * scale.y(), rv.z() * scale.z()};
-            images.real(y, x) += Float3{real.x() * scale.x(), real.y() * scale.y(), real.z() * scale.z()};
+            const Float3 add_rv{rv.x() * scale.x(), rv.y() * scale.y(), rv.z() * scale.z()};
+            const Float3 add_real{real.x() * scale.x(), real.y() * scale.y(), real.z() * scale.z()};
+            images.real_virtual(y, x) += add_rv;
+            images.real(y, x) += add_real;
+            if (indirect) {
+              images.indirect_real_virtual(y, x) += add_rv;
+              images.indirect_real(y, x) += add_real;
+            }
           }
       },
       4);

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "relight/core/parallel.h"
+#include "relight/render/scene/luminance.h"
 #include "relight/render/scene/specular_bsdf.h"
 #include "scene/surface_shading.h"
 
@@ -20,8 +21,6 @@ Vec3 leave(const SurfaceHit& hit, const Vec3& direction) {
   const float scale = 1e-4f * (1.f + hit.point.cwiseAbs().maxCoeff());
   return hit.point + (direction.dot(hit.geometric_normal) >= 0.f ? scale : -scale) * hit.geometric_normal;
 }
-
-float luminance(const Vec3& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
 
 struct BranchEnd {
   std::optional<SurfaceHit> surface;  ///< the diffuse surface; none: the branch left the scene

@@ -1,5 +1,7 @@
 #include "relight/render/dir/specular_shading.h"
 
+#include <array>
+
 #include "relight/core/error.h"
 
 namespace relight::render {
@@ -24,7 +26,7 @@ SpecularLight shade_specular_from_maps(const SpecularGBuffers& specular, const M
                                        const ShadowLayout& layout, std::span<const float> shadow_atlas,
                                        std::span<const Vpl> vpls, std::span<const float> ism_atlas,
                                        const IsmPointPools& ism_points, const DirRenderOptions& options,
-                                       const CausticPhotons* photons) {
+                                       std::span<const CausticPhotons> photons) {
   const int width = specular.specular.width(), height = specular.specular.height();
   SpecularLight out{{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,
                      RadianceImage(width, height), RadianceImage(width, height)},
@@ -34,8 +36,8 @@ SpecularLight shade_specular_from_maps(const SpecularGBuffers& specular, const M
   for (const SpecularBranch* branch : {&specular.reflected, &specular.refracted}) {
     DifferentialImages light = detail::shade_from_maps(branch->gbuffer, scene, Eigen::Vector3f::Zero(), &branch->eye,
                                                        layout, shadow_atlas, vpls, ism_atlas, ism_points, options);
-    if (photons)
-      add_caustic_light(light, branch->gbuffer, scene, *photons, Eigen::Vector3f::Zero(), &branch->eye, nullptr,
+    for (const CausticPhotons& some : photons)
+      add_caustic_light(light, branch->gbuffer, scene, some, Eigen::Vector3f::Zero(), &branch->eye, nullptr,
                         options.shading.threads);
     for (std::size_t i = 0; i < sum.real_virtual.size(); ++i) {
       if (!specular.specular.pixels()[i]) continue;
@@ -72,13 +74,15 @@ SpecularBackProjection add_specular_light(DifferentialImages& images, const RayT
                                           std::span<const float> ism_atlas, const IsmPointPools& ism_points,
                                           const DirRenderOptions& options) {
   const int threads = options.shading.threads;
-  const CausticPhotons photons = trace_caustic_photons(tracer, options.caustics, threads);
-  add_caustic_light(images, gbuffer, tracer.scene(), photons, camera.camera_to_world.translation().cast<float>(),
-                    nullptr, nullptr, threads);
+  const std::array<CausticPhotons, 2> photons{trace_caustic_photons(tracer, options.caustics, threads),
+                                              trace_vpl_caustic_photons(tracer, vpls, options.caustics, threads)};
+  for (const CausticPhotons& some : photons)
+    add_caustic_light(images, gbuffer, tracer.scene(), some, camera.camera_to_world.translation().cast<float>(),
+                      nullptr, nullptr, threads);
   const SpecularGBuffers specular = specular_gbuffers_cpu(tracer, camera, gbuffer, {.threads = threads});
   if (specular.pixels == 0) return {};
   const SpecularLight light = shade_specular_from_maps(specular, tracer.scene(), layout, shadow_atlas, vpls, ism_atlas,
-                                                       ism_points, options, &photons);
+                                                       ism_points, options, photons);
   put_specular_light(images, light.light, specular);
   return back_project(specular, light.reflected_real, light.refracted_real, tracer, camera);
 }

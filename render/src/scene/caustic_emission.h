@@ -18,6 +18,15 @@ struct Emission {
   Eigen::Vector3f beta;
 };
 
+/// A direction from `origin` uniform in the cone around the sphere `target` (the whole sphere of
+/// directions when `origin` lies inside it) and its density (per steradian).
+struct ConeSample {
+  Eigen::Vector3f direction;
+  float pdf = 0.f;
+};
+[[nodiscard]] ConeSample sample_cone_towards(const Eigen::Vector3f& origin, const BoundingSphere& target, float u1,
+                                             float u2);
+
 /// Samples the first ray from `light` towards `target` with the uniform numbers u1, u2; none
 /// where a spot light's cone gives it no light.
 [[nodiscard]] std::optional<Emission> emit_towards(const MrLight& light, const BoundingSphere& target,

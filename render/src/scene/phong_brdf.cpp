@@ -4,12 +4,12 @@
 #include <cmath>
 #include <numbers>
 
+#include "relight/render/scene/luminance.h"
+
 namespace relight::render {
 namespace {
 
 constexpr float kPi = std::numbers::pi_v<float>;
-
-float luminance(const Eigen::Vector3f& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
 
 float diffuse_probability(const Phong& m) {
   const float d = std::max(0.f, luminance(m.kd));

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <optional>
 
+#include "relight/render/scene/luminance.h"
 #include "relight/render/scene/mr_scene.h"
 #include "relight/render/scene/phong_brdf.h"
 #include "scene/surface_shading.h"  // detail::spot_falloff
@@ -17,8 +18,6 @@ namespace relight::render::vpl_detail {
 
 using Vec3 = Eigen::Vector3f;
 inline constexpr float kPi = std::numbers::pi_v<float>;
-
-inline float luminance(const Vec3& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
 
 /// Solid angle a light emits into (the spot's cone up to its outer edge).
 inline float emission_solid_angle(const MrLight& light) {

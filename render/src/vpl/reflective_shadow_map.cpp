@@ -9,6 +9,7 @@
 #include <string>
 
 #include "relight/core/error.h"
+#include "relight/render/scene/luminance.h"
 #include "relight/render/scene/phong_brdf.h"
 #include "scene/surface_shading.h"
 
@@ -16,8 +17,6 @@ namespace relight::render {
 namespace {
 
 using Vec3 = Eigen::Vector3f;
-
-float luminance(const Vec3& c) { return 0.2126f * c.x() + 0.7152f * c.y() + 0.0722f * c.z(); }
 
 /// The centre of texel (x, y) on the view's image plane at distance 1 along the axis.
 Eigen::Vector2f texel_centre(const RsmView& view, int x, int y) {
@@ -76,7 +75,6 @@ RsmView rsm_view(const MrScene& scene, std::size_t light_index, int size, const 
   view.size = size;
   return view;
 }
-
 
 std::vector<ReflectiveShadowMap> assemble_reflective_shadow_maps(const MrScene& scene, std::size_t light_index,
                                                                  const RsmView& view, const RsmTexelHitsFn& hits) {

@@ -8,13 +8,14 @@
 #include <utility>
 
 #include "relight/core/error.h"
+#include "relight/render/scene/discrete_sampler.h"
+#include "relight/render/scene/phong_brdf.h"
+#include "relight/render/scene/sampler.h"
 #include "relight/render/vpl/cone_search.h"
 #include "relight/render/vpl/cone_search_vk.h"
 #include "relight/render/vpl/hierarchical_warp.h"
-#include "relight/render/scene/phong_brdf.h"
 #include "relight/render/vpl/reflective_shadow_map.h"
 #include "relight/render/vpl/reflective_shadow_map_vk.h"
-#include "relight/render/scene/sampler.h"
 #include "scene/surface_shading.h"
 #include "vpl/light_sampling.h"
 #include "vpl/vpl_budget.h"
@@ -139,33 +140,6 @@ void add_emitters(const MrScene& scene, const BoundingSphere& bounds, std::vecto
   }
 }
 
-/// Sources of the multiple-bounce light source: picked in proportion to their flux's luminance,
-/// or uniformly.
-class SourceStratum {
- public:
-  explicit SourceStratum(bool by_flux) : by_flux_(by_flux) {}
-  void add(std::size_t index, double luminance) {
-    if (!(luminance > 0.0)) return;
-    total_ += by_flux_ ? luminance : 1.0;
-    indices_.push_back(index);
-    cumulative_.push_back(total_);
-  }
-  [[nodiscard]] std::size_t size() const { return indices_.size(); }
-  /// The source at u in [0, 1) and the probability it had.
-  [[nodiscard]] std::pair<std::size_t, double> pick(double u) const {
-    const auto found = static_cast<std::size_t>(std::upper_bound(cumulative_.begin(), cumulative_.end(), u * total_) -
-                                                cumulative_.begin());
-    const std::size_t k = std::min(found, indices_.size() - 1);
-    return {indices_[k], (cumulative_[k] - (k > 0 ? cumulative_[k - 1] : 0.0)) / total_};
-  }
-
- private:
-  bool by_flux_;
-  std::vector<std::size_t> indices_;
-  std::vector<double> cumulative_;
-  double total_ = 0.0;
-};
-
 /// The multiple-bounce light source (vpl.h): `n` segments continuing the paths of the previous
 /// frame's VPLs of bounce below options.bounces, in directions sampled from the sources' BRDFs.
 /// Two strata cover every source once:
@@ -184,12 +158,15 @@ bool continues_path(const Vpl& source, const VplOptions& options) {
 
 void emit_from_previous_vpls(int n, const VplOptions& options, VplTracer& tracer) {
   const std::span<const Vpl> sources = options.previous_vpls;
-  SourceStratum differential(false), rest(true);
+  DiscreteSampler differential, rest;
   for (std::size_t i = 0; i < sources.size(); ++i) {
     const Vpl& source = sources[i];
     if (!continues_path(source, options)) continue;
     const bool differs = !source.on_real_surface || source.in_real != source.in_real_virtual;
-    (differs ? differential : rest).add(i, static_cast<double>(luminance(source.flux)));
+    if (differs)
+      differential.add(i, 1.0);
+    else
+      rest.add(i, static_cast<double>(luminance(source.flux)));
   }
   if (n <= 0 || differential.size() + rest.size() == 0) return;
   int n_differential = 0;

@@ -22,15 +22,29 @@
 // same photons light the primary G-buffer and the secondary G-buffers of reflections and
 // refractions (caustics seen in a mirror, §4.2.1's last paragraph) without a buffer per view.
 //
+// Indirect light through mirrors and glass (L D S+ D E): the VPLs send photons at the specular
+// objects the same way (trace_vpl_caustic_photons): a VPL lights a point behind a mirror or glass
+// through its imperfect shadow map not at all (the object occludes it, as the paper's ISMs do),
+// and the light the object passes on - the room that a mirror bottle reflects onto the table
+// beside it, the light through a glass - reaches the table only along specular paths. The paper
+// has no such term (its caustics start at spot lights); the path tracer does. Each photon picks
+// a VPL in proportion to the flux it sends into the cone around the specular objects (luminance
+// x the cone's solid angle x the best cosine inside it), a direction uniform in that cone, and
+// carries Phi f_y(incident, w) cos(theta_y) / (pdf(w) N p(VPL)) in the VPL's worlds. Light from a
+// diffuse source is smooth, so these photons are gathered over a wider disc (`vpl_radius`).
+// Emitters (vpl.h) are left out: their lights send photons of their own above.
+//
 // Reads the MrScene through a RayTracer; writes CausticPhotons, which add_caustic_light()
 // gathers into DifferentialImages for any G-buffer.
 #include <cstdint>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
 #include "relight/render/differential_images.h"
 #include "relight/render/dir/gbuffer.h"
 #include "relight/render/reference/ray_tracer.h"
+#include "relight/render/vpl/vpl.h"
 
 namespace relight::render {
 
@@ -46,6 +60,8 @@ struct CausticOptions {
   int photons_per_light = 16384;  ///< rays per light aimed at the specular objects; 0 = no caustics
   float radius = 0.015f;          ///< metres: the density estimate's disc
   int max_vertices = 8;           ///< specular vertices one photon path may pass
+  int vpl_photons = 16384;        ///< photons from all VPLs together (above); 0 = none
+  float vpl_radius = 0.05f;       ///< metres: the disc their light is gathered over
   std::uint64_t seed = 1;
 };
 
@@ -53,11 +69,14 @@ struct CausticOptions {
 class CausticPhotons {
  public:
   CausticPhotons() = default;
-  CausticPhotons(std::vector<CausticPhoton> photons, float radius);
+  /// `indirect`: the photons of VPLs, whose light add_caustic_light() also counts in the
+  /// images' indirect parts (for their temporal smoothing).
+  CausticPhotons(std::vector<CausticPhoton> photons, float radius, bool indirect = false);
 
   [[nodiscard]] const std::vector<CausticPhoton>& photons() const { return photons_; }
   [[nodiscard]] float radius() const { return radius_; }
   [[nodiscard]] bool empty() const { return photons_.empty(); }
+  [[nodiscard]] bool indirect() const { return indirect_; }
   /// Calls visit(photon) for every photon within `radius` of `point` (in either world).
   template <class Visit>
   void for_each_near(const Eigen::Vector3f& point, const Visit& visit) const;
@@ -66,6 +85,7 @@ class CausticPhotons {
   [[nodiscard]] std::int64_t key(int x, int y, int z) const;
   std::vector<CausticPhoton> photons_;
   float radius_ = 0.f;
+  bool indirect_ = false;
   std::unordered_map<std::int64_t, std::vector<std::uint32_t>> cells_;
 };
 
@@ -73,10 +93,16 @@ class CausticPhotons {
 [[nodiscard]] CausticPhotons trace_caustic_photons(const RayTracer& tracer, const CausticOptions& options,
                                                    int threads = 0);
 
+/// The photons that `vpls` send through the specular objects of the tracer's scene (above; none
+/// without specular surfaces or VPLs).
+[[nodiscard]] CausticPhotons trace_vpl_caustic_photons(const RayTracer& tracer, std::span<const Vpl> vpls,
+                                                       const CausticOptions& options, int threads = 0);
+
 /// Adds the caustic light that each pixel of `gbuffer` reflects towards its eye (`eyes`, or
 /// `camera_centre` for all) to `images`' L_rv (photons of the virtual world) and, on real
 /// surfaces, L_r (photons of the real world); `weights` (optional) scales it per pixel (a
-/// secondary G-buffer's branch weight). The indirect parts are left as they are.
+/// secondary G-buffer's branch weight). The images' indirect parts (when they have them) gain the
+/// light of indirect photons (the VPLs') only.
 void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const MrScene& scene,
                        const CausticPhotons& photons, const Eigen::Vector3f& camera_centre,
                        const PositionMap* eyes = nullptr, const RadianceImage* weights = nullptr, int threads = 0);

@@ -32,16 +32,17 @@ struct SpecularLight {
   RadianceImage reflected_real, refracted_real;
 };
 
-/// `photons`: the frame's caustics, which the surfaces seen in mirrors and glass show too (none:
-/// no caustics).
+/// `photons`: the frame's caustics (the lights' and the VPLs'), which the surfaces seen in mirrors
+/// and glass show too (none: no caustics).
 [[nodiscard]] SpecularLight shade_specular_from_maps(const SpecularGBuffers& specular, const MrScene& scene,
                                                      const ShadowLayout& layout, std::span<const float> shadow_atlas,
                                                      std::span<const Vpl> vpls, std::span<const float> ism_atlas,
                                                      const IsmPointPools& ism_points, const DirRenderOptions& options,
-                                                     const CausticPhotons* photons = nullptr);
+                                                     std::span<const CausticPhotons> photons = {});
 
 /// The whole step on the CPU, where both DIR renderers call it: the caustics of the frame
-/// (caustic_photons.h, options.caustics) gathered at `gbuffer`; the secondary G-buffers of
+/// (caustic_photons.h, options.caustics: the lights' photons and those of `vpls`) gathered at
+/// `gbuffer`; the secondary G-buffers of
 /// `gbuffer` (specular_gbuffers_cpu over `tracer`), shaded with their caustics
 /// (shade_specular_from_maps), put into `images` (put_specular_light). Returns their
 /// back-projection into the camera image (specular_back_projection.h; empty where no pixel is
