@@ -14,6 +14,9 @@ using Vec3 = Eigen::Vector3f;
 constexpr float kNear = 0.01f;
 constexpr float kFar = 100.f;
 constexpr float kMaxSpotHalfAngle = 1.309f;  // 75 degrees: wider spots use the six cube faces
+/// A focused view's half-angle is this much wider than the virtual objects' bounding sphere, and
+/// a light must be this many radii from its centre to get one.
+constexpr float kFocusMargin = 1.02f;
 
 /// World-to-view rotation rows (right, down, forward): relight's camera convention.
 Eigen::Matrix3f view_rotation(const Vec3& forward) {
@@ -84,17 +87,31 @@ ShadowLayout plan_shadow_views(const MrScene& scene, int tile) {
         layout.virtual_views.push_back(
             orthographic_view(light.direction, virtual_bounds.centre, virtual_bounds.radius, tile));
       }
-    } else if (light.kind == LightKind::Spot && spot_half_angle <= kMaxSpotHalfAngle) {
-      layout.views.push_back(perspective_view(light.position, light.direction, spot_half_angle, tile));
     } else {
-      for (int face = 0; face < 6; ++face) {
-        Vec3 forward = Vec3::Zero();
-        forward[face / 2] = face % 2 == 0 ? 1.f : -1.f;
-        layout.views.push_back(perspective_view(light.position, forward, static_cast<float>(M_PI / 4), tile));
+      const bool spot = light.kind == LightKind::Spot && spot_half_angle <= kMaxSpotHalfAngle;
+      if (spot) {
+        layout.views.push_back(perspective_view(light.position, light.direction, spot_half_angle, tile));
+      } else {
+        for (int face = 0; face < 6; ++face) {
+          Vec3 forward = Vec3::Zero();
+          forward[face / 2] = face % 2 == 0 ? 1.f : -1.f;
+          layout.views.push_back(perspective_view(light.position, forward, static_cast<float>(M_PI / 4), tile));
+        }
+      }
+      // The virtual layer's view: the cone around the virtual objects, every view of the light
+      // alike (the lookup picks a cube face by direction; each face then holds the same view).
+      const Vec3 to_virtual = virtual_bounds.centre - light.position;
+      const float distance = to_virtual.norm();
+      if (virtual_bounds.radius > 0.f && distance > kFocusMargin * virtual_bounds.radius) {
+        const float half_angle = std::asin(virtual_bounds.radius / distance) * kFocusMargin;
+        if (half_angle < (spot ? spot_half_angle : kMaxSpotHalfAngle)) {
+          const ShadowView focused = perspective_view(light.position, to_virtual / distance, half_angle, tile);
+          layout.virtual_views.insert(layout.virtual_views.end(), spot ? 1 : 6, focused);
+        }
       }
     }
-    // Views of positional lights (and of any light in a scene without virtual objects) are
-    // the same for both layers.
+    // Views of a light without a focused virtual view (and of any light in a scene without
+    // virtual objects) are the same for both layers.
     const auto shared = layout.views.begin() + static_cast<std::ptrdiff_t>(layout.virtual_views.size());
     layout.virtual_views.insert(layout.virtual_views.end(), shared, layout.views.end());
     layout.light_views.push_back({first, static_cast<std::uint32_t>(layout.views.size()) - first});

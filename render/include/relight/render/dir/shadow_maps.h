@@ -6,11 +6,17 @@
 //   directional light                  one orthographic view over the scene's bounding sphere;
 //   light with MrLight::through_vpl    none (its emitter VPL's ISM shadows it).
 // Each view is rendered twice, through the real and through the virtual layer, so that the
-// shading pass gets V_r and V_v separately (eqs. 5.1-5.5 need min(V_r, V_v) and V_r). A
-// directional light's virtual-layer view covers only the virtual objects' bounding sphere: the
-// virtual layer casts no shadow outside it, and an orthographic view over the whole room gives
-// a small object a few texels (256-texel tiles over a 5 m room: 2 cm each), which smeared its
-// contact shadow over the real surface around it.
+// shading pass gets V_r and V_v separately (eqs. 5.1-5.5 need min(V_r, V_v) and V_r). The
+// virtual layer's views look only at the virtual objects' bounding sphere: the virtual layer
+// casts no shadow outside it (a lookup outside a view is unshadowed), and a view over the whole
+// room or the whole spot cone gives a small object few texels. A directional light's is the
+// orthographic view of that sphere: over a 5 m room, 256-texel tiles are 2 cm each, which
+// smeared the objects' contact shadows over the real surface around them. A spot or point
+// light's is the perspective view of the cone around the sphere (when the light stands outside
+// it and the cone is narrower than the spot's, or than 75 degrees for the six cube faces, which
+// then all hold it): the spot of bench dir/specular_640x480 saw its virtual objects through a
+// 70-degree view, whose texels made staircases of a glass pebble's shadow edge, a pixel or more
+// each.
 //
 // A texel stores the nearest surface's "light depth": the distance to the light for point and
 // spot lights, and the distance along the light's direction for a directional light
