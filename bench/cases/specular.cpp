@@ -6,7 +6,8 @@
 // the baseline the same frame without them ("dir_without_specular_objects"), interleaved;
 // stages_ms per step (specular: the caustic photons traced and gathered, the secondary
 // G-buffers traced and shaded, on the CPU); by_photon_count: the caustic error for 1k to 64k
-// photons per light; by_vpl_photon_count: caustic_region_error_without_caustics and the
+// photons per light; caustic_delta_rel_error_fixed_radius: the error when every photon is spread
+// over the widest disc (caustic_photons.h); by_vpl_photon_count: caustic_region_error_without_caustics and the
 // specular step's ms for 0 to 64k photons from the VPLs (the indirect light that mirrors and
 // glass pass on, caustic_photons.h).
 // Errors against the path tracer (1 bounce, caustics on, kReferenceSpp samples per pixel):
@@ -190,6 +191,9 @@ bench::Json specular_640x480(const bench::Options& options) {
   json["composite_rmse"] = bench::compare(ours.images, reference).composite_rmse;
   json["caustic_photons_per_light"] = dir_options.caustics.photons_per_light;
   json["caustic_vpl_photons"] = dir_options.caustics.vpl_photons;
+  json["caustic_radius"] = dir_options.caustics.radius;
+  json["caustic_min_radius"] = dir_options.caustics.min_radius;
+  json["caustic_neighbours"] = dir_options.caustics.neighbours;
   // The caustic error against the photon count (the VPL count stays at 256).
   bench::Json by_photons = bench::Json::array();
   for (const int photons : {1024, 4096, 16384, 65536}) {
@@ -222,6 +226,13 @@ bench::Json specular_640x480(const bench::Options& options) {
                                 {"specular_ms", ours.renderer.last_timings().specular_ms}});
     }
     json["by_vpl_photon_count"] = by_vpl_photons;
+  }
+  // The same photons each spread over the widest disc (no adaptation to their density).
+  {
+    render::DirRenderOptions fixed = dir_options;
+    fixed.caustics.min_radius = fixed.caustics.radius;
+    ours.draw(view, fixed);
+    json["caustic_delta_rel_error_fixed_radius"] = caustic_error(ours.images, reference, without_caustics).first;
   }
   json["width"] = width;
   json["height"] = height;

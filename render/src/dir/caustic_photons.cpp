@@ -1,6 +1,7 @@
 #include "relight/render/dir/caustic_photons.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -95,11 +96,43 @@ std::vector<CausticPhoton> trace_paths(const RayTracer& tracer, std::size_t tota
 
 }  // namespace
 
-CausticPhotons::CausticPhotons(std::vector<CausticPhoton> photons, float radius, bool indirect)
-    : photons_(std::move(photons)), radius_(radius), indirect_(indirect) {
+CausticPhotons::CausticPhotons(std::vector<CausticPhoton> photons, const PhotonKernel& kernel, bool indirect)
+    : photons_(std::move(photons)), radius_(kernel.radius), indirect_(indirect) {
+  const auto cell_of = [this](const Vec3& p) { return (p / radius_).array().floor().cast<int>().eval(); };
+  // Photons per cell and world (index 0: L_rv's, 1: L_r's).
+  std::unordered_map<std::int64_t, std::array<int, 2>> counts;
   for (std::size_t i = 0; i < photons_.size(); ++i) {
-    const Eigen::Vector3i cell = (photons_[i].position / radius_).array().floor().cast<int>();
-    cells_[key(cell.x(), cell.y(), cell.z())].push_back(static_cast<std::uint32_t>(i));
+    const Eigen::Vector3i cell = cell_of(photons_[i].position);
+    const std::int64_t k = key(cell.x(), cell.y(), cell.z());
+    cells_[k].push_back(static_cast<std::uint32_t>(i));
+    ++counts[k][photons_[i].real_world ? 1 : 0];
+  }
+  // Each cell's disc radius per world, from the photons of its 3 x 3 x 3 block: a disc holding
+  // `neighbours` of them where they cover (3 radius)^2.
+  const float min_radius = std::clamp(kernel.min_radius, 0.f, radius_);
+  const float block_area = 9.f * radius_ * radius_;
+  std::unordered_map<std::int64_t, std::array<float, 2>> radii;
+  for (const auto& [k, unused] : counts) {
+    const Eigen::Vector3i cell = cell_of(photons_[cells_[k].front()].position);
+    std::array<int, 2> block{0, 0};
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const auto found = counts.find(key(cell.x() + dx, cell.y() + dy, cell.z() + dz));
+          if (found == counts.end()) continue;
+          block[0] += found->second[0];
+          block[1] += found->second[1];
+        }
+    std::array<float, 2>& r = radii[k];
+    for (int world = 0; world < 2; ++world) {
+      const float wanted = std::sqrt(static_cast<float>(kernel.neighbours) * block_area /
+                                     (std::numbers::pi_v<float> * static_cast<float>(std::max(block[world], 1))));
+      r[static_cast<std::size_t>(world)] = std::clamp(wanted, min_radius, radius_);
+    }
+  }
+  for (CausticPhoton& q : photons_) {
+    const Eigen::Vector3i cell = cell_of(q.position);
+    q.radius = radii[key(cell.x(), cell.y(), cell.z())][q.real_world ? 1 : 0];
   }
 }
 
@@ -126,7 +159,7 @@ CausticPhotons trace_caustic_photons(const RayTracer& tracer, const CausticOptio
                     emission->beta *= inv_paths;
                     return PhotonSource{*emission, true, light.real};
                   }),
-      options.radius};
+      PhotonKernel{options.radius, options.min_radius, options.neighbours}};
 }
 
 CausticPhotons trace_vpl_caustic_photons(const RayTracer& tracer, std::span<const Vpl> vpls,
@@ -172,7 +205,7 @@ CausticPhotons trace_vpl_caustic_photons(const RayTracer& tracer, std::span<cons
                             vpl.in_real_virtual,
                             vpl.in_real};
                       }),
-          options.vpl_radius, true};
+          PhotonKernel{options.vpl_radius, options.vpl_radius, options.neighbours}, true};
 }
 
 void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const MrScene& scene,
@@ -181,8 +214,6 @@ void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const
   if (photons.empty()) return;
   const RadianceImage kd_texture = texture_factors(gbuffer, scene, MaterialTexture::BaseColor);
   const RadianceImage metallic_roughness = texture_factors(gbuffer, scene, MaterialTexture::MetallicRoughness);
-  const float r = photons.radius();
-  const float kernel = 3.f / (std::numbers::pi_v<float> * r * r);
   const int width = gbuffer.distance.width();
   const bool indirect = photons.indirect() && images.indirect_real_virtual.same_shape(images.real_virtual) &&
                         images.indirect_real.same_shape(images.real);
@@ -205,9 +236,10 @@ void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const
             Vec3 rv = Vec3::Zero(), real = Vec3::Zero();
             photons.for_each_near(p, [&](const CausticPhoton& q) {
               // On this side of this surface: not through a thin wall, not from a surface at an angle.
+              const float r = q.radius;
               if (q.normal.dot(n) < 0.7f || std::abs((q.position - p).dot(n)) > 0.5f * r || q.incident.dot(n) <= 0.f)
                 return;
-              const float falloff = kernel * (1.f - (q.position - p).norm() / r);
+              const float falloff = 3.f / (std::numbers::pi_v<float> * r * r) * (1.f - (q.position - p).norm() / r);
               const Vec3 light = phong_brdf(phong, n, q.incident, wo).cwiseProduct(q.flux) * falloff;
               if (q.real_world) {
                 if (real_surface) real += light;

@@ -1,6 +1,8 @@
-// Indirect light through mirrors and glass (dir/caustic_photons.h, trace_vpl_caustic_photons):
-// the photons a VPL sends at the specular objects bring the light they pass on to a diffuse
-// surface, which the VPL's imperfect shadow map cannot (it sees them as occluders).
+// Caustic photons (dir/caustic_photons.h) beyond the lights' caustics, which specular_dir_test.cpp
+// measures: the discs photons are spread over, and the indirect light through mirrors and glass
+// (trace_vpl_caustic_photons) - the photons a VPL sends at the specular objects bring the light
+// they pass on to a diffuse surface, which the VPL's imperfect shadow map cannot (it sees them
+// as occluders).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +11,7 @@
 
 #include "relight/render/dir/caustic_photons.h"
 #include "relight/render/dir/gbuffer.h"
+#include "relight/render/scene/sampler.h"
 #include "relight/render/scene/specular_bsdf.h"
 #include "relight/render/scene/tessellation.h"
 #include "specular_scenes.h"
@@ -31,6 +34,39 @@ Vpl upward_vpl(const Vector3f& position, float flux) {
 DifferentialImages blank_images(int width, int height) {
   return {RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,
           RadianceImage(width, height), RadianceImage(width, height)};
+}
+
+/// A photon on the floor (z = 0, lit from above) in world L_rv or L_r.
+CausticPhoton floor_photon(float x, float y, bool real_world) {
+  return {{x, y, 0.f}, Vector3f::UnitZ(), Vector3f::UnitZ(), Vector3f::Constant(1e-3f), real_world};
+}
+
+// Where photons crowd (a focus of 2 mm) their discs shrink to hold about `neighbours` of them; a
+// photon alone keeps the widest disc. A photon traced alike in both worlds gets the same disc in
+// both, so that it cancels in L_rv - L_r.
+TEST(CausticPhotons, CrowdedPhotonsGetSmallDiscsAndLoneOnesTheWidest) {
+  std::vector<CausticPhoton> photons;
+  Pcg32 rng(5, 1);
+  for (int i = 0; i < 4000; ++i) {
+    const float x = 0.002f * (rng.uniform() - 0.5f), y = 0.002f * (rng.uniform() - 0.5f);
+    photons.push_back(floor_photon(x, y, false));
+    photons.push_back(floor_photon(x, y, true));
+  }
+  for (int i = 0; i < 5; ++i) photons.push_back(floor_photon(0.2f * static_cast<float>(i + 1), 0.3f, false));
+  const CausticPhotons discs(photons, PhotonKernel{0.03f, 0.002f, 32});
+  // 32 of 4000 photons over a block of (3 x 3 cm)^2: a disc of sqrt(32 * 81e-4 / (4000 pi)) = 4.5 mm.
+  const float crowded = std::sqrt(32.f * 81e-4f / (4000.f * std::numbers::pi_v<float>));
+  for (std::size_t i = 0; i < 8000; ++i) EXPECT_NEAR(discs.photons()[i].radius, crowded, 1e-5f) << i;
+  for (std::size_t i = 8000; i < photons.size(); ++i) EXPECT_FLOAT_EQ(discs.photons()[i].radius, 0.03f);
+  int near_focus = 0, beside = 0;
+  discs.for_each_near({0.f, 0.f, 0.f}, [&](const CausticPhoton&) { ++near_focus; });
+  discs.for_each_near({0.01f, 0.f, 0.f}, [&](const CausticPhoton&) { ++beside; });
+  EXPECT_EQ(near_focus, 8000);
+  EXPECT_EQ(beside, 0);  // 1 cm from the focus: outside every disc of it
+  // One disc for all: what the widest gives every photon.
+  const CausticPhotons fixed(photons, PhotonKernel{0.03f, 0.03f, 32});
+  fixed.for_each_near({0.01f, 0.f, 0.f}, [&](const CausticPhoton&) { ++beside; });
+  EXPECT_EQ(beside, 8000);
 }
 
 // A VPL facing up under a perfect ceiling mirror lights the floor as its mirror image would: a
