@@ -7,10 +7,11 @@
 // stages_ms per step (specular: the caustic photons traced and gathered, the secondary
 // G-buffers traced and shaded, on the CPU); by_photon_count: the caustic error for 1k to 64k
 // photons per light; caustic_delta_rel_error_fixed_radius: the error when every photon is spread
-// over the widest disc (caustic_photons.h); by_vpl_photon_count: caustic_region_error_without_caustics and the
-// specular step's ms for 0 to 64k photons from the VPLs (the indirect light that mirrors and
-// glass pass on, caustic_photons.h).
-// Errors against the path tracer (1 bounce, caustics on, kReferenceSpp samples per pixel):
+// over the widest disc (caustic_photons.h); high_budget: the caustic error and the frame's ms with
+// 16 times the photons (lights' and VPLs') and 1024 light samples; by_vpl_photon_count:
+// caustic_region_error_without_caustics and the specular step's ms for 0 to 64k photons from the VPLs (the indirect
+// light that mirrors and glass pass on, caustic_photons.h). Errors against the path tracer (1 bounce, caustics on,
+// kReferenceSpp samples per pixel):
 //   specular_delta_rel_error: sum |TM(L_rv) - TM(L_rv_ref)| / sum |TM(L_rv_ref)| over the
 //     pixels inside the mirror and glass (what they show where the camera image cannot be
 //     back-projected; elsewhere the composite takes the camera's own colours);
@@ -24,7 +25,9 @@
 //   caustic_region_error_without_caustics: the same region's error of our frame without the
 //     lights' photons against the reference without caustic paths (DIR's shadows and VPLs
 //     there, and the VPLs' photons: light from a diffuse surface through a mirror or glass is a
-//     camera path's, L D S D E, not a caustic);
+//     camera path's, L D S D E, not a caustic). Not quite like for like: our frame keeps the
+//     caustic VPLs (vpl.h: light through glass leaves its VPL where it lands) and their photons,
+//     L S D (S) D E paths, which the reference finds only by its light tracing;
 //   composite_rmse: as dir/vs_reference.
 #include <chrono>
 
@@ -156,10 +159,11 @@ bench::Json specular_640x480(const bench::Options& options) {
         : scene(std::move(s)), tracer(scene), renderer(context, width, height) {
       renderer.set_scene(scene, options);
     }
+    int light_samples = 256;
     void draw(const render::MrCamera& view, const render::DirRenderOptions& options) {
       const auto start = std::chrono::steady_clock::now();
       render::VplOptions vpl_options;
-      vpl_options.count = 256;
+      vpl_options.count = light_samples;
       const std::vector<render::Vpl> vpls = render::generate_vpls(scene, tracer, vpl_options);
       vpl_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
       images = renderer.render(view, vpls, options);
@@ -226,6 +230,23 @@ bench::Json specular_640x480(const bench::Options& options) {
                                 {"specular_ms", ours.renderer.last_timings().specular_ms}});
     }
     json["by_vpl_photon_count"] = by_vpl_photons;
+  }
+  // The error where the method converges: 16 times the photons of every kind and 4 times the
+  // light samples.
+  {
+    render::DirRenderOptions more = dir_options;
+    more.caustics.photons_per_light *= 16;
+    more.caustics.vpl_photons *= 16;
+    ours.light_samples = 1024;
+    const auto start = std::chrono::steady_clock::now();
+    ours.draw(view, more);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    json["high_budget"] = {{"photons_per_light", more.caustics.photons_per_light},
+                           {"vpl_photons", more.caustics.vpl_photons},
+                           {"light_samples", ours.light_samples},
+                           {"caustic_delta_rel_error", caustic_error(ours.images, reference, without_caustics).first},
+                           {"ms", ms}};
+    ours.light_samples = 256;
   }
   // The same photons each spread over the widest disc (no adaptation to their density).
   {
