@@ -148,15 +148,27 @@ CausticPhotons trace_caustic_photons(const RayTracer& tracer, const CausticOptio
   if (options.photons_per_light <= 0 || target.radius <= 0.f || scene.lights.empty()) return {};
   const BoundingSphere whole = bounding_sphere(scene, SceneMeshes::All);
   const auto per_light = static_cast<std::size_t>(options.photons_per_light);
-  const float inv_paths = 1.f / static_cast<float>(per_light);
+  // Each light's first rays are a rotated Hammersley set over the cone (or disc) around the
+  // specular objects rather than independent numbers: the set covers the cone evenly, so the
+  // caustic's density is not blotched by clusters and gaps of random directions. Every light
+  // gets as many (measured: shares in proportion to the flux each light sends at the objects
+  // raised the bench's caustic error from 0.227 to 0.243 - the error is relative, and a dim
+  // light's caustic in a dark corner counts as much as the key light's).
+  std::vector<std::array<float, 2>> shifts;
+  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
+    Pcg32 rng = Pcg32::for_sample(options.seed ^ kPhotonSeed, l, 1);
+    shifts.push_back({rng.uniform(), rng.uniform()});
+  }
   return {
       trace_paths(tracer, per_light * scene.lights.size(), options.seed ^ kPhotonSeed, options.max_vertices, threads,
-                  [&](std::size_t i, Pcg32& rng) -> std::optional<PhotonSource> {
-                    const MrLight& light = scene.lights[i / per_light];
-                    const float u1 = rng.uniform(), u2 = rng.uniform();
+                  [&](std::size_t i, Pcg32&) -> std::optional<PhotonSource> {
+                    const std::size_t l = i / per_light;
+                    const MrLight& light = scene.lights[l];
+                    const auto [u1, u2] = rotated_hammersley(static_cast<std::uint32_t>(i % per_light),
+                                                             static_cast<std::uint32_t>(per_light), shifts[l]);
                     std::optional<detail::Emission> emission = detail::emit_towards(light, target, whole, u1, u2);
                     if (!emission) return std::nullopt;
-                    emission->beta *= inv_paths;
+                    emission->beta /= static_cast<float>(per_light);
                     return PhotonSource{*emission, true, light.real};
                   }),
       PhotonKernel{options.radius, options.min_radius, options.neighbours}};
@@ -186,12 +198,16 @@ CausticPhotons trace_vpl_caustic_photons(const RayTracer& tracer, std::span<cons
   }
   if (sources.size() == 0) return {};
   const auto total = static_cast<std::size_t>(options.vpl_photons);
+  // A VPL's photons are a run of consecutive indices (the pick is stratified by index), and the
+  // Halton points of any such run cover its cone evenly.
+  Pcg32 shift_rng(options.seed ^ kVplPhotonSeed, 1);
+  const std::array<float, 2> shift{shift_rng.uniform(), shift_rng.uniform()};
   return {trace_paths(tracer, total, options.seed ^ kVplPhotonSeed, options.max_vertices, threads,
                       [&](std::size_t i, Pcg32& rng) -> std::optional<PhotonSource> {
                         const auto [index, probability] =
                             sources.pick((static_cast<double>(i) + rng.uniform()) / static_cast<double>(total));
                         const Vpl& vpl = vpls[index];
-                        const float u1 = rng.uniform(), u2 = rng.uniform();
+                        const auto [u1, u2] = rotated_halton(static_cast<std::uint32_t>(i), shift);
                         const auto [direction, pdf] = detail::sample_cone_towards(vpl.position, target, u1, u2);
                         const float cos_y = direction.dot(vpl.normal);
                         if (cos_y <= 0.f || direction.dot(vpl.geometric_normal) <= 0.f || !(pdf > 0.f))

@@ -2,15 +2,16 @@
 // Caustics in DIR (Knecht et al., TVCG 2013 §4.2.1 and §5.2, eqs. 12-14): the light a spot,
 // point or directional light sends through mirrors and glass onto diffuse surfaces (LS+DE).
 //
-// Photons: from every light, rays aimed at the specular objects (the sampler of the path
-// tracer's light tracing), followed through their specular vertices (Fresnel-proportional choice,
-// Beer-Lambert inside glass, up to `max_vertices`) to the first diffuse surface, where the photon
-// is stored with its flux and incident direction; a ray whose first hit is not specular is direct
-// light, which the shadow maps already give. Each photon path is traced in both worlds with the
-// same random numbers: with the virtual objects (L_rv, every light) and without them (L_r, real
-// lights; virtual meshes invisible), so the paper's real(ls, p_hit, p) of eq. 14 - a caustic
-// reaches L_r only when the light, the specular object and the receiver are all real - follows
-// from the geometry instead of being a flag.
+// Photons: from every light, rays aimed at the specular objects (the sampler of the path tracer's
+// light tracing, but a rotated Hammersley set of directions per light where the tracer draws
+// independent ones; the VPLs' photons take rotated Halton points), followed through their specular
+// vertices (Fresnel-proportional choice, Beer-Lambert inside glass, up to `max_vertices`) to the
+// first diffuse surface, where the photon is stored with its flux and incident direction; a ray
+// whose first hit is not specular is direct light, which the shadow maps already give. Each photon
+// path is traced in both worlds with the same random numbers: with the virtual objects (L_rv, every
+// light) and without them (L_r, real lights; virtual meshes invisible), so the paper's real(ls,
+// p_hit, p) of eq. 14 - a caustic reaches L_r only when the light, the specular object and the
+// receiver are all real - follows from the geometry instead of being a flag.
 //
 // Density estimation: a G-buffer pixel at p with normal n reflects
 //   L(p, wo) = sum over photons q within r_q of p (on p's side of the surface)
@@ -24,9 +25,10 @@
 // to `min_radius`. The density is counted per cell of `radius` over its 3 x 3 x 3 block (a
 // surface crossing it covers about (3 radius)^2), the same for every photon of a cell and world,
 // so that a photon traced alike in both worlds gets the same disc in both and cancels in
-// L_rv - L_r. Measured (bench dir/specular_640x480, 16k photons per light, caustic_delta_rel_error):
-// one disc of 1.5 cm 0.302; adaptive from 3 cm down to 4 mm with 32 neighbours 0.281 (64
-// neighbours 0.292; 2.5 cm to 3 mm with 48: 0.280; 2 cm to 4 mm with 64: 0.286). Where this
+// L_rv - L_r. Measured (bench dir/specular_640x480, 16k photons per light, caustic_delta_rel_error,
+// independent random directions): one disc of 1.5 cm 0.302; adaptive from 3 cm down to 4 mm with
+// 32 neighbours 0.281 (64 neighbours 0.292; 2.5 cm to 3 mm with 48: 0.280; 2 cm to 4 mm with 64:
+// 0.286); with the Hammersley and Halton directions 0.227 (one 3 cm disc 0.288). Where this
 // departs from the paper: the paper rasterises photon G-buffers from each spot light and splats
 // photon quads into a screen-space caustic buffer (CBuf); relight traces the photons (exact
 // refraction, any light type, several specular vertices) and gathers them in world space, so the
