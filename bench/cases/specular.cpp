@@ -1,17 +1,16 @@
 // DIR with reflective and refractive objects (render/dir/specular_gbuffer.h, specular_shading.h;
 // Knecht et al., TVCG 2013) against the path tracer, on the synthetic room at 640x480: the glass
 // pebble and the aluminium bottle on the table under a real spot light, 256 light samples.
-//
 // dir/specular_640x480: `ms` per frame (VPLs included) of the Vulkan renderer with both objects,
-// the baseline the same frame without them ("dir_without_specular_objects"), interleaved;
-// stages_ms per step (specular: the caustic photons traced and gathered, the secondary
-// G-buffers traced and shaded, on the CPU); by_photon_count: the caustic error for 1k to 64k
-// photons per light; caustic_delta_rel_error_fixed_radius: the error when every photon is spread
-// over the widest disc (caustic_photons.h); high_budget: the caustic error and the frame's ms with
-// 16 times the photons (lights' and VPLs') and 1024 light samples; by_vpl_photon_count:
-// caustic_region_error_without_caustics and the specular step's ms for 0 to 64k photons from the VPLs (the indirect
-// light that mirrors and glass pass on, caustic_photons.h). Errors against the path tracer (1 bounce, caustics on,
-// kReferenceSpp samples per pixel):
+// the baseline the same frame without them ("dir_without_specular_objects"), interleaved; stages_ms
+// per step (specular: the caustic photons traced and gathered, the secondary G-buffers traced and
+// shaded, on the CPU); by_photon_count: the caustic error for 1k to 64k photons per light;
+// caustic_delta_rel_error_fixed_radius: the error when every photon is spread over the widest disc
+// (caustic_photons.h); high_budget: the caustic error and the frame's ms with 262144 photons per
+// light and from the VPLs and 1024 light samples; by_vpl_photon_count:
+// caustic_region_error_without_caustics and the specular step's ms for 0 to 64k photons from the
+// VPLs (the indirect light that mirrors and glass pass on, caustic_photons.h). Errors against the
+// path tracer (1 bounce, caustics on, kReferenceSpp samples per pixel):
 //   specular_delta_rel_error: sum |TM(L_rv) - TM(L_rv_ref)| / sum |TM(L_rv_ref)| over the
 //     pixels inside the mirror and glass (what they show where the camera image cannot be
 //     back-projected; elsewhere the composite takes the camera's own colours);
@@ -200,7 +199,7 @@ bench::Json specular_640x480(const bench::Options& options) {
   json["caustic_neighbours"] = dir_options.caustics.neighbours;
   // The caustic error against the photon count (the VPL count stays at 256).
   bench::Json by_photons = bench::Json::array();
-  for (const int photons : {1024, 4096, 16384, 65536}) {
+  for (const int photons : {1024, 4096, 16384, 32768, 65536}) {
     render::DirRenderOptions more = dir_options;
     more.caustics.photons_per_light = photons;
     ours.draw(view, more);
@@ -231,12 +230,12 @@ bench::Json specular_640x480(const bench::Options& options) {
     }
     json["by_vpl_photon_count"] = by_vpl_photons;
   }
-  // The error where the method converges: 16 times the photons of every kind and 4 times the
-  // light samples.
+  // The error where the method converges: 262144 photons of each kind and 4 times the light
+  // samples.
   {
     render::DirRenderOptions more = dir_options;
-    more.caustics.photons_per_light *= 16;
-    more.caustics.vpl_photons *= 16;
+    more.caustics.photons_per_light = 262144;
+    more.caustics.vpl_photons = 262144;
     ours.light_samples = 1024;
     const auto start = std::chrono::steady_clock::now();
     ours.draw(view, more);
