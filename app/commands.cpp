@@ -62,6 +62,13 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_option("--place", options.places,
                      std::string("Placement x,y,z[,yaw_degrees[,scale]] per --object, world frame (synthetic default ") +
                          kDefaultSynthPlacement + ")");
+  command.add_option("--real-object", options.real_objects,
+                     "A model of an object of the real scene - a real mirror or glass, whose depth the camera cannot "
+                     "measure - that virtual objects are seen in and virtual lights shine through: .obj, .gltf, .glb "
+                     "(repeatable, one --real-place each; it replaces the reconstruction around it)");
+  command.add_option("--real-place", options.real_places,
+                     "Placement x,y,z[,yaw_degrees[,scale]] of each --real-object, world frame (with markers: the "
+                     "marker frame)");
   command.add_option("--place-at", options.places_at,
                      "Placement u,v[,yaw_degrees[,scale]]: stand the object on the surface seen at pixel (u, v) of the "
                      "first frame, its up axis along that surface's normal (repeatable; objects take the --place "

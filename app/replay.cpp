@@ -162,7 +162,14 @@ BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayO
 /// The lights, the BRDF stages (real materials) and the DIR stage with its outputs, when the
 /// options ask for any virtual content.
 void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel) {
-  if (options.objects.empty() && options.virtual_lights.empty() && options.virtual_spots.empty()) return;
+  if (options.real_objects.size() != options.real_places.size())
+    throw Error("--real-object: " + std::to_string(options.real_objects.size()) + " objects but " +
+                std::to_string(options.real_places.size()) + " --real-place");
+  if (options.objects.empty() && options.virtual_lights.empty() && options.virtual_spots.empty()) {
+    if (!options.real_objects.empty())
+      throw Error("--real-object needs something virtual to render (--object, --virtual-light or --virtual-spot)");
+    return;
+  }
   if (options.vpls < 0 || options.vpls > 4096) throw Error("--vpls must be 0 to 4096");
   if (!(options.exposure > 0.f)) throw Error("--exposure must be positive");
   const auto scene = scene_folder(options);
@@ -187,6 +194,13 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
         requests[i].placement.scale * 0.5 * std::hypot(box.sizes().x(), box.sizes().z());
     content.objects.emplace_back(std::move(model), requests[i].placement);
     names.push_back(options.objects[i].filename().string());
+  }
+
+  for (std::size_t i = 0; i < options.real_objects.size(); ++i) {
+    render::VirtualModel model = render::load_model(options.real_objects[i]);
+    for (const std::string& warning : model.warnings)
+      std::cerr << "relight: warning: " << options.real_objects[i].string() << ": " << warning << "\n";
+    content.real_objects.emplace_back(std::move(model), render::Placement::parse(options.real_places[i]));
   }
 
   FrameGraph& graph = *pipeline.graph;
@@ -389,6 +403,13 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
   if (pipeline.camera_look) report["camera_look"] = camera_look_json(pipeline.camera_look->summary());
   if (pipeline.tone_map) report["tone_map"] = tone_map_json(pipeline.tone_map->options(), pipeline.tone_map->last());
   report["latency_ms"] = pipeline.latency->summary();
+  if (!options.real_objects.empty()) {
+    nlohmann::ordered_json real_objects = nlohmann::ordered_json::array();
+    for (std::size_t i = 0; i < options.real_objects.size(); ++i)
+      real_objects.push_back(
+          {{"model", options.real_objects[i].filename().string()}, {"place", options.real_places[i]}});
+    report["real_objects"] = real_objects;
+  }
   if (pipeline.placement) {
     report["placements"] = pipeline.placement->summary();
     if (!options.quiet) std::cerr << pipeline.placement->describe();

@@ -74,6 +74,9 @@ struct ReplayOptions {
   std::vector<std::string> places;             ///< x,y,z[,yaw[,scale]] (world), see object_placement_stage.h
   std::vector<std::string> places_at;          ///< u,v[,yaw[,scale]]: on the surface at a first-frame pixel
   std::vector<std::string> places_on_plane;    ///< [yaw[,scale]]: on the dominant support plane
+  /// Pre-modelled objects of the real scene (a real mirror or glass), one --real-place each.
+  std::vector<std::filesystem::path> real_objects;
+  std::vector<std::string> real_places;  ///< x,y,z[,yaw[,scale]] (world) per real object
   /// The main job (`relight replay` on the embedded sample with nothing to render) renders the
   /// shipped pebble on the sample's support plane, lit by the shipped probe; this turns it off.
   bool no_object = false;

@@ -2,6 +2,7 @@
 // buffers on request, and one-line errors for what it cannot render.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
 #include "cli.h"
@@ -211,6 +212,48 @@ TEST(ReplayRenderCli, RealOnlyRenderCarriesTheCamerasColoursWithPerPixelAlbedo) 
   EXPECT_LT(median_error[0], 0.5 * median_error[1]);
 }
 
+// A real mirror given as a model (--real-object; the aluminium bottle beside the pebble): the
+// pebble is seen in it, so DeltaL changes there and in the pebble's light around the bottle, and
+// nowhere else - the bottle's own light, in both worlds, cancels. report.json names it.
+TEST(ReplayRenderCli, ARealMirrorModelShowsThePebbleAndChangesNothingElse) {
+  test::TempDir dir;
+  const std::string common = "replay --quiet " + two_frame_sequence().string() + " --object " +
+                             (kData / "models" / "glossy_pebble.gltf").string() + " --vpls 32 --buffers --out ";
+  const auto plain = dir.path() / "plain", mirrored = dir.path() / "mirrored";
+  ASSERT_EQ(relight(common + plain.string()).exit_code, 0);
+  const auto result = relight(common + mirrored.string() + " --real-object " +
+                              (kData / "models" / "metal_bottle.gltf").string() + " --real-place 0.12,-0.38,0.75");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto report = nlohmann::json::parse(read_text_file(mirrored / "report.json"));
+  ASSERT_EQ(report.at("real_objects").size(), 1u);
+  EXPECT_EQ(report["real_objects"][0]["model"], "metal_bottle.gltf");
+  for (const char* frame : {"000000", "000001"}) {
+    const RadianceImage a = read_radiance(plain / "frames" / (std::string(frame) + "_delta_L.exr"));
+    const RadianceImage b = read_radiance(mirrored / "frames" / (std::string(frame) + "_delta_L.exr"));
+    ASSERT_TRUE(a.same_shape(b));
+    // Changes below 0.01 are everywhere: the VPLs land elsewhere once the bottle stands in the
+    // room, and the pebble's own indirect light reaches the whole room.
+    int changed = 0, strongly = 0;
+    Eigen::AlignedBox2i where;
+    for (int y = 0; y < a.height(); ++y)
+      for (int x = 0; x < a.width(); ++x) {
+        const Float3 d = a(y, x) - b(y, x);
+        const float m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+        changed += m > 0.01f ? 1 : 0;
+        if (m <= 0.1f) continue;
+        ++strongly;
+        where.extend(Eigen::Vector2i(x, y));
+      }
+    std::cout << frame << ": DeltaL changed by > 0.01 at " << changed << " pixels, by > 0.1 at " << strongly
+              << " within columns " << where.min().x() << ".." << where.max().x() << ", rows " << where.min().y()
+              << ".." << where.max().y() << "\n";
+    EXPECT_GT(strongly, 20) << "the pebble seen in the bottle";
+    EXPECT_LT(where.sizes().x(), 200);  // the bottle and the pebble beside it, 140 x 70 measured
+    EXPECT_LT(where.sizes().y(), 120);
+    EXPECT_LT(changed, static_cast<int>(a.size()) / 50);
+  }
+}
+
 TEST(ReplayRenderCli, WithoutVirtualContentNothingIsRendered) {
   test::TempDir dir;
   const auto out = dir.path() / "out";
@@ -238,6 +281,11 @@ TEST(ReplayRenderCli, BadRenderInputGivesOneLineErrors) {
   expect_one_line_error(relight("replay" + seq + pebble + " --vpl-budget weights --vpl-weights 1,-2" + out), 2);
   expect_one_line_error(relight("replay" + seq + pebble + " --vpl-bounces 0" + out), 2);
   expect_one_line_error(relight("replay" + seq + pebble + " --bounce-method photons" + out), 2);
+  const std::string bottle = " --real-object " + (kData / "models" / "metal_bottle.gltf").string();
+  expect_one_line_error(relight("replay" + seq + pebble + bottle + out), 1);                 // no --real-place
+  expect_one_line_error(relight("replay" + seq + bottle + " --real-place 0,0,1" + out), 1);  // nothing virtual
+  expect_one_line_error(relight("replay" + seq + pebble + bottle + " --real-place 0,0" + out), 1);
+  expect_one_line_error(relight("replay" + seq + pebble + " --real-object /no/such.glb --real-place 0,0,1" + out), 1);
   // A recorded sequence needs its lights and a placement.
   expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + " --place 0,0,1" + out), 1);
   expect_one_line_error(relight("replay " + (kData / "tum_fr1_rpy").string() + pebble + out), 1);

@@ -225,9 +225,15 @@ TEST(SpecularDir, AVirtualGlassBallShowsTheFloorBehindItAsThePathTracerDoes) {
             << (c.dir_sum.array() / c.reference_sum.array()).transpose() << "\n";
 }
 
-// Eqs. 4-5: light of a virtual lamp, and a virtual object seen in the mirror, reach L'_rv only.
-TEST(SpecularDir, OnlyRealLightOnRealSurfacesReachesTheReflectionsLr) {
+// Eqs. 4-5: light of a virtual lamp, and a virtual object seen in the mirror, reach L'_rv only -
+// in a virtual mirror and in a real one alike (Knecht et al. 2013 Fig. 7: the yellow box is seen
+// in the real and in the virtual bottle).
+class SpecularDirMirrorLayer : public ::testing::TestWithParam<bool> {};
+
+TEST_P(SpecularDirMirrorLayer, OnlyRealLightOnRealSurfacesReachesTheReflectionsLr) {
   MrScene scene = mirror_scene(Vector3f::Ones());
+  for (TriangleMesh& mesh : scene.meshes)
+    if (mesh.name == "mirror") mesh.real = GetParam();
   scene.lights[0].real = false;
   test::add_virtual_box(scene, synth::Box{{-0.3, 0.0, 0.0}, {-0.1, 0.2, 0.2}},
                         test::diffuse({0.8f, 0.2f, 0.2f}, "box"));
@@ -258,6 +264,9 @@ TEST(SpecularDir, OnlyRealLightOnRealSurfacesReachesTheReflectionsLr) {
   EXPECT_GT(box_seen, 5);
   EXPECT_GT(floor_seen, 50);
 }
+
+INSTANTIATE_TEST_SUITE_P(VirtualAndRealMirror, SpecularDirMirrorLayer, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& info) { return info.param ? "Real" : "Virtual"; });
 
 /// A camera image whose pixels tell where they are: linear red = x / width, green = y / height.
 ColorImage position_coded(int width, int height) {
@@ -434,6 +443,55 @@ TEST(DirCaustics, AGlassSlabLetsTheSunThroughItIntoLrvOnly) {
   const Eigen::Vector3d through = test::mean_over(dir.real_virtual, under);
   std::cout << "slab caustic, DIR / closed form: " << through.x() / (lit * slab_transmittance(1.5f, colour.x()))
             << "\n";
+}
+
+// Knecht et al. 2013 Fig. 7's four combinations: a real or a virtual mirror under a real or a
+// virtual lamp. The mirror (x = 0.4, facing -x) throws the lamp's light onto the floor as the
+// lamp's mirror image at (0.8, 0, 1) would: (albedo / pi) I h / d^3 with h = 1 m and d the
+// distance to the image. That caustic reaches L_rv always and L_r only when the lamp and the
+// mirror are both real (eq. 14) - then the two cancel and DeltaL keeps nothing of it, since the
+// camera image shows it already.
+TEST(DirCaustics, FourCombinationsOfARealOrVirtualMirrorAndLamp) {
+  const float albedo = 0.5f, intensity = 2.f;
+  const Vector3f image(0.8f, 0.f, 1.f);
+  const MrCamera camera = mirror_camera(64, 48);
+  for (const bool real_mirror : {true, false})
+    for (const bool real_lamp : {true, false}) {
+      SCOPED_TRACE(std::string(real_mirror ? "real" : "virtual") + " mirror, " + (real_lamp ? "real" : "virtual") +
+                   " lamp");
+      MrScene scene = mirror_scene(Vector3f::Ones(), {0.f, 0.f, 1.f}, intensity);
+      for (TriangleMesh& mesh : scene.meshes)
+        if (mesh.name == "mirror") mesh.real = real_mirror;
+      scene.lights[0].real = real_lamp;
+      DirRenderOptions options = direct_only();
+      options.caustics.photons_per_light = 65536;
+      DirRenderOptions none = options;
+      none.caustics.photons_per_light = 0;
+      const DifferentialImages with = render_dir_cpu(scene, camera, {}, options);
+      const DifferentialImages without = render_dir_cpu(scene, camera, {}, none);
+      const auto pixels = test::floor_pixels(scene, camera, {-0.4f, -0.25f}, {0.2f, 0.25f});
+      ASSERT_GT(pixels.size(), 100u);
+      const GBuffer gbuffer = gbuffer_cpu(RayTracer(scene), camera);
+      double expected = 0.0;
+      for (const auto& [row, col] : pixels) {
+        const Float3& p = gbuffer.position(row, col);
+        const double d = (Vector3f(p.x, p.y, p.z) - image).norm();
+        expected += albedo / std::numbers::pi * intensity / (d * d * d);
+      }
+      expected /= static_cast<double>(pixels.size());
+      const double caustic_rv =
+          (test::mean_over(with.real_virtual, pixels) - test::mean_over(without.real_virtual, pixels)).x();
+      const double caustic_r = (test::mean_over(with.real, pixels) - test::mean_over(without.real, pixels)).x();
+      std::cout << (real_mirror ? "real" : "virtual") << " mirror, " << (real_lamp ? "real" : "virtual")
+                << " lamp: caustic in L_rv " << caustic_rv / expected << ", in L_r " << caustic_r / expected
+                << " of the closed form\n";
+      EXPECT_NEAR(caustic_rv, expected, 0.05 * expected);
+      if (real_mirror && real_lamp) {
+        EXPECT_NEAR(caustic_r, caustic_rv, 1e-6 * expected);  // the same photons in both worlds
+      } else {
+        EXPECT_LT(std::abs(caustic_r), 1e-9);
+      }
+    }
 }
 
 // A ball lens focuses a point light's rays below it: the brightest floor pixel lies on the axis,

@@ -10,6 +10,7 @@
 #include "relight/render/dir/composite.h"
 #include "relight/render/dir/edge_coverage.h"
 #include "relight/render/reference/ray_tracer.h"
+#include "relight/render/scene/real_object_carving.h"
 #include "relight/render/scene/scene_lights.h"
 
 namespace relight::render {
@@ -130,6 +131,16 @@ void MrSceneStage::run(StageContext& context) {
     scene.coarse_real_meshes.push_back(
         mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, coarse));
     scene.coarse_real_meshes.back().name = "reconstruction (coarse)";
+  }
+  const std::size_t reconstruction = scene.meshes.size() - 1;
+  for (const auto& [model, placement] : content_.real_objects) {
+    const std::size_t first = scene.meshes.size();
+    add_real_model(scene, model, placement);
+    const std::span<const TriangleMesh> object(scene.meshes.data() + first, scene.meshes.size() - first);
+    remove_triangles_within(scene.meshes[reconstruction], object, kRealObjectMargin);
+    if (scene.coarse_real_meshes.empty()) continue;
+    remove_triangles_within(scene.coarse_real_meshes.front(), object, kRealObjectMargin);  // the reconstruction's
+    scene.coarse_real_meshes.insert(scene.coarse_real_meshes.end(), object.begin(), object.end());
   }
   if (!placements_buffer_) {
     for (const auto& [model, placement] : content_.objects) add_virtual_model(scene, model, placement);

@@ -107,19 +107,31 @@ void check_model(VirtualModel& model, const std::filesystem::path& file) {
   }
 }
 
-void add_virtual_model(MrScene& scene, const VirtualModel& model, const Placement& placement) {
+namespace {
+
+void add_model(MrScene& scene, const VirtualModel& model, const Placement& placement, bool real) {
   const auto first_material = static_cast<std::uint32_t>(scene.materials.size());
   for (const PhongMaterial& m : model.materials) scene.materials.push_back(m);
   const Eigen::Affine3f t = placement.transform().cast<float>();
   const Eigen::Matrix3f normal_matrix = t.linear().inverse().transpose();
   for (const TriangleMesh& source : model.meshes) {
     TriangleMesh mesh = source;
-    mesh.real = false;
+    mesh.real = real;
     for (Eigen::Vector3f& p : mesh.positions) p = t * p;
     for (Eigen::Vector3f& n : mesh.normals) n = (normal_matrix * n).normalized();
     for (std::uint32_t& m : mesh.triangle_material) m += first_material;
     scene.meshes.push_back(std::move(mesh));
   }
+}
+
+}  // namespace
+
+void add_virtual_model(MrScene& scene, const VirtualModel& model, const Placement& placement) {
+  add_model(scene, model, placement, false);
+}
+
+void add_real_model(MrScene& scene, const VirtualModel& model, const Placement& placement) {
+  add_model(scene, model, placement, true);
 }
 
 Eigen::AlignedBox3f bounds(const VirtualModel& model) {

@@ -154,7 +154,14 @@ struct DirStageOptions {
 struct DirSceneContent {
   std::vector<MrLight> lights;  ///< real lights that do not change, and virtual lights
   std::vector<std::pair<VirtualModel, Placement>> objects;
+  /// Pre-modelled objects of the real scene (add_real_model: a real mirror or glass), in place of
+  /// the reconstruction's triangles within kRealObjectMargin of them (real_object_carving.h).
+  std::vector<std::pair<VirtualModel, Placement>> real_objects{};
 };
+
+/// Metres around a pre-modelled real object within which the reconstruction is taken for the
+/// object's own noisy depth (a Kinect's depth noise at 1-2 m is a few millimetres).
+inline constexpr float kRealObjectMargin = 0.01f;
 
 /// The stages of add_dir_stages whose summaries the report shows.
 struct DirStages {

@@ -52,6 +52,12 @@ struct ObjectPlacements {
 
 /// Adds the model to the scene as virtual meshes (materials appended, normals transformed).
 void add_virtual_model(MrScene& scene, const VirtualModel& model, const Placement& placement);
+/// Adds the model to the scene as real meshes (r = real): a pre-modelled object of the real
+/// scene - a mirror or a glass, whose depth the camera cannot measure - that reflects, refracts
+/// and casts caustics in both worlds of differential rendering (Knecht et al. 2013, Fig. 7's
+/// real bottle). Its light is in the camera image already; what changes is what the virtual
+/// objects and lights add to it.
+void add_real_model(MrScene& scene, const VirtualModel& model, const Placement& placement);
 
 /// Axis-aligned bounds of all vertices (for tests and reports).
 [[nodiscard]] Eigen::AlignedBox3f bounds(const VirtualModel& model);
