@@ -7,7 +7,8 @@
 # after colour mapping, composite.mp4, report.html. Then the same on a short synthetic sequence
 # (`relight synth`, with its own light probe and exact geometry), results in
 # out/replay-mixed-reality, and on that sequence the glass pebble beside the aluminium bottle
-# (reflections, refractions and caustics), results in out/replay-glass.
+# (reflections, refractions and caustics), results in out/replay-glass; and the glass pebble on
+# the real TUM desk, results in out/replay-glass-tum.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/install-deps.sh"
@@ -22,4 +23,7 @@ mixed="$out-mixed-reality"
 glass="$out-glass"
 "$relight" replay "$mixed/sequence" --object "$root/data/models/glass_pebble.gltf" --place 0.35,-0.2,0.75,30 \
   --object "$root/data/models/metal_bottle.gltf" --place 0.1,-0.3,0.75 --out "$glass"
-echo "Results (open report.html in each): $out, $mixed, $glass"
+glass_tum="$out-glass-tum"
+"$relight" replay --object "$root/data/models/glass_pebble.gltf" --place-on-plane \
+  --probe "$root/data/probes/grace_latlong.hdr" --composite multiplicative --out "$glass_tum"
+echo "Results (open report.html in each): $out, $mixed, $glass, $glass_tum"
