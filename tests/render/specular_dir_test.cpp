@@ -252,7 +252,11 @@ TEST_P(SpecularDirMirrorLayer, OnlyRealLightOnRealSurfacesReachesTheReflectionsL
       if (!g.specular(row, col) || g.reflected.gbuffer.distance(row, col) == 0.f) continue;
       const Vector3f rv = at(dir.real_virtual, row, col), r = at(dir.real, row, col);
       if (g.reflected.gbuffer.virtual_surface(row, col)) {
-        EXPECT_EQ(r, Vector3f::Zero()) << row << "," << col;  // the virtual box: r(p_refl) false
+        if (GetParam()) {
+          EXPECT_GT(r.sum(), 0.f) << row << "," << col;  // a real mirror's L'_r: the real floor behind the box
+        } else {
+          EXPECT_EQ(r, Vector3f::Zero()) << row << "," << col;  // the virtual box: r(p_refl) false
+        }
         box_seen += rv.sum() > 0.f;
       } else {
         // The real floor: L'_r has the real lamp's light only, L'_rv both lamps'.
@@ -267,6 +271,35 @@ TEST_P(SpecularDirMirrorLayer, OnlyRealLightOnRealSurfacesReachesTheReflectionsL
 
 INSTANTIATE_TEST_SUITE_P(VirtualAndRealMirror, SpecularDirMirrorLayer, ::testing::Bool(),
                          [](const ::testing::TestParamInfo<bool>& info) { return info.param ? "Real" : "Virtual"; });
+
+// A virtual box seen in a real mirror takes the place of what the mirror shows behind it: L'_r
+// there is the real world's reflection - the floor behind the box, exactly as the scene without
+// the box has it - rather than eq. 4's zero, so Delta L' = box - floor and the composite shows
+// the box instead of the box added to the camera's reflection of the floor.
+TEST(SpecularDir, AVirtualBoxInARealMirrorReplacesTheFloorBehindIt) {
+  MrScene without = mirror_scene(Vector3f::Ones());
+  for (TriangleMesh& mesh : without.meshes)
+    if (mesh.name == "mirror") mesh.real = true;
+  MrScene scene = without;
+  test::add_virtual_box(scene, synth::Box{{-0.3, 0.0, 0.0}, {-0.1, 0.2, 0.2}},
+                        test::diffuse({0.8f, 0.2f, 0.2f}, "box"));
+  const MrCamera camera = mirror_camera(48, 36);
+  const DifferentialImages dir = render_dir_cpu(scene, camera, {}, direct_only());
+  const DifferentialImages plain = render_dir_cpu(without, camera, {}, direct_only());
+  const RayTracer tracer(scene);
+  const SpecularGBuffers g = specular_gbuffers_cpu(tracer, camera, gbuffer_cpu(tracer, camera));
+  int box_seen = 0;
+  for (int row = 0; row < 36; ++row)
+    for (int col = 0; col < 48; ++col) {
+      if (!g.specular(row, col) || !g.reflected.gbuffer.virtual_surface(row, col)) continue;
+      const Vector3f r = at(dir.real, row, col), floor = at(plain.real, row, col);
+      ASSERT_GT(floor.sum(), 0.f) << row << "," << col;
+      EXPECT_LT((r - floor).cwiseAbs().maxCoeff(), 1e-5f * floor.maxCoeff()) << row << "," << col;
+      EXPECT_GT((at(dir.real_virtual, row, col) - r).cwiseAbs().sum(), 0.01f * floor.sum());  // the box, not the floor
+      ++box_seen;
+    }
+  EXPECT_GT(box_seen, 5);
+}
 
 /// A camera image whose pixels tell where they are: linear red = x / width, green = y / height.
 ColorImage position_coded(int width, int height) {

@@ -31,7 +31,8 @@ struct BranchEnd {
 
 /// Follows one branch from the specular surface `at`, starting along `first` (a lobe of its
 /// material), to the first diffuse surface or out of the scene.
-BranchEnd follow(const RayTracer& tracer, const SurfaceHit& at, const SpecularSample& first, int max_vertices) {
+BranchEnd follow(const RayTracer& tracer, const SurfaceHit& at, const SpecularSample& first, int max_vertices,
+                 bool real_world) {
   const MrScene& scene = tracer.scene();
   BranchEnd end;
   end.weight = first.weight;
@@ -44,7 +45,7 @@ BranchEnd follow(const RayTracer& tracer, const SurfaceHit& at, const SpecularSa
   std::uint32_t rays = 0;
   for (int vertex = 1;; ++vertex) {
     const Vec3 origin = leave(from, direction);
-    std::optional<SurfaceHit> hit = detail::nearest_hit(tracer, origin, direction, true, rays);
+    std::optional<SurfaceHit> hit = detail::nearest_hit(tracer, origin, direction, !real_world, rays);
     // From surface to surface, not from the offset origin.
     if (medium && hit) end.weight = end.weight.cwiseProduct(beer_lambert(*medium, (hit->point - from.point).norm()));
     end.eye = origin;
@@ -104,20 +105,23 @@ SpecularGBuffers specular_gbuffers_cpu(const RayTracer& tracer, const MrCamera& 
           for (int col = 0; col < width; ++col) {
             const std::uint16_t label = primary.material(row, col);
             if (label == 0 || !scene.materials.at(label - 1u).specular.specular()) continue;
+            if (options.real_world && primary.virtual_surface(row, col)) continue;
             // The camera ray again, for the hit's own winding (the G-buffer's normal faces the camera).
             const Float3& p = primary.position(row, col);
             const Vec3 d = (Vec3(p.x, p.y, p.z) - centre).normalized();
             std::uint32_t rays = 0;
-            const std::optional<SurfaceHit> hit = detail::nearest_hit(tracer, centre, d, true, rays);
+            const std::optional<SurfaceHit> hit = detail::nearest_hit(tracer, centre, d, !options.real_world, rays);
             if (!hit || !specular_of(scene, *hit).specular()) continue;
             out.specular(row, col) = 1;
             ++counts[static_cast<std::size_t>(row)];
             const SpecularLobes lobes =
                 specular_lobes(specular_of(scene, *hit), hit->interpolated_normal, -d, Transport::Radiance);
             if (lobes.reflected)
-              store(out.reflected, row, col, follow(tracer, *hit, *lobes.reflected, options.max_vertices));
+              store(out.reflected, row, col,
+                    follow(tracer, *hit, *lobes.reflected, options.max_vertices, options.real_world));
             if (lobes.refracted)
-              store(out.refracted, row, col, follow(tracer, *hit, *lobes.refracted, options.max_vertices));
+              store(out.refracted, row, col,
+                    follow(tracer, *hit, *lobes.refracted, options.max_vertices, options.real_world));
           }
       },
       4);

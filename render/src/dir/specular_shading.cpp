@@ -1,5 +1,6 @@
 #include "relight/render/dir/specular_shading.h"
 
+#include <algorithm>
 #include <array>
 
 #include "relight/core/error.h"
@@ -19,6 +20,32 @@ namespace {
 
 /// Per channel: a branch's weight times its light.
 Float3 times(const Float3& a, const Float3& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+
+/// L'_r at the real specular pixels (a real mirror or glass, add_real_model) from branches
+/// traced in the real world. Eq. 4 gives L'_r nothing where a branch ends on a virtual object,
+/// so the composite CI + (L'_rv - L'_r) would add the object's light to the camera's reflection
+/// of what stands behind it; the real-world branch sees that surface, so Delta L' takes it out
+/// and the object replaces it - better than the paper, which has no such branch. Only where the
+/// scene has virtual meshes and a real specular surface is in view.
+void put_real_world_reflections(DifferentialImages& images, const RayTracer& tracer, const MrCamera& camera,
+                                const GBuffer& gbuffer, const ShadowLayout& layout, std::span<const float> shadow_atlas,
+                                std::span<const Vpl> vpls, std::span<const float> ism_atlas,
+                                const IsmPointPools& ism_points, const DirRenderOptions& options,
+                                std::span<const CausticPhotons> photons) {
+  const MrScene& scene = tracer.scene();
+  if (std::none_of(scene.meshes.begin(), scene.meshes.end(), [](const TriangleMesh& m) { return !m.real; })) return;
+  const SpecularGBuffers real_world =
+      specular_gbuffers_cpu(tracer, camera, gbuffer, {.threads = options.shading.threads, .real_world = true});
+  if (real_world.pixels == 0) return;
+  const SpecularLight seen =
+      shade_specular_from_maps(real_world, scene, layout, shadow_atlas, vpls, ism_atlas, ism_points, options, photons);
+  const bool indirect = !images.indirect_real.empty();
+  for (std::size_t i = 0; i < images.real.size(); ++i) {
+    if (!real_world.specular.pixels()[i]) continue;
+    images.real.pixels()[i] = seen.light.real.pixels()[i];
+    if (indirect) images.indirect_real.pixels()[i] = seen.light.indirect_real.pixels()[i];
+  }
+}
 
 }  // namespace
 
@@ -84,6 +111,8 @@ SpecularBackProjection add_specular_light(DifferentialImages& images, const RayT
   const SpecularLight light = shade_specular_from_maps(specular, tracer.scene(), layout, shadow_atlas, vpls, ism_atlas,
                                                        ism_points, options, photons);
   put_specular_light(images, light.light, specular);
+  put_real_world_reflections(images, tracer, camera, gbuffer, layout, shadow_atlas, vpls, ism_atlas, ism_points,
+                             options, photons);
   return back_project(specular, light.reflected_real, light.refracted_real, tracer, camera);
 }
 

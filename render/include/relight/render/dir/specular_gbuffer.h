@@ -49,6 +49,10 @@ struct SpecularGBuffers {
 struct SpecularTraceOptions {
   int max_vertices = 8;  ///< specular vertices one branch may pass (entry, exit, internal reflections)
   int threads = 0;
+  /// Trace in the real world alone (virtual meshes invisible), from the real specular pixels
+  /// only: what a real mirror or glass shows without the virtual objects, L'_r's own branches
+  /// (specular_shading.h).
+  bool real_world = false;
 };
 
 /// Whether any surface of `scene` has a specular material (then DIR traces secondary G-buffers).

@@ -12,6 +12,12 @@
 // seen from its branch's eye; a branch that leaves the scene sees the environment (the paper's
 // L_env), which is real, so it cancels in L'_rv - L'_r as the paper's separate L_env buffer does.
 //
+// At a real mirror or glass (add_real_model) relight departs from eq. 4: where a branch ends on a
+// virtual object, L'_r is not zero but the light of the branch traced again in the real world
+// (specular_gbuffers_cpu's real_world: what the camera sees in the mirror behind the object), so
+// that the composite's Delta L' replaces that surface by the object instead of adding the object
+// to it (add_specular_light).
+//
 // Reads SpecularGBuffers, the MrScene and the same maps and VPLs as shade_dir_from_maps; writes
 // DifferentialImages holding L'_rv and L'_r (with their indirect parts) at the specular pixels,
 // zero elsewhere, and each branch's L_r for the back-projection (specular_back_projection.h). put_specular_light()
