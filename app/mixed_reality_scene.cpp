@@ -1,6 +1,7 @@
 #include "mixed_reality_scene.h"
 
 #include <cmath>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -46,6 +47,13 @@ render::MrLight parse_spot(const std::string& option, const std::string& text, b
   if (!(v[6] > 0.f && v[6] < 90.f)) throw Error(what + ": the angle must be in (0, 90) degrees");
   return render::spot_light(position, axis.normalized(), v[6], kSpotInnerFraction * v[6],
                             parse_intensity(option.c_str(), text, v, 7), real);
+}
+
+render::VirtualModel load_model_telling_warnings(const fs::path& file) {
+  render::VirtualModel model = render::load_model(file);
+  for (const std::string& warning : model.warnings)
+    std::cerr << "relight: warning: " << file.string() << ": " << warning << "\n";
+  return model;
 }
 
 lights::LightSet real_light_set(const fs::path& sequence, const fs::path& lights_file) {

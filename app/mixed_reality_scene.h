@@ -51,6 +51,9 @@ inline constexpr float kSpotInnerFraction = 0.8f;
   return parse_spot("--virtual-spot", text, false);
 }
 
+/// The model in `file` (render::load_model), its warnings printed to stderr one line each.
+[[nodiscard]] render::VirtualModel load_model_telling_warnings(const std::filesystem::path& file);
+
 /// The measured lights of a recorded sequence: the lights JSON of `relight lights` when given,
 /// else 8 lights extracted from the sequence's probe.hdr (a centred 180-degree fisheye looking up,
 /// as `relight synth` writes it). Throws relight::Error when there is neither.

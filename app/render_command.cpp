@@ -22,6 +22,7 @@
 #include "relight/render/scene/depth_mesh.h"
 #include "relight/render/scene/model_io.h"
 #include "relight/render/scene/procedural_models.h"
+#include "relight/render/scene/real_object_carving.h"
 #include "relight/render/scene/scene_lights.h"
 #include "relight/synth/light_animation.h"
 #include "relight/truth/scene_from_synth.h"
@@ -39,6 +40,8 @@ struct RenderReferenceOptions {
   int frame = 0;
   fs::path object;
   std::string place;
+  std::vector<fs::path> real_objects;
+  std::vector<std::string> real_places;
   fs::path lights;
   std::vector<std::string> virtual_lights;
   std::vector<std::string> virtual_spots;
@@ -99,6 +102,13 @@ ColorImage downsample_color(const ColorImage& image, int factor) {
   return out;
 }
 
+nlohmann::ordered_json real_objects_json(const RenderReferenceOptions& command) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < command.real_objects.size(); ++i)
+    out.push_back({{"model", command.real_objects[i].filename().string()}, {"place", command.real_places[i]}});
+  return out;
+}
+
 fs::path sibling(const fs::path& out, const std::string& suffix) {
   fs::path path = out;
   path.replace_filename(out.stem().string() + suffix);
@@ -122,6 +132,7 @@ int run_render_reference(const RenderReferenceOptions& command) {
     throw Error("frame " + std::to_string(command.frame) + " has no camera pose (groundtruth.txt)");
   const bool synthetic = is_synthetic(command.sequence);
   MrScene scene = real_scene(command, synthetic, sequence, frame);
+  const std::size_t depth_mesh = scene.meshes.size() - 1;  // a recorded frame's (real_scene)
   std::string placement_text;
   if (!command.object.empty()) {
     placement_text = command.place;
@@ -129,10 +140,23 @@ int run_render_reference(const RenderReferenceOptions& command) {
       if (!synthetic) throw Error("--place x,y,z[,yaw[,scale]] is needed to put the object into a recorded scene");
       placement_text = kDefaultSynthPlacement;
     }
-    const render::VirtualModel model = render::load_model(command.object);
-    for (const std::string& warning : model.warnings)
-      std::cerr << "relight: warning: " << command.object.string() << ": " << warning << "\n";
+    const render::VirtualModel model = load_model_telling_warnings(command.object);
     render::add_virtual_model(scene, model, render::Placement::parse(placement_text));
+  }
+  // Real mirrors and glass as replay's --real-object puts them: in the real layer, and in place of a
+  // recorded frame's depth mesh around them (a synthetic scene's exact geometry has none of them).
+  if (command.real_objects.size() != command.real_places.size())
+    throw Error("--real-object: " + std::to_string(command.real_objects.size()) + " objects but " +
+                std::to_string(command.real_places.size()) + " --real-place");
+  for (std::size_t i = 0; i < command.real_objects.size(); ++i) {
+    const render::VirtualModel model = load_model_telling_warnings(command.real_objects[i]);
+    const std::size_t first = scene.meshes.size();
+    render::add_real_model(scene, model, render::Placement::parse(command.real_places[i]));
+    if (!synthetic)
+      render::remove_triangles_within(
+          scene.meshes[depth_mesh],
+          std::span<const render::TriangleMesh>(scene.meshes.data() + first, scene.meshes.size() - first),
+          render::kRealObjectMargin);
   }
   for (const std::string& light : command.virtual_lights) scene.lights.push_back(parse_virtual_light(light));
   for (const std::string& spot : command.real_spots) scene.lights.push_back(parse_spot("--real-spot", spot, true));
@@ -168,6 +192,7 @@ int run_render_reference(const RenderReferenceOptions& command) {
                                     {"height", camera.intrinsics.height},
                                     {"object", command.object.empty() ? "" : fs::absolute(command.object).string()},
                                     {"placement", placement_text},
+                                    {"real_objects", real_objects_json(command)},
                                     {"samples_per_pixel", images.samples_per_pixel},
                                     {"max_bounces", command.max_bounces},
                                     {"seed", command.seed},
@@ -200,6 +225,11 @@ void register_render_reference(CLI::App& app, Runners& runners) {
   command->add_option("--place", options->place,
                       std::string("Object placement x,y,z[,yaw_degrees[,scale]] in the world frame (synthetic default ") +
                           kDefaultSynthPlacement + ")");
+  command->add_option(
+      "--real-object", options->real_objects,
+      "A model of a real mirror or glass, as replay's --real-object (repeatable, one --real-place each)");
+  command->add_option("--real-place", options->real_places,
+                      "Placement x,y,z[,yaw_degrees[,scale]] of each --real-object in the world frame");
   command->add_option("--lights", options->lights, "Lights JSON (from `relight lights`), needed for recorded sequences");
   command->add_option("--virtual-light", options->virtual_lights,
                       "A virtual point light x,y,z,intensity[,r,g,b] (W/sr; repeat for more)");

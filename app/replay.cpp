@@ -186,9 +186,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
                                      options.places_on_plane, kDefaultSynthPlacement, synthetic);
   std::vector<std::string> names;
   for (std::size_t i = 0; i < options.objects.size(); ++i) {
-    render::VirtualModel model = render::load_model(options.objects[i]);
-    for (const std::string& warning : model.warnings)
-      std::cerr << "relight: warning: " << options.objects[i].string() << ": " << warning << "\n";
+    render::VirtualModel model = load_model_telling_warnings(options.objects[i]);
     const Eigen::AlignedBox3f box = render::bounds(model);  // y-up: the footprint is x by z
     requests[i].footprint_radius_m =
         requests[i].placement.scale * 0.5 * std::hypot(box.sizes().x(), box.sizes().z());
@@ -197,9 +195,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   }
 
   for (std::size_t i = 0; i < options.real_objects.size(); ++i) {
-    render::VirtualModel model = render::load_model(options.real_objects[i]);
-    for (const std::string& warning : model.warnings)
-      std::cerr << "relight: warning: " << options.real_objects[i].string() << ": " << warning << "\n";
+    render::VirtualModel model = load_model_telling_warnings(options.real_objects[i]);
     content.real_objects.emplace_back(std::move(model), render::Placement::parse(options.real_places[i]));
   }
 

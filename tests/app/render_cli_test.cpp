@@ -71,6 +71,36 @@ TEST(RenderReferenceCli, TheGlassPebbleFocusesTheLampsOntoTheTable) {
   EXPECT_LT(brighter, static_cast<int>(with_rv.size()) / 4);
 }
 
+// A real mirror (--real-object, as replay's) is part of both worlds: unlike the virtual pebble,
+// it changes L_r too - the bottle itself and the light it reflects - while L_rv - L_r changes
+// only where the pebble and the bottle meet (far fewer pixels). ref.json names it.
+TEST(RenderReferenceCli, ARealMirrorBottleIsInBothWorlds) {
+  test::TempDir dir;
+  const std::string common = "render-reference --quiet --sequence " + synthetic_sequence().string() + " --object " +
+                             (kData / "models" / "glossy_pebble.gltf").string() +
+                             " --spp 2 --downsample 8 --max-bounces 0 --caustic-paths 0";
+  ASSERT_EQ(relight(common + " --out " + (dir.path() / "plain.exr").string()).exit_code, 0);
+  const auto result = relight(common + " --real-object " + (kData / "models" / "metal_bottle.gltf").string() +
+                              " --real-place 0.12,-0.38,0.75 --out " + (dir.path() / "bottle.exr").string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto summary = nlohmann::json::parse(read_text_file(dir.path() / "bottle.json"));
+  ASSERT_EQ(summary.at("real_objects").size(), 1u);
+  EXPECT_EQ(summary["real_objects"][0]["model"], "metal_bottle.gltf");
+  const RadianceImage plain_r = read_radiance(dir.path() / "plain.Lr.exr"),
+                      bottle_r = read_radiance(dir.path() / "bottle.Lr.exr");
+  const RadianceImage plain_rv = read_radiance(dir.path() / "plain.exr"),
+                      bottle_rv = read_radiance(dir.path() / "bottle.exr");
+  int real_changed = 0, delta_changed = 0;
+  for (std::size_t i = 0; i < plain_r.size(); ++i) {
+    real_changed += plain_r.pixels()[i] == bottle_r.pixels()[i] ? 0 : 1;
+    const Float3 a = plain_rv.pixels()[i] - plain_r.pixels()[i], b = bottle_rv.pixels()[i] - bottle_r.pixels()[i];
+    delta_changed += length(a - b) > 0.05f * std::max(length(a), 0.05f) ? 1 : 0;
+  }
+  std::cout << "L_r changed at " << real_changed << " pixels, L_rv - L_r at " << delta_changed << "\n";
+  EXPECT_GT(real_changed, 5);
+  EXPECT_LT(delta_changed, real_changed);
+}
+
 // The path tracer's composite takes the same operators as replay's: Reinhard's key from the
 // traced L_rv itself (eq. 1 over its lit pixels), the highlight rolled off below the clamp's.
 TEST(RenderReferenceCli, ReinhardTakesItsKeyFromTheTracedImage) {
@@ -133,6 +163,9 @@ TEST(RenderReferenceCli, BadInputGivesOneLineErrors) {
   expect_one_line_error(relight("render-reference" + seq + " --object " + (kData / "models" / "matte_box.obj").string() +
                                 " --place 1,2" + out),
                         1);
+  expect_one_line_error(
+      relight("render-reference" + seq + " --real-object " + (kData / "models" / "metal_bottle.gltf").string() + out),
+      1);  // no --real-place
   // A recorded sequence has no lights of its own.
   expect_one_line_error(relight("render-reference --sequence " + (kData / "tum_fr1_rpy").string() + out), 1);
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "ref.exr"));

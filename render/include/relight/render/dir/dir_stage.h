@@ -159,10 +159,6 @@ struct DirSceneContent {
   std::vector<std::pair<VirtualModel, Placement>> real_objects{};
 };
 
-/// Metres around a pre-modelled real object within which the reconstruction is taken for the
-/// object's own noisy depth (a Kinect's depth noise at 1-2 m is a few millimetres).
-inline constexpr float kRealObjectMargin = 0.01f;
-
 /// The stages of add_dir_stages whose summaries the report shows.
 struct DirStages {
   VplStage* vpls = nullptr;

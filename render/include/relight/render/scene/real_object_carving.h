@@ -14,6 +14,10 @@
 
 namespace relight::render {
 
+/// Metres around a pre-modelled real object within which the reconstruction is taken for the
+/// object's own noisy depth (a Kinect's depth noise at 1-2 m is a few millimetres).
+inline constexpr float kRealObjectMargin = 0.01f;
+
 /// Removes from `mesh` the triangles whose centre lies inside `object` or within `margin` metres
 /// of its surface; returns how many.
 std::size_t remove_triangles_within(TriangleMesh& mesh, std::span<const TriangleMesh> object, float margin);
