@@ -56,6 +56,28 @@ render::VirtualModel load_model_telling_warnings(const fs::path& file) {
   return model;
 }
 
+void check_real_places(const std::vector<fs::path>& objects, const std::vector<std::string>& places) {
+  if (objects.size() != places.size())
+    throw Error("--real-object: " + std::to_string(objects.size()) + " objects but " + std::to_string(places.size()) +
+                " --real-place");
+}
+
+std::vector<std::pair<render::VirtualModel, render::Placement>> load_real_objects(
+    const std::vector<fs::path>& objects, const std::vector<std::string>& places) {
+  check_real_places(objects, places);
+  std::vector<std::pair<render::VirtualModel, render::Placement>> out;
+  for (std::size_t i = 0; i < objects.size(); ++i)
+    out.emplace_back(load_model_telling_warnings(objects[i]), render::Placement::parse(places[i]));
+  return out;
+}
+
+nlohmann::ordered_json real_objects_json(const std::vector<fs::path>& objects, const std::vector<std::string>& places) {
+  nlohmann::ordered_json out = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < objects.size() && i < places.size(); ++i)
+    out.push_back({{"model", objects[i].filename().string()}, {"place", places[i]}});
+  return out;
+}
+
 lights::LightSet real_light_set(const fs::path& sequence, const fs::path& lights_file) {
   if (!lights_file.empty()) return lights::lights_from_json(read_text_file(lights_file), lights_file.string());
   const fs::path probe = sequence / "probe.hdr";

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -53,6 +54,15 @@ inline constexpr float kSpotInnerFraction = 0.8f;
 
 /// The model in `file` (render::load_model), its warnings printed to stderr one line each.
 [[nodiscard]] render::VirtualModel load_model_telling_warnings(const std::filesystem::path& file);
+
+/// Throws relight::Error unless there is one --real-place for each --real-object.
+void check_real_places(const std::vector<std::filesystem::path>& objects, const std::vector<std::string>& places);
+/// The real objects of --real-object and --real-place (render::add_real_model), loaded.
+[[nodiscard]] std::vector<std::pair<render::VirtualModel, render::Placement>> load_real_objects(
+    const std::vector<std::filesystem::path>& objects, const std::vector<std::string>& places);
+/// What report.json and ref.json say of them: [{"model": file name, "place": its placement}].
+[[nodiscard]] nlohmann::ordered_json real_objects_json(const std::vector<std::filesystem::path>& objects,
+                                                       const std::vector<std::string>& places);
 
 /// The measured lights of a recorded sequence: the lights JSON of `relight lights` when given,
 /// else 8 lights extracted from the sequence's probe.hdr (a centred 180-degree fisheye looking up,

@@ -102,13 +102,6 @@ ColorImage downsample_color(const ColorImage& image, int factor) {
   return out;
 }
 
-nlohmann::ordered_json real_objects_json(const RenderReferenceOptions& command) {
-  nlohmann::ordered_json out = nlohmann::ordered_json::array();
-  for (std::size_t i = 0; i < command.real_objects.size(); ++i)
-    out.push_back({{"model", command.real_objects[i].filename().string()}, {"place", command.real_places[i]}});
-  return out;
-}
-
 fs::path sibling(const fs::path& out, const std::string& suffix) {
   fs::path path = out;
   path.replace_filename(out.stem().string() + suffix);
@@ -145,18 +138,9 @@ int run_render_reference(const RenderReferenceOptions& command) {
   }
   // Real mirrors and glass as replay's --real-object puts them: in the real layer, and in place of a
   // recorded frame's depth mesh around them (a synthetic scene's exact geometry has none of them).
-  if (command.real_objects.size() != command.real_places.size())
-    throw Error("--real-object: " + std::to_string(command.real_objects.size()) + " objects but " +
-                std::to_string(command.real_places.size()) + " --real-place");
-  for (std::size_t i = 0; i < command.real_objects.size(); ++i) {
-    const render::VirtualModel model = load_model_telling_warnings(command.real_objects[i]);
-    const std::size_t first = scene.meshes.size();
-    render::add_real_model(scene, model, render::Placement::parse(command.real_places[i]));
-    if (!synthetic)
-      render::remove_triangles_within(
-          scene.meshes[depth_mesh],
-          std::span<const render::TriangleMesh>(scene.meshes.data() + first, scene.meshes.size() - first),
-          render::kRealObjectMargin);
+  for (const auto& [model, placement] : load_real_objects(command.real_objects, command.real_places)) {
+    const std::span<const render::TriangleMesh> object = render::add_real_model(scene, model, placement);
+    if (!synthetic) render::remove_triangles_within(scene.meshes[depth_mesh], object, render::kRealObjectMargin);
   }
   for (const std::string& light : command.virtual_lights) scene.lights.push_back(parse_virtual_light(light));
   for (const std::string& spot : command.real_spots) scene.lights.push_back(parse_spot("--real-spot", spot, true));
@@ -192,7 +176,7 @@ int run_render_reference(const RenderReferenceOptions& command) {
                                     {"height", camera.intrinsics.height},
                                     {"object", command.object.empty() ? "" : fs::absolute(command.object).string()},
                                     {"placement", placement_text},
-                                    {"real_objects", real_objects_json(command)},
+                                    {"real_objects", real_objects_json(command.real_objects, command.real_places)},
                                     {"samples_per_pixel", images.samples_per_pixel},
                                     {"max_bounces", command.max_bounces},
                                     {"seed", command.seed},

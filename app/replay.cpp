@@ -162,9 +162,7 @@ BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayO
 /// The lights, the BRDF stages (real materials) and the DIR stage with its outputs, when the
 /// options ask for any virtual content.
 void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel) {
-  if (options.real_objects.size() != options.real_places.size())
-    throw Error("--real-object: " + std::to_string(options.real_objects.size()) + " objects but " +
-                std::to_string(options.real_places.size()) + " --real-place");
+  check_real_places(options.real_objects, options.real_places);
   if (options.objects.empty() && options.virtual_lights.empty() && options.virtual_spots.empty()) {
     if (!options.real_objects.empty())
       throw Error("--real-object needs something virtual to render (--object, --virtual-light or --virtual-spot)");
@@ -194,10 +192,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
     names.push_back(options.objects[i].filename().string());
   }
 
-  for (std::size_t i = 0; i < options.real_objects.size(); ++i) {
-    render::VirtualModel model = load_model_telling_warnings(options.real_objects[i]);
-    content.real_objects.emplace_back(std::move(model), render::Placement::parse(options.real_places[i]));
-  }
+  content.real_objects = load_real_objects(options.real_objects, options.real_places);
 
   FrameGraph& graph = *pipeline.graph;
   if (!content.objects.empty())
@@ -399,13 +394,8 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
   if (pipeline.camera_look) report["camera_look"] = camera_look_json(pipeline.camera_look->summary());
   if (pipeline.tone_map) report["tone_map"] = tone_map_json(pipeline.tone_map->options(), pipeline.tone_map->last());
   report["latency_ms"] = pipeline.latency->summary();
-  if (!options.real_objects.empty()) {
-    nlohmann::ordered_json real_objects = nlohmann::ordered_json::array();
-    for (std::size_t i = 0; i < options.real_objects.size(); ++i)
-      real_objects.push_back(
-          {{"model", options.real_objects[i].filename().string()}, {"place", options.real_places[i]}});
-    report["real_objects"] = real_objects;
-  }
+  if (!options.real_objects.empty())
+    report["real_objects"] = real_objects_json(options.real_objects, options.real_places);
   if (pipeline.placement) {
     report["placements"] = pipeline.placement->summary();
     if (!options.quiet) std::cerr << pipeline.placement->describe();

@@ -131,6 +131,32 @@ TEST(ImportanceSampling, HammersleyPointsAreStratified) {
   EXPECT_TRUE(std::all_of(cells.begin(), cells.end(), [](int count) { return count == 1; }));
 }
 
+// Hammersley's 256 points form a (0, 8, 2)-net in base 2: every box of 1/2^a x 1/2^(8 - a) holds
+// exactly one point. The rotation moves the set without breaking that (modulo 1), and every
+// point stays in the unit square (DIR's caustic photons take their directions from it too).
+TEST(ImportanceSampling, RotatedHammersleyIsANetInEveryShapeOfBox) {
+  const std::array<float, 2> shift{0.37f, 0.81f};
+  constexpr std::uint32_t kCount = 256;
+  for (int a = 0; a <= 8; ++a) {
+    const int nx = 1 << a, ny = kCount / nx;
+    std::vector<int> boxes(static_cast<std::size_t>(nx * ny), 0);
+    for (std::uint32_t i = 0; i < kCount; ++i) {
+      const auto p = hammersley_point(i, 1.f / static_cast<float>(kCount), shift[0], shift[1]);
+      ASSERT_GE(p[0], 0.f);
+      ASSERT_LT(p[0], 1.f);
+      ASSERT_GE(p[1], 0.f);
+      ASSERT_LT(p[1], 1.f);
+      const auto back = [](float value, float by) { return value - by < 0.f ? value - by + 1.f : value - by; };
+      const float u = back(p[0], shift[0]), v = back(p[1], shift[1]);
+      // A hair inside, against float rounding of the shift at a box's edge.
+      const int x = std::min(nx - 1, static_cast<int>(std::floor((u + 1e-6f) * static_cast<float>(nx))));
+      const int y = std::min(ny - 1, static_cast<int>(std::floor((v + 1e-6f) * static_cast<float>(ny))));
+      ++boxes[static_cast<std::size_t>(y) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(x)];
+    }
+    for (const int count : boxes) ASSERT_EQ(count, 1) << nx << " x " << ny << " boxes";
+  }
+}
+
 TEST(ImportanceSampling, BadInputIsAnError) {
   const ProbeGeometry geometry(ProbeCalibration::centred_fisheye(32, 32), 32, 32);
   EXPECT_THROW((void)sample_importance(RadianceImage(32, 32), geometry, {16, 0}), Error);  // black

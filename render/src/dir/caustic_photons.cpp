@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "relight/core/parallel.h"
+#include "relight/lights/importance_sampling.h"
 #include "relight/render/scene/discrete_sampler.h"
 #include "relight/render/scene/luminance.h"
 #include "relight/render/scene/phong_brdf.h"
@@ -148,6 +149,7 @@ CausticPhotons trace_caustic_photons(const RayTracer& tracer, const CausticOptio
   if (options.photons_per_light <= 0 || target.radius <= 0.f || scene.lights.empty()) return {};
   const BoundingSphere whole = bounding_sphere(scene, SceneMeshes::All);
   const auto per_light = static_cast<std::size_t>(options.photons_per_light);
+  const float inv_paths = 1.f / static_cast<float>(per_light);
   // Each light's first rays are a rotated Hammersley set over the cone (or disc) around the
   // specular objects rather than independent numbers: the set covers the cone evenly, so the
   // caustic's density is not blotched by clusters and gaps of random directions. Every light
@@ -164,11 +166,11 @@ CausticPhotons trace_caustic_photons(const RayTracer& tracer, const CausticOptio
                   [&](std::size_t i, Pcg32&) -> std::optional<PhotonSource> {
                     const std::size_t l = i / per_light;
                     const MrLight& light = scene.lights[l];
-                    const auto [u1, u2] = rotated_hammersley(static_cast<std::uint32_t>(i % per_light),
-                                                             static_cast<std::uint32_t>(per_light), shifts[l]);
+                    const auto [u1, u2] = lights::hammersley_point(static_cast<std::uint32_t>(i % per_light), inv_paths,
+                                                                   shifts[l][0], shifts[l][1]);
                     std::optional<detail::Emission> emission = detail::emit_towards(light, target, whole, u1, u2);
                     if (!emission) return std::nullopt;
-                    emission->beta /= static_cast<float>(per_light);
+                    emission->beta *= inv_paths;
                     return PhotonSource{*emission, true, light.real};
                   }),
       PhotonKernel{options.radius, options.min_radius, options.neighbours}};

@@ -134,9 +134,7 @@ void MrSceneStage::run(StageContext& context) {
   }
   const std::size_t reconstruction = scene.meshes.size() - 1;
   for (const auto& [model, placement] : content_.real_objects) {
-    const std::size_t first = scene.meshes.size();
-    add_real_model(scene, model, placement);
-    const std::span<const TriangleMesh> object(scene.meshes.data() + first, scene.meshes.size() - first);
+    const std::span<const TriangleMesh> object = add_real_model(scene, model, placement);
     remove_triangles_within(scene.meshes[reconstruction], object, kRealObjectMargin);
     if (scene.coarse_real_meshes.empty()) continue;
     remove_triangles_within(scene.coarse_real_meshes.front(), object, kRealObjectMargin);  // the reconstruction's

@@ -34,6 +34,14 @@ void put_real_world_reflections(DifferentialImages& images, const RayTracer& tra
                                 std::span<const CausticPhotons> photons) {
   const MrScene& scene = tracer.scene();
   if (std::none_of(scene.meshes.begin(), scene.meshes.end(), [](const TriangleMesh& m) { return !m.real; })) return;
+  // Most scenes' mirrors and glass are virtual: no second pair of full-size G-buffers for them.
+  bool real_specular_in_view = false;
+  for (std::size_t i = 0; i < gbuffer.material.size() && !real_specular_in_view; ++i) {
+    const std::uint16_t label = gbuffer.material.pixels()[i];
+    real_specular_in_view =
+        label != 0 && !gbuffer.virtual_surface.pixels()[i] && scene.materials[label - 1u].specular.specular();
+  }
+  if (!real_specular_in_view) return;
   const SpecularGBuffers real_world =
       specular_gbuffers_cpu(tracer, camera, gbuffer, {.threads = options.shading.threads, .real_world = true});
   if (real_world.pixels == 0) return;

@@ -130,8 +130,10 @@ void add_virtual_model(MrScene& scene, const VirtualModel& model, const Placemen
   add_model(scene, model, placement, false);
 }
 
-void add_real_model(MrScene& scene, const VirtualModel& model, const Placement& placement) {
+std::span<const TriangleMesh> add_real_model(MrScene& scene, const VirtualModel& model, const Placement& placement) {
+  const std::size_t first = scene.meshes.size();
   add_model(scene, model, placement, true);
+  return {scene.meshes.data() + first, scene.meshes.size() - first};
 }
 
 Eigen::AlignedBox3f bounds(const VirtualModel& model) {

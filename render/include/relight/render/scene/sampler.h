@@ -44,36 +44,18 @@ class Pcg32 {
   std::uint64_t increment_ = 1;
 };
 
-namespace detail {
-inline float wrap_unit(float v) { return v >= 1.f ? v - 1.f : v; }
-}  // namespace detail
-
-/// Point `index` of the Hammersley set of `count` points in the unit square, both coordinates
-/// shifted by `shift` modulo 1 (Cranley-Patterson rotation: a set of its own per seed, each point
-/// still uniform, the set still stratified).
-inline std::array<float, 2> rotated_hammersley(std::uint32_t index, std::uint32_t count, std::array<float, 2> shift) {
-  std::uint32_t bits = index;
-  bits = (bits << 16u) | (bits >> 16u);
-  bits = ((bits & 0x00ff00ffu) << 8u) | ((bits & 0xff00ff00u) >> 8u);
-  bits = ((bits & 0x0f0f0f0fu) << 4u) | ((bits & 0xf0f0f0f0u) >> 4u);
-  bits = ((bits & 0x33333333u) << 2u) | ((bits & 0xccccccccu) >> 2u);
-  bits = ((bits & 0x55555555u) << 1u) | ((bits & 0xaaaaaaaau) >> 1u);
-  const float u = (static_cast<float>(index) + 0.5f) / static_cast<float>(count);
-  const float v = static_cast<float>(bits >> 8u) * 0x1p-24f;
-  return {detail::wrap_unit(u + shift[0]), detail::wrap_unit(v + shift[1])};
-}
-
-/// Point `index` of the Halton sequence in bases 2 and 3, rotated by `shift` as above. Unlike
-/// Hammersley's, any run of consecutive indices is itself spread evenly: for samples whose
-/// indices are shared out among several sources in runs.
+/// Point `index` of the Halton sequence in bases 2 and 3, both coordinates shifted by `shift`
+/// modulo 1 (Cranley-Patterson rotation, as lights::hammersley_point's). Unlike the Hammersley
+/// set's, any run of consecutive indices is itself spread evenly: for samples whose indices are
+/// shared out among several sources in runs.
 inline std::array<float, 2> rotated_halton(std::uint32_t index, std::array<float, 2> shift) {
   const auto radical_inverse = [](std::uint32_t i, std::uint32_t base) {
     double inverse_base = 1.0 / base, factor = inverse_base, value = 0.0;
     for (; i > 0; i /= base, factor *= inverse_base) value += static_cast<double>(i % base) * factor;
     return static_cast<float>(std::min(value, 1.0 - 0x1p-24));
   };
-  return {detail::wrap_unit(radical_inverse(index, 2) + shift[0]),
-          detail::wrap_unit(radical_inverse(index, 3) + shift[1])};
+  const auto wrap = [](float v) { return v >= 1.f ? v - 1.f : v; };
+  return {wrap(radical_inverse(index, 2) + shift[0]), wrap(radical_inverse(index, 3) + shift[1])};
 }
 
 }  // namespace relight::render

@@ -9,6 +9,7 @@
 // point of the table stands it on the table.
 #include <Eigen/Geometry>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -56,8 +57,9 @@ void add_virtual_model(MrScene& scene, const VirtualModel& model, const Placemen
 /// scene - a mirror or a glass, whose depth the camera cannot measure - that reflects, refracts
 /// and casts caustics in both worlds of differential rendering (Knecht et al. 2013, Fig. 7's
 /// real bottle). Its light is in the camera image already; what changes is what the virtual
-/// objects and lights add to it.
-void add_real_model(MrScene& scene, const VirtualModel& model, const Placement& placement);
+/// objects and lights add to it. Returns the meshes it added (the end of scene.meshes; valid
+/// until scene.meshes changes), e.g. for remove_triangles_within (real_object_carving.h).
+std::span<const TriangleMesh> add_real_model(MrScene& scene, const VirtualModel& model, const Placement& placement);
 
 /// Axis-aligned bounds of all vertices (for tests and reports).
 [[nodiscard]] Eigen::AlignedBox3f bounds(const VirtualModel& model);
