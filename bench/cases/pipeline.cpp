@@ -76,6 +76,13 @@ bench::Json stage_medians(const FrameGraph& graph) {
   return stages;
 }
 
+/// Per-stage median CPU milliseconds of the process (all threads) while the stage ran.
+bench::Json stage_cpu_medians(const FrameGraph& graph) {
+  bench::Json stages = bench::Json::object();
+  for (const auto& timing : graph.timings()) stages[timing.stage] = steady_median(timing.cpu_ms);
+  return stages;
+}
+
 /// Per-stage median GPU milliseconds, for the stages that report device time.
 bench::Json stage_gpu_medians(const FrameGraph& graph) {
   bench::Json stages = bench::Json::object();
@@ -144,6 +151,7 @@ bench::Json compare_replays(app::ReplayPipeline& ours, app::ReplayPipeline& base
   result["composite_pixels_over_2"] = difference.pixels_over_2;
   result["compute"] = ours.compute;
   result["stages_ms"] = stage_medians(*ours.graph);
+  result["stages_cpu_ms"] = stage_cpu_medians(*ours.graph);
   result["baseline_stages_ms"] = stage_medians(*baseline.graph);
   return result;
 }

@@ -1,6 +1,7 @@
 #include "relight/core/frame_graph.h"
 
 #include <cxxabi.h>
+#include <time.h>
 
 #include <algorithm>
 #include <cstdlib>
@@ -11,6 +12,15 @@
 namespace relight {
 
 const char* to_string(Backend backend) { return backend == Backend::Vulkan ? "Vulkan" : "CPU"; }
+
+namespace {
+/// CPU time of the whole process so far (every thread), in milliseconds.
+double process_cpu_ms() {
+  timespec now{};
+  if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now) != 0) return 0.0;
+  return static_cast<double>(now.tv_sec) * 1e3 + static_cast<double>(now.tv_nsec) * 1e-6;
+}
+}  // namespace
 
 std::string demangle(const char* mangled) {
   int status = 0;
@@ -207,7 +217,7 @@ void FrameGraph::allocate_buffers() {
   }
   timings_.clear();
   for (std::size_t s : order_) {
-    if (!stages_[s].culled) timings_.push_back({stages_[s].name, stages_[s].stage->backend(), {}, {}});
+    if (!stages_[s].culled) timings_.push_back({stages_[s].name, stages_[s].stage->backend(), {}, {}, {}});
   }
 }
 
@@ -229,12 +239,15 @@ bool FrameGraph::run_frame() {
     auto& entry = stages_[s];
     if (entry.culled) continue;
     StageContext context(*this, s);
+    const double cpu_start = process_cpu_ms();
     const auto start = std::chrono::steady_clock::now();
     entry.stage->run(context);
     const auto stop = std::chrono::steady_clock::now();
+    const double cpu_stop = process_cpu_ms();
     if (context.end_of_stream_) return false;
     auto& timing = timings_[timing_index++];
     timing.wall_ms.push_back(std::chrono::duration<double, std::milli>(stop - start).count());
+    timing.cpu_ms.push_back(cpu_stop - cpu_start);
     if (context.device_ms_ >= 0.0) timing.device_ms.push_back(context.device_ms_);
     timing.device_buffers = context.device_access_;
   }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <ctime>
 
 #include "relight/core/image.h"
 
@@ -185,7 +186,42 @@ TEST(FrameGraph, TimesEveryStageEveryFrame) {
   for (const auto& timing : graph.timings()) {
     EXPECT_EQ(timing.wall_ms.size(), 4u) << timing.stage;
     for (double ms : timing.wall_ms) EXPECT_GE(ms, 0.0);
+    EXPECT_EQ(timing.cpu_ms.size(), 4u) << timing.stage;
+    for (double ms : timing.cpu_ms) EXPECT_GE(ms, 0.0);
   }
+}
+
+// Works on the calling thread until the process has spent `cpu_ms` more of CPU time.
+class CpuBurner final : public Stage {
+ public:
+  explicit CpuBurner(double cpu_ms) : cpu_ms_(cpu_ms) {}
+  std::string name() const override { return "burner"; }
+  bool has_side_effects() const override { return true; }
+  void declare(StageBuilder& b) override { in_ = b.read<DepthMap>("depth"); }
+  void run(StageContext&) override {
+    const std::clock_t start = std::clock();
+    volatile double sink = 0.0;
+    while (static_cast<double>(std::clock() - start) * 1000.0 / CLOCKS_PER_SEC < cpu_ms_) sink = sink + 1.0;
+  }
+
+ private:
+  double cpu_ms_;
+  Read<DepthMap> in_;
+};
+
+TEST(FrameGraph, CountsTheCpuTimeEachStageSpends) {
+  FrameGraph graph;
+  graph.emplace<CountingSource>(2);
+  graph.emplace<CpuBurner>(30.0);
+  while (graph.run_frame()) {
+  }
+  const StageTimings& burner = graph.timings().at(1);
+  ASSERT_EQ(burner.stage, "burner");
+  ASSERT_EQ(burner.cpu_ms.size(), 2u);
+  // At least what it burnt (the process's CPU time, so other threads can only add to it); the
+  // source, which does next to nothing, far less.
+  for (double ms : burner.cpu_ms) EXPECT_GE(ms, 29.0);
+  for (double ms : graph.timings().at(0).cpu_ms) EXPECT_LT(ms, 29.0);
 }
 
 class FinishCounter final : public Stage {

@@ -260,6 +260,10 @@ struct StageTimings {
   Backend backend = Backend::Cpu;
   std::vector<double> wall_ms;    ///< one entry per frame the stage ran in
   std::vector<double> device_ms;  ///< GPU time where the stage reported it (else empty)
+  /// The process's CPU time while the stage ran, all threads together (its helper threads, the
+  /// Vulkan CPU device's, and any background writer's): cpu_ms / wall_ms says how many cores the
+  /// stage kept busy.
+  std::vector<double> cpu_ms;
   /// Whether the stage's last run read or wrote graph buffers on the device (else on the host).
   bool device_buffers = false;
 };
