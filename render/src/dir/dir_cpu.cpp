@@ -27,8 +27,7 @@ class MapShader {
             std::span<const Vpl> vpls, std::span<const float> ism_atlas, const IsmPointPools& ism_points,
             const DirRenderOptions& options)
       : scene_(scene),
-        layout_(layout),
-        shadow_atlas_(shadow_atlas),
+        shadows_(layout, shadow_atlas),
         vpls_(vpls),
         ism_(ism_atlas, options.ism, vpls, ism_points),
         first_emitter_(vpls.size() - emitter_count(vpls)),
@@ -70,9 +69,9 @@ class MapShader {
       if (cos_i <= 0.f) continue;
       // The real layer's shadow first: no BRDF to evaluate where it is dark.
       const auto index = static_cast<std::uint32_t>(l);
-      if (shadow_visibility(layout_, shadow_atlas_, index, 0, point, n, real_tolerance) == 0.f) continue;
+      if (shadows_(index, 0, point, n, real_tolerance) == 0.f) continue;
       const Vec3 contribution = phong_brdf(m, n, sample->wi, wo).cwiseProduct(sample->irradiance) * cos_i;
-      if (want_rv()) out.real_virtual += contribution * shadow_visibility(layout_, shadow_atlas_, index, 1, point, n);
+      if (want_rv()) out.real_virtual += contribution * shadows_(index, 1, point, n);
       out.real += contribution * ((light.real ? 1.f : 0.f) * real_pixel);
     }
     // Emitter VPLs (vpl.h): direct light, so every pixel sees all of them (not interleaved).
@@ -120,8 +119,7 @@ class MapShader {
   }
 
   const MrScene& scene_;
-  const ShadowLayout& layout_;
-  std::span<const float> shadow_atlas_;
+  ShadowLookup shadows_;
   std::span<const Vpl> vpls_;
   IsmLookup ism_;
   std::size_t first_emitter_;  ///< vpls_[first_emitter_, end) are emitters

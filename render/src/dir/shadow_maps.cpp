@@ -154,34 +154,61 @@ std::vector<float> shadow_atlas_cpu(const RayTracer& tracer, const ShadowLayout&
 
 float shadow_visibility(const ShadowLayout& layout, std::span<const float> atlas, std::uint32_t light, int layer,
                         const Vec3& point, const Vec3& normal, float surface_tolerance) {
-  if (light >= layout.light_views.size()) return 1.f;
-  const auto [first, count] = layout.light_views[light];
-  if (count == 0) return 1.f;
-  const ShadowView& any = layout.view(first, layer);
-  const Vec3 eye = any.eye.head<3>();
-  const bool positional = any.eye.w() > 0.5f;
-  const Vec3 towards_light = positional ? Vec3(eye - point) : eye;
-  const std::uint32_t index = count == 6 ? first + static_cast<std::uint32_t>(cube_face(point - eye)) : first;
-  const ShadowView& view = layout.view(index, layer);
+  return ShadowLookup(layout, atlas)(light, layer, point, normal, surface_tolerance);
+}
+
+ShadowLookup::ShadowLookup(const ShadowLayout& layout, std::span<const float> atlas)
+    : tile_(layout.tile), atlas_width_(static_cast<std::size_t>(layout.atlas_width())) {
+  if (atlas.size() < atlas_width_ * static_cast<std::size_t>(layout.atlas_height()))
+    throw Error("shadow lookup: the atlas is smaller than its layout");
+  for (int layer = 0; layer < 2; ++layer) {
+    auto& views = views_[static_cast<std::size_t>(layer)];
+    for (std::size_t v = 0; v < layout.views.size(); ++v) {
+      const auto [ox, oy] = layout.tile_origin(static_cast<int>(v), layer);
+      views.push_back({&layout.view(v, layer),
+                       atlas.data() + static_cast<std::size_t>(oy) * atlas_width_ + static_cast<std::size_t>(ox)});
+    }
+    for (const auto& [first, count] : layout.light_views) {
+      Light light{first, count};
+      if (count > 0) {
+        const ShadowView& any = layout.view(first, layer);
+        light.positional = any.eye.w() > 0.5f;
+        light.eye = any.eye.head<3>();
+        light.unit_towards = light.eye.normalized();
+      }
+      lights_[static_cast<std::size_t>(layer)].push_back(light);
+    }
+  }
+}
+
+float ShadowLookup::operator()(std::uint32_t light_index, int layer, const Vec3& point, const Vec3& normal,
+                               float surface_tolerance) const {
+  const auto& lights = lights_[layer == 0 ? 0 : 1];
+  if (light_index >= lights.size()) return 1.f;
+  const Light& light = lights[light_index];
+  if (light.count == 0) return 1.f;
+  const Vec3 towards_light = light.positional ? Vec3(light.eye - point) : light.eye;
+  const std::uint32_t index =
+      light.count == 6 ? light.first + static_cast<std::uint32_t>(cube_face(point - light.eye)) : light.first;
+  const View& tile = views_[layer == 0 ? 0 : 1][index];
+  const ShadowView& view = *tile.view;
   // Against shadow acne: the receiver moves half a texel (measured at the receiver) off its
   // surface, and the depth test allows one texel. Larger offsets lift receivers next to a
   // contact (a virtual object standing on a real table) out of its shadow (bench
   // dir/vs_reference: 1.5 texels doubled the direct-light error of DeltaL).
-  const float texel = positional ? view.texel_size * towards_light.norm() : view.texel_size;
+  const float texel = light.positional ? view.texel_size * towards_light.norm() : view.texel_size;
   const Vec3 facing = normal.dot(towards_light) < 0.f ? Vec3(-normal) : normal;
-  const float cos_incidence = std::max(std::abs(normal.dot(towards_light.normalized())), 0.2f);
+  const Vec3 unit_towards = light.positional ? Vec3(towards_light.normalized()) : light.unit_towards;
+  const float cos_incidence = std::max(std::abs(normal.dot(unit_towards)), 0.2f);
   const float tolerance = texel + surface_tolerance / cos_incidence;
   const Vec3 receiver = point + 0.5f * texel * facing;
   const Eigen::Vector4f clip = view.world_to_clip * receiver.homogeneous();
   if (clip.w() <= 0.f) return 1.f;
   const float nx = clip.x() / clip.w(), ny = clip.y() / clip.w();
   if (std::abs(nx) > 1.f || std::abs(ny) > 1.f) return 1.f;
-  const int tile = layout.tile;
-  const int tx = std::clamp(static_cast<int>(std::floor((nx * 0.5f + 0.5f) * static_cast<float>(tile))), 0, tile - 1);
-  const int ty = std::clamp(static_cast<int>(std::floor((ny * 0.5f + 0.5f) * static_cast<float>(tile))), 0, tile - 1);
-  const auto [ox, oy] = layout.tile_origin(static_cast<int>(index), layer);
-  const float stored =
-      atlas[static_cast<std::size_t>(oy + ty) * static_cast<std::size_t>(layout.atlas_width()) + static_cast<std::size_t>(ox + tx)];
+  const int tx = std::clamp(static_cast<int>(std::floor((nx * 0.5f + 0.5f) * static_cast<float>(tile_))), 0, tile_ - 1);
+  const int ty = std::clamp(static_cast<int>(std::floor((ny * 0.5f + 0.5f) * static_cast<float>(tile_))), 0, tile_ - 1);
+  const float stored = tile.texels[static_cast<std::size_t>(ty) * atlas_width_ + static_cast<std::size_t>(tx)];
   const float depth = light_depth(view, receiver);
   return depth <= stored + tolerance ? 1.f : 0.f;
 }
