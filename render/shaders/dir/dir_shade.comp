@@ -122,25 +122,25 @@ float shadow_visibility(Light light, int layer, vec3 point, vec3 normal, float s
   return depth <= stored + tolerance ? 1.0 : 0.0;
 }
 
-// IsmLookup::visible (ism.h).
-float ism_visible(Projection projection, uint tile_offset, vec3 point) {
+// IsmLookup::visible (ism.h); constant_bias: kIsmBias or kEmitterVirtualIsmBias.
+float ism_visible(Projection projection, uint tile_offset, vec3 point, float constant_bias) {
   float distance;
   const vec3 dir = projection_local(projection, point, distance);
   vec2 texel;
   if (!(distance > 0.0) || !projection_texel(projection, dir, params.ism_tile, texel)) return 1.0;
   const int tile = params.ism_tile;
   const ivec2 xy = clamp(ivec2(floor(texel)), ivec2(0), ivec2(tile - 1));
-  const float reach = distance - (0.02 + distance * 2.0 * texel_angle(projection, tile));
+  const float reach = distance - (constant_bias + distance * 2.0 * texel_angle(projection, tile));
   return reach <= ism_atlas[tile_offset + uint(xy.y * tile + xy.x)] ? 1.0 : 0.0;
 }
 
 // IsmLookup: V_r from the VPL's real tile (its hemisphere), V_v from its (focused) virtual tile.
 vec2 ism_visibility(uint index, Vpl vpl, vec3 point) {
   const uint texels = uint(params.ism_tile * params.ism_tile);
-  const float real = ism_visible(real_tile(vpl, params.scene_bounds), index * texels, point);
+  const float real = ism_visible(real_tile(vpl, params.scene_bounds), index * texels, point, 0.02);
   if (real == 0.0) return vec2(0.0);
   return vec2(real, ism_visible(virtual_tile(vpl, params.virtual_bounds, params.scene_bounds),
-                                (params.vpl_count + index) * texels, point));
+                                (params.vpl_count + index) * texels, point, is_emitter(vpl) ? 0.002 : 0.02));
 }
 
 void main() {

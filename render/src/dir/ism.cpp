@@ -318,10 +318,12 @@ IsmLookup::IsmLookup(std::span<const float> atlas, const IsmOptions& options, st
   for (const Vpl& vpl : vpls) {
     real_.push_back(TileProjection::real_tile(vpl, points));
     virtual_.push_back(TileProjection::virtual_tile(vpl, points));
+    emitter_.push_back(vpl.emitter());
   }
 }
 
-float IsmLookup::visible(const TileProjection& projection, std::size_t tile_offset, const Vec3& point) const {
+float IsmLookup::visible(const TileProjection& projection, std::size_t tile_offset, const Vec3& point,
+                         float constant_bias) const {
   float distance = 0.f;
   const Vec3 dir = projection.local(point, distance);
   Vec2 texel;
@@ -329,16 +331,17 @@ float IsmLookup::visible(const TileProjection& projection, std::size_t tile_offs
   const int x = std::clamp(static_cast<int>(std::floor(texel.x())), 0, tile_ - 1);
   const int y = std::clamp(static_cast<int>(std::floor(texel.y())), 0, tile_ - 1);
   const std::size_t i = tile_offset + static_cast<std::size_t>(y) * static_cast<std::size_t>(tile_) + static_cast<std::size_t>(x);
-  // Two texels' worth of angle, plus 2 cm.
-  const float reach = distance - (0.02f + distance * 2.f * projection.texel_angle(tile_));
+  // Two texels' worth of angle, plus the constant (kIsmBias, kEmitterVirtualIsmBias).
+  const float reach = distance - (constant_bias + distance * 2.f * projection.texel_angle(tile_));
   return reach <= atlas_[i] ? 1.f : 0.f;
 }
 
 IsmLookup::Visibility IsmLookup::operator()(std::uint32_t index, const Vec3& point) const {
   const std::size_t offset = static_cast<std::size_t>(index) * static_cast<std::size_t>(tile_) * static_cast<std::size_t>(tile_);
-  const float real = visible(real_[index], offset, point);
+  const float real = visible(real_[index], offset, point, kIsmBias);
   if (real == 0.f) return {0.f, 0.f};
-  return {real, visible(virtual_[index], layer_stride_ + offset, point)};
+  return {real,
+          visible(virtual_[index], layer_stride_ + offset, point, emitter_[index] ? kEmitterVirtualIsmBias : kIsmBias)};
 }
 
 }  // namespace relight::render
