@@ -122,7 +122,8 @@ void timing_table(std::ostringstream& html, const Json& stages) {
   for (const auto& stage : stages) total += stage.value("median_ms", 0.0);
   html << "<table><tr><th class=l>stage<th class=l>backend<th class=l>buffers<th>frames<th>median "
           "ms<th>mean<th>p95<th>max"
-          "<th>device ms<th class=l>share of the median frame\n";
+          "<th>device ms<th title=\"CPU time of the process during the stage over its wall time\">cores busy"
+          "<th class=l>share of the median frame\n";
   for (const auto& stage : stages) {
     const double median = stage.value("median_ms", 0.0);
     const double share = total > 0 ? median / total : 0;
@@ -130,11 +131,15 @@ void timing_table(std::ostringstream& html, const Json& stages) {
          << html_escape(stage.value("backend", "")) << "<td class=l>" << html_escape(stage.value("buffers", ""))
          << "<td>" << stage.value("frames", 0) << "<td>" << ms(median) << "<td>" << ms(stage.value("mean_ms", 0.0))
          << "<td>" << ms(stage.value("p95_ms", 0.0)) << "<td>" << ms(stage.value("max_ms", 0.0)) << "<td>"
-         << (stage.contains("device_median_ms") ? ms(stage["device_median_ms"].get<double>()) : "") << "<td class=l>"
+         << (stage.contains("device_median_ms") ? ms(stage["device_median_ms"].get<double>()) : "") << "<td>"
+         << (stage.contains("cpu_median_ms") && median > 0
+                 ? format("%.1f", stage["cpu_median_ms"].get<double>() / median)
+                 : "")
+         << "<td class=l>"
          << "<span class=bar style=\"width:" << std::lround(200 * share) << "px\"></span> "
          << format("%.0f %%", 100 * share) << "\n";
   }
-  html << "<tr><th class=l>sum of medians<th><th><th><th>" << ms(total) << "<th colspan=5></table>\n";
+  html << "<tr><th class=l>sum of medians<th><th><th><th>" << ms(total) << "<th colspan=6></table>\n";
 }
 
 // Stacked areas: each stage's wall time per frame on top of the stages before it.

@@ -53,6 +53,7 @@ TEST(Cli, ReplayOfTheEmbeddedSampleWritesFramesReportAndGraph) {
     stages.insert(stage["stage"]);
     EXPECT_EQ(stage["wall_ms"].size(), 4u) << stage["stage"];
     EXPECT_GE(stage["median_ms"].get<double>(), 0.0);
+    EXPECT_GE(stage["cpu_median_ms"].get<double>(), 0.0) << stage["stage"];
   }
   EXPECT_TRUE(stages.count("source"));
   EXPECT_TRUE(stages.count("frame_writer"));
@@ -72,6 +73,7 @@ TEST(Cli, ReplayOfTheEmbeddedSampleWritesFramesReportAndGraph) {
   }
   EXPECT_EQ(pictures, 12u);
   for (const auto& stage : stages) EXPECT_NE(html.find("<td class=l>" + stage + "<"), std::string::npos) << stage;
+  EXPECT_NE(html.find(">cores busy<"), std::string::npos);
   EXPECT_NE(html.find("<div class=graph><svg"), std::string::npos);
 }
 
