@@ -56,8 +56,8 @@ nlohmann::ordered_json timing_report(const FrameGraph& graph, double total_secon
     stage["p95_ms"] = wall.p95;
     stage["max_ms"] = wall.max;
     if (!timing.device_ms.empty()) stage["device_median_ms"] = summarize(timing.device_ms).median;
-    // Cores the stage kept busy (its CPU time over its wall time, medians): what is left of
-    // the machine for work that could overlap it.
+    // The process's CPU time while the stage ran; over median_ms, the cores it kept busy (what
+    // report.html's timing table shows).
     if (!timing.cpu_ms.empty()) stage["cpu_median_ms"] = summarize(timing.cpu_ms).median;
     stage["wall_ms"] = timing.wall_ms;
     if (!timing.device_ms.empty()) stage["device_ms"] = timing.device_ms;

@@ -69,25 +69,13 @@ double steady_median(const std::vector<double>& values) {
   return app::summarize(steady).median;
 }
 
-/// Per-stage medians of the frames after the first.
-bench::Json stage_medians(const FrameGraph& graph) {
-  bench::Json stages = bench::Json::object();
-  for (const auto& timing : graph.timings()) stages[timing.stage] = steady_median(timing.wall_ms);
-  return stages;
-}
-
-/// Per-stage median CPU milliseconds of the process (all threads) while the stage ran.
-bench::Json stage_cpu_medians(const FrameGraph& graph) {
-  bench::Json stages = bench::Json::object();
-  for (const auto& timing : graph.timings()) stages[timing.stage] = steady_median(timing.cpu_ms);
-  return stages;
-}
-
-/// Per-stage median GPU milliseconds, for the stages that report device time.
-bench::Json stage_gpu_medians(const FrameGraph& graph) {
+/// Per-stage medians of the frames after the first, of one of StageTimings' series: wall_ms,
+/// cpu_ms (the process's CPU time while the stage ran) or device_ms (GPU time). Stages without
+/// entries in the series (no GPU timestamps) are left out.
+bench::Json stage_medians(const FrameGraph& graph, std::vector<double> StageTimings::*series = &StageTimings::wall_ms) {
   bench::Json stages = bench::Json::object();
   for (const auto& timing : graph.timings())
-    if (!timing.device_ms.empty()) stages[timing.stage] = steady_median(timing.device_ms);
+    if (!(timing.*series).empty()) stages[timing.stage] = steady_median(timing.*series);
   return stages;
 }
 
@@ -151,7 +139,7 @@ bench::Json compare_replays(app::ReplayPipeline& ours, app::ReplayPipeline& base
   result["composite_pixels_over_2"] = difference.pixels_over_2;
   result["compute"] = ours.compute;
   result["stages_ms"] = stage_medians(*ours.graph);
-  result["stages_cpu_ms"] = stage_cpu_medians(*ours.graph);
+  result["stages_cpu_ms"] = stage_medians(*ours.graph, &StageTimings::cpu_ms);
   result["baseline_stages_ms"] = stage_medians(*baseline.graph);
   return result;
 }
@@ -224,7 +212,7 @@ bench::Json replay_gpu(const bench::Options& options, int width, int height, dou
   bench::Json result = compare_replays(gpu, cpu, frames, name, "cpu_replay");
   result["goal_fps"] = goal_fps;
   result["vpls"] = 256;
-  result["stages_gpu_ms"] = stage_gpu_medians(*gpu.graph);
+  result["stages_gpu_ms"] = stage_medians(*gpu.graph, &StageTimings::device_ms);
   result["stages_on_device"] = stages_on_device(*gpu.graph);
   return result;
 }
