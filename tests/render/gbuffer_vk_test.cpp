@@ -91,6 +91,46 @@ TEST_F(GBufferVkTest, TextureCoordinatesMatchTheRayDifferentials) {
   }
 }
 
+// The draw is indexed and a triangle takes the material of its first corner (mesh_raster_vk.h):
+// a fan whose four triangles start at one shared vertex with four materials, and a mesh without
+// vertex normals (face normals on corners of its own), come out as the ray-cast G-buffer has them.
+TEST_F(GBufferVkTest, TrianglesThatShareTheirFirstCornerKeepTheirOwnMaterials) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  MrScene scene;
+  TriangleMesh fan;  // a square on z = 0 around its centre vertex 0, each quarter its own material
+  fan.positions = {{0.f, 0.f, 0.f}, {-0.5f, -0.5f, 0.f}, {0.5f, -0.5f, 0.f}, {0.5f, 0.5f, 0.f}, {-0.5f, 0.5f, 0.f}};
+  fan.normals.assign(fan.positions.size(), Eigen::Vector3f::UnitZ());
+  for (std::uint32_t quarter = 0; quarter < 4; ++quarter) {
+    fan.triangles.push_back({0u, 1u + quarter, 1u + (quarter + 1) % 4});
+    fan.triangle_material.push_back(scene.add_material({}));
+  }
+  TriangleMesh tent;  // two faces meeting on a ridge above the fan, no vertex normals
+  tent.positions = {{-0.2f, -0.1f, 0.1f}, {0.2f, -0.1f, 0.1f}, {0.2f, 0.f, 0.2f},
+                    {-0.2f, 0.f, 0.2f},   {-0.2f, 0.1f, 0.1f}, {0.2f, 0.1f, 0.1f}};
+  tent.triangles = {{0, 1, 2}, {0, 2, 3}, {3, 2, 5}, {3, 5, 4}};
+  tent.triangle_material.assign(4, scene.add_material({}));
+  tent.real = false;
+  scene.meshes = {fan, tent};
+  const MrCamera camera = test::camera_at({0.05, -0.6, 1.2}, {0.0, 0.0, 0.0}, 80, 60);
+  GBufferVk renderer(context, 80, 60);
+  renderer.set_scene(scene);
+  const GBuffer gpu = renderer.render(camera);
+  const GBuffer cpu = gbuffer_cpu(RayTracer(scene), camera);
+  std::vector<int> seen(scene.materials.size() + 1, 0);
+  int compared = 0, same = 0;
+  for (int row = 0; row < 60; ++row)
+    for (int col = 0; col < 80; ++col) {
+      if (cpu.material(row, col) == 0) continue;
+      ++compared;
+      ++seen[cpu.material(row, col)];
+      if (gpu.material(row, col) != cpu.material(row, col)) continue;  // an edge between two triangles
+      ++same;
+      EXPECT_GT(dot(gpu.normal(row, col), cpu.normal(row, col)), 0.999f) << row << "," << col;
+    }
+  for (std::size_t label = 1; label < seen.size(); ++label) EXPECT_GT(seen[label], 20) << "material " << label - 1;
+  EXPECT_GT(same, compared * 95 / 100);
+}
+
 TEST_F(GBufferVkTest, RejectsAWrongCameraSizeAndRenderBeforeScene) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   GBufferVk renderer(context, 32, 24);

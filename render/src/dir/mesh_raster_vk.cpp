@@ -19,33 +19,67 @@ bool in_layers(const TriangleMesh& mesh, MeshLayers layers) {
 
 void upload_scene_vertices(vk::VulkanContext& context, const MrScene& scene, MeshLayers layers, SceneVertices& out) {
   scene.validate();
-  std::size_t corners = 0;
-  for (const TriangleMesh& mesh : scene.meshes)
-    if (in_layers(mesh, layers)) corners += 3 * mesh.triangles.size();
+  std::size_t vertex_count = 0, index_count = 0;
+  for (const TriangleMesh& mesh : scene.meshes) {
+    if (!in_layers(mesh, layers)) continue;
+    vertex_count += mesh.normals.empty() ? 3 * mesh.triangles.size() : mesh.positions.size();
+    index_count += 3 * mesh.triangles.size();
+  }
   std::vector<RasterVertex> vertices;
-  vertices.reserve(corners);  // 300k corners of a reconstruction: no regrowth (and its copies) every frame
+  std::vector<std::uint32_t> indices;
+  vertices.reserve(vertex_count);  // a reconstruction's 300k vertices: no regrowth (and its copies) every frame
+  indices.reserve(index_count);
+  std::vector<bool> provoking;  // per vertex of the mesh: first corner of a triangle already, its info set
   for (const TriangleMesh& mesh : scene.meshes) {
     if (!in_layers(mesh, layers)) continue;
     const bool textured = !mesh.texcoords.empty();
-    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-      const std::uint32_t info =
-          mesh.triangle_material[t] | (mesh.real ? 0u : kVirtualBit) | (textured ? kTexcoordBit : 0u);
-      const auto& tri = mesh.triangles[t];
-      Eigen::Vector3f flat = Eigen::Vector3f::Zero();
-      if (mesh.normals.empty())
-        flat = (mesh.positions[tri[1]] - mesh.positions[tri[0]]).cross(mesh.positions[tri[2]] - mesh.positions[tri[0]]).normalized();
-      for (std::uint32_t v : tri) {
-        const Eigen::Vector3f& p = mesh.positions[v];
-        const Eigen::Vector3f n = mesh.normals.empty() ? flat : mesh.normals[v];
-        const Eigen::Vector2f uv = textured ? mesh.texcoords[v] : Eigen::Vector2f::Zero();
-        vertices.push_back({{p.x(), p.y(), p.z()}, {n.x(), n.y(), n.z()}, info, {uv.x(), uv.y()}});
+    const auto vertex = [&](std::uint32_t v, const Eigen::Vector3f& n, std::uint32_t info) {
+      const Eigen::Vector3f& p = mesh.positions[v];
+      const Eigen::Vector2f uv = textured ? mesh.texcoords[v] : Eigen::Vector2f::Zero();
+      return RasterVertex{{p.x(), p.y(), p.z()}, {n.x(), n.y(), n.z()}, info, {uv.x(), uv.y()}};
+    };
+    const auto info_of = [&](std::size_t t) {
+      return mesh.triangle_material[t] | (mesh.real ? 0u : kVirtualBit) | (textured ? kTexcoordBit : 0u);
+    };
+    if (mesh.normals.empty()) {
+      for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+        const auto& tri = mesh.triangles[t];
+        const Eigen::Vector3f flat = (mesh.positions[tri[1]] - mesh.positions[tri[0]])
+                                         .cross(mesh.positions[tri[2]] - mesh.positions[tri[0]])
+                                         .normalized();
+        for (std::uint32_t v : tri) {
+          indices.push_back(static_cast<std::uint32_t>(vertices.size()));
+          vertices.push_back(vertex(v, flat, info_of(t)));
+        }
       }
+      continue;
+    }
+    const auto base = static_cast<std::uint32_t>(vertices.size());
+    for (std::uint32_t v = 0; v < mesh.positions.size(); ++v) vertices.push_back(vertex(v, mesh.normals[v], 0u));
+    provoking.assign(mesh.positions.size(), false);
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+      const auto& tri = mesh.triangles[t];
+      const std::uint32_t info = info_of(t);
+      std::uint32_t first = base + tri[0];
+      if (!provoking[tri[0]]) {
+        provoking[tri[0]] = true;
+        vertices[first].info = info;
+      } else if (vertices[first].info != info) {
+        RasterVertex copy = vertices[first];
+        copy.info = info;
+        first = static_cast<std::uint32_t>(vertices.size());
+        vertices.push_back(copy);
+      }
+      indices.insert(indices.end(), {first, base + tri[1], base + tri[2]});
     }
   }
-  const std::size_t bytes = std::max<std::size_t>(4, vertices.size() * sizeof(RasterVertex));
-  vk::reserve_with_headroom(out.buffer, context, bytes, vk::BufferDomain::Upload, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  vk::reserve_with_headroom(out.buffer, context, std::max<std::size_t>(4, vertices.size() * sizeof(RasterVertex)),
+                            vk::BufferDomain::Upload, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+  vk::reserve_with_headroom(out.indices, context, std::max<std::size_t>(4, indices.size() * sizeof(std::uint32_t)),
+                            vk::BufferDomain::Upload, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
   if (!vertices.empty()) out.buffer->write(std::as_bytes(std::span(vertices)));
-  out.count = static_cast<std::uint32_t>(vertices.size());
+  if (!indices.empty()) out.indices->write(std::as_bytes(std::span(indices)));
+  out.index_count = static_cast<std::uint32_t>(indices.size());
 }
 
 void upload_scene_positions(vk::VulkanContext& context, std::span<const TriangleMesh> meshes, MeshLayers layers,
@@ -250,21 +284,27 @@ void begin_draw(VkCommandBuffer cmd, const MeshPipeline& pipeline, VkBuffer vert
   vkCmdBindVertexBuffers(cmd, 0, 1, &vertex_buffer, &offset);
 }
 
+void draw_indexed(VkCommandBuffer cmd, const MeshPipeline& pipeline, VkBuffer vertex_buffer, VkBuffer index_buffer,
+                  std::uint32_t index_count, std::span<const std::byte> constants, const VkRect2D& area) {
+  begin_draw(cmd, pipeline, vertex_buffer, constants, area);
+  vkCmdBindIndexBuffer(cmd, index_buffer, 0, VK_INDEX_TYPE_UINT32);
+  vkCmdDrawIndexed(cmd, index_count, 1, 0, 0, 0);
+}
+
 }  // namespace
 
 void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const SceneVertices& vertices,
                 std::span<const std::byte> constants, const VkRect2D& area) {
-  if (vertices.count == 0) return;
-  begin_draw(cmd, pipeline, vertices.buffer->handle(), constants, area);
-  vkCmdDraw(cmd, vertices.count, 1, 0, 0);
+  if (vertices.index_count == 0) return;
+  draw_indexed(cmd, pipeline, vertices.buffer->handle(), vertices.indices->handle(), vertices.index_count, constants,
+               area);
 }
 
 void draw_scene(VkCommandBuffer cmd, const MeshPipeline& pipeline, const ScenePositions& positions,
                 std::span<const std::byte> constants, const VkRect2D& area) {
   if (positions.index_count == 0) return;
-  begin_draw(cmd, pipeline, positions.positions->handle(), constants, area);
-  vkCmdBindIndexBuffer(cmd, positions.indices->handle(), 0, VK_INDEX_TYPE_UINT32);
-  vkCmdDrawIndexed(cmd, positions.index_count, 1, 0, 0, 0);
+  draw_indexed(cmd, pipeline, positions.positions->handle(), positions.indices->handle(), positions.index_count,
+               constants, area);
 }
 
 }  // namespace relight::render::detail
