@@ -35,6 +35,7 @@ void BufferPreviews::declare(StageBuilder& builder) {
 void BufferPreviews::for_each(StageContext& context,
                               const std::function<void(const std::string&, const ColorImage&)>& visit) const {
   for (const Entry& entry : entries_) {
+    if (entry.frames && !entry.frames(context.frame_index())) continue;
     const std::string name = buffer_name(entry.buffer);
     std::visit(
         [&](auto handle) {

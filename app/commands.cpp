@@ -245,6 +245,14 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
   command.add_flag("!--no-video", options.video, "Do not write composite.mp4");
 }
 
+void add_frame_options(CLI::App& command, ReplayOptions& options) {
+  command.add_flag("!--no-frames", options.write_frames, "Do not write per-frame images");
+  add_choice_option(command, "--previews", options.previews, kPreviewFramesNames,
+                    "Frames whose inner buffers (depth, smoothed depth, normals, the BRDF estimation's mosaic) are "
+                    "written as pictures: shown (the frames report.html shows) or every frame; the camera image and "
+                    "the composites are written for every frame");
+}
+
 void add_view_options(CLI::App& command, ReplayOptions& options) {
   command.add_flag("--view", options.view,
                    "Show the final picture in a window as it is made, with fps, tracking state and dropped frames; "
@@ -282,7 +290,7 @@ void register_replay(CLI::App& app) {
   add_choice_option(*replay, "--intrinsics", options->intrinsics, kIntrinsicsPresets,
                     "Override the sequence's intrinsics: the Kinect v1 defaults or a TUM calibration");
   replay->add_flag("--quiet", options->quiet, "No progress or summary on stderr");
-  replay->add_flag("!--no-frames", options->write_frames, "Do not write per-frame images");
+  add_frame_options(*replay, *options);
   replay->add_flag("--skip-bad-frames", options->skip_bad_frames,
                    "A TUM frame that cannot be read is skipped with a warning naming it (default: an error)");
   add_pose_options(*replay, *options);

@@ -22,6 +22,8 @@ void register_live(CLI::App& app, Runners& runners);
 /// The options of differential rendering (--object, --place, --lights, ...) shared by replay,
 /// live and graph.
 void add_render_options(CLI::App& command, ReplayOptions& options);
+/// --no-frames and --previews (which per-frame pictures are written), shared by replay and live.
+void add_frame_options(CLI::App& command, ReplayOptions& options);
 /// --view and --view-side (a window on the final picture), shared by replay and live.
 void add_view_options(CLI::App& command, ReplayOptions& options);
 /// --pose auto|sequence|marker|odometry|marker+odometry, shared by replay and live.

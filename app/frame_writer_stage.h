@@ -21,8 +21,8 @@ class FrameWriterStage final : public Stage {
   explicit FrameWriterStage(std::filesystem::path folder) : folder_(std::move(folder)) {}
   /// A PNG per frame: colour as it is, depth in false colour, a NormalMap as
   /// relight::normal_preview's colour coding, a CoverageImage (the virtual share of each pixel)
-  /// as grey (buffer_previews.h).
-  void add(PreviewBuffer buffer) { previews_.add(buffer); }
+  /// as grey (buffer_previews.h); for the frames `frames` wants (empty: every frame).
+  void add(PreviewBuffer buffer, FrameFilter frames = {}) { previews_.add(buffer, std::move(frames)); }
   /// A RadianceImage, written as OpenEXR (linear, full range).
   void add(BufferName<RadianceImage> buffer) { radiance_names_.push_back(buffer); }
 

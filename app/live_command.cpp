@@ -367,7 +367,7 @@ void register_live(CLI::App& app, Runners& runners) {
       ->capture_default_str();
   live->add_option("--out", live_options->replay.out, "Output folder")->required();
   live->add_flag("--quiet", live_options->replay.quiet, "No progress or summary on stderr");
-  live->add_flag("!--no-frames", live_options->replay.write_frames, "Do not write per-frame images");
+  add_frame_options(*live, live_options->replay);
   live->add_option("--markers", live_options->replay.markers,
                    "AprilTag layout for the camera pose: auto (the layout the device's scene describes, relight's "
                    "virtual devices), none, or a layout JSON file")

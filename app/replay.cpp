@@ -452,17 +452,23 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<capture::FrameSource> sourc
   pipeline.latency =
       &graph.emplace<LatencyStage>(pipeline.renders ? std::optional(pipeline.final_composite) : std::nullopt);
   if (options.view) add_view(pipeline, options, method2);
+  // The frames report.html shows: the inner buffers' pictures by default (--previews).
+  const FrameFilter shown = [total_frames](std::int64_t frame) {
+    return contact_sheet_row(frame, total_frames, kContactSheetRows).has_value();
+  };
+  const bool every_preview = options.write_frames && options.previews == PreviewFrames::Every;
+  const FrameFilter previewed = every_preview ? FrameFilter{} : shown;
   if (options.write_frames) {
     auto writer = std::make_unique<FrameWriterStage>(options.out / "frames");
     writer->add(kColor);
-    writer->add(kDepth);
-    writer->add(kDepthSmoothed);
-    if (method2) writer->add(kDepthFiltered);
-    writer->add(kNormals);
+    writer->add(kDepth, previewed);
+    writer->add(kDepthSmoothed, previewed);
+    if (method2) writer->add(kDepthFiltered, previewed);
+    writer->add(kNormals, previewed);
     if (pipeline.renders) {
       writer->add(kComposite);
       if (pipeline.final_composite != kComposite) writer->add(pipeline.final_composite);
-      writer->add(kBrdfPreview);
+      writer->add(kBrdfPreview, previewed);
     }
     if (pipeline.renders && options.write_buffers) {
       writer->add(kRealVirtualRadiance);
@@ -473,10 +479,9 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<capture::FrameSource> sourc
     graph.add(std::move(writer));
   }
   add_report_collector(pipeline, total_frames, method2);
-  if (pipeline.brdf_preview && !options.write_frames) {
-    const ReportCollectorStage* shown = pipeline.report;
-    pipeline.brdf_preview->only_for([shown](std::int64_t frame) { return shown->shows(frame); });
-  }
+  // The mosaic's re-render costs as much as the BRDF estimation's own stages: made only for the
+  // frames that write or show it.
+  if (pipeline.brdf_preview && !every_preview) pipeline.brdf_preview->only_for(shown);
   return pipeline;
 }
 

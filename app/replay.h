@@ -47,6 +47,13 @@ inline constexpr std::array<NamedValue<Method2Normals>, 2> kMethod2NormalsNames{
     {{"filtered", Method2Normals::Filtered}, {"plain", Method2Normals::Plain}}};
 /// The k_d real surfaces are rendered with: each camera pixel's own estimate (render/dir/camera_albedo.h)
 /// or its material cluster's.
+/// Which frames get the per-frame pictures of the pipeline's inner buffers (depth, smoothed and
+/// filtered depth, normals, the BRDF estimation's mosaic): the frames report.html shows, or
+/// every frame. The camera image and the composites are written for every frame either way.
+enum class PreviewFrames { Shown, Every };
+inline constexpr std::array<NamedValue<PreviewFrames>, 2> kPreviewFramesNames{
+    {{"shown", PreviewFrames::Shown}, {"every", PreviewFrames::Every}}};
+
 enum class RealAlbedo { Pixel, Cluster };
 inline constexpr std::array<NamedValue<RealAlbedo>, 2> kRealAlbedoNames{
     {{"pixel", RealAlbedo::Pixel}, {"cluster", RealAlbedo::Cluster}}};
@@ -59,6 +66,7 @@ struct ReplayOptions {
   std::optional<PinholeIntrinsics> intrinsics;  ///< a preset (kIntrinsicsPresets) overriding the sequence's own
   bool quiet = false;
   bool write_frames = true;        ///< per-frame PNGs under out/frames
+  PreviewFrames previews = PreviewFrames::Shown;        ///< which frames get the inner buffers' pictures
   vk::BackendPolicy backend = vk::BackendPolicy::Auto;  ///< see vk/backend.h
   std::string device;              ///< Vulkan device selector (index, type or name part)
   /// AprilTag layout for the marker pose: "auto" (the sequence's scene.json when it has a tag),

@@ -67,15 +67,15 @@ void ReportCollectorStage::declare(StageBuilder& builder) {
   }
 }
 
-std::optional<std::size_t> ReportCollectorStage::row_for(std::int64_t frame) const {
-  if (total_frames_ == 0) {  // unknown length: the first frame, then a rolling latest one
+std::optional<std::size_t> contact_sheet_row(std::int64_t frame, std::int64_t total_frames, int rows_wanted) {
+  if (total_frames == 0) {  // unknown length: the first frame, then a rolling latest one
     if (frame == 0) return 0;
     if (frame % 15 == 0) return 1;
     return std::nullopt;
   }
-  const std::int64_t rows = std::min<std::int64_t>(rows_, total_frames_);
+  const std::int64_t rows = std::min<std::int64_t>(rows_wanted, total_frames);
   for (std::int64_t row = 0; row < rows; ++row) {
-    const std::int64_t chosen = rows == 1 ? 0 : row * (total_frames_ - 1) / (rows - 1);
+    const std::int64_t chosen = rows == 1 ? 0 : row * (total_frames - 1) / (rows - 1);
     if (chosen == frame) return static_cast<std::size_t>(row);
   }
   return std::nullopt;
@@ -84,7 +84,7 @@ std::optional<std::size_t> ReportCollectorStage::row_for(std::int64_t frame) con
 void ReportCollectorStage::run(StageContext& context) {
   if (materials_name_) content_.materials = context.get(materials_).clusters;
   if (lights_name_) content_.lights = context.get(lights_);
-  const auto row = row_for(context.frame_index());
+  const auto row = contact_sheet_row(context.frame_index(), total_frames_, rows_);
   if (row && close_up_names_) {
     if (auto picture = close_up(context.frame_index(), context.get(close_up_before_), context.get(close_up_after_),
                                 context.get(close_up_coverage_)))

@@ -6,6 +6,8 @@
 // buffer. Writes nothing; the run reads content() after the last frame.
 // The frames are chosen evenly over a run of known length; for a run of unknown length (live) the
 // first frame and a rolling latest frame (refreshed every 15th frame) are kept.
+#include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -18,11 +20,18 @@
 
 namespace relight::app {
 
+/// Frames on report.html's contact sheet by default.
+inline constexpr int kContactSheetRows = 4;
+
+/// The contact-sheet row of `frame` if report.html shows it: `rows` frames chosen evenly over a
+/// run of `total_frames`, or for a run of unknown length (0) the first frame and every 15th.
+[[nodiscard]] std::optional<std::size_t> contact_sheet_row(std::int64_t frame, std::int64_t total_frames, int rows);
+
 class ReportCollectorStage final : public Stage {
  public:
   /// total_frames: frames the run will process (0 = unknown); rows: frames on the contact sheet;
   /// pictures are scaled to thumbnail_height (wide mosaics such as brdf_preview stay readable).
-  ReportCollectorStage(std::int64_t total_frames, int rows = 4, int thumbnail_height = 110);
+  ReportCollectorStage(std::int64_t total_frames, int rows = kContactSheetRows, int thumbnail_height = 110);
 
   void add_picture(PreviewBuffer buffer) { previews_.add(buffer); }
   void collect_materials(BufferName<brdf::Materials> buffer) { materials_name_ = buffer; }
@@ -41,14 +50,13 @@ class ReportCollectorStage final : public Stage {
 
   /// Whether the contact sheet (and the close-up) shows this frame (stages that make pictures
   /// only for it ask).
-  [[nodiscard]] bool shows(std::int64_t frame) const { return row_for(frame).has_value(); }
+  [[nodiscard]] bool shows(std::int64_t frame) const {
+    return contact_sheet_row(frame, total_frames_, rows_).has_value();
+  }
   /// Contact sheet, materials and lights gathered so far (timings and graph are the run's to add).
   [[nodiscard]] const ReportContent& content() const { return content_; }
 
  private:
-  /// The contact-sheet row the frame goes into, if it is one of the chosen frames.
-  [[nodiscard]] std::optional<std::size_t> row_for(std::int64_t frame) const;
-
   std::int64_t total_frames_;
   int rows_;
   int thumbnail_height_;

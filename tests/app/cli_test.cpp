@@ -1,6 +1,8 @@
 // The relight executable as users run it: exit codes, one-line errors, outputs.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <filesystem>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
@@ -128,6 +130,36 @@ TEST(Cli, CorruptFrameMidSequenceFailsCleanlyWithoutPartialFiles) {
   EXPECT_NE(result.err.find("1305031229.596617.png"), std::string::npos) << result.err;
   EXPECT_EQ(temporary_files_under(out), 0u);
   EXPECT_FALSE(std::filesystem::exists(out / "report.json"));
+}
+
+// The pictures of the inner buffers (depth, smoothed depth, normals, the BRDF mosaic) are made
+// and written for the frames report.html shows (8 frames: 0, 2, 4 and 7), the camera image and
+// the composites for every frame; --previews every writes all of them for every frame.
+TEST(Cli, ReplayWritesTheInnerBuffersPicturesForTheFramesTheReportShows) {
+  test::TempDir dir;
+  const auto shown = dir.path() / "shown", every = dir.path() / "every";
+  const auto result = relight("replay --quiet --loop 2 --no-video --out " + shown.string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto written = [](const std::filesystem::path& out, int frame, const std::string& buffer) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%06d_", frame);
+    return std::filesystem::exists(out / "frames" / (name + buffer + ".png"));
+  };
+  for (int frame = 0; frame < 8; ++frame) {
+    const bool on_the_report = frame == 0 || frame == 2 || frame == 4 || frame == 7;
+    for (const char* buffer : {"color", "composite", "composite_mapped"})
+      EXPECT_TRUE(written(shown, frame, buffer)) << frame << " " << buffer;
+    for (const char* buffer : {"depth", "depth_smoothed", "normals", "brdf_preview"})
+      EXPECT_EQ(written(shown, frame, buffer), on_the_report) << frame << " " << buffer;
+  }
+  const auto report = nlohmann::json::parse(read_text_file(shown / "report.json"));
+  EXPECT_EQ(report["frames"], 8);
+
+  ASSERT_EQ(relight("replay --quiet --no-object --loop 2 --previews every --out " + every.string()).exit_code, 0);
+  for (int frame = 0; frame < 8; ++frame)
+    for (const char* buffer : {"color", "depth", "depth_smoothed", "normals"})
+      EXPECT_TRUE(written(every, frame, buffer)) << frame << " " << buffer;
+  expect_one_line_error(relight("replay --previews sometimes --out " + dir.path().string()), 2);
 }
 
 TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {

@@ -203,7 +203,7 @@ TEST(DeviceRobustness, CtrlCDuringLive) {
   const auto out = dir.path() / "out";
   BoundedRun live;
   live.arguments = {"live", "--quiet", "--device", kDevice, "--frames", "3000", "--out", out.string()};
-  live.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_normals.png"); };
+  live.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_color.png"); };
   const auto run = run_relight(live);
   ASSERT_TRUE(run.interrupted) << describe(run);
   expect_clean_success(run, out);

@@ -40,7 +40,7 @@ TEST(ReplayRunRobustness, CtrlCDuringReplayOfATumFolder) {
   const auto out = dir.path() / "out";
   BoundedRun replay;
   replay.arguments = {"replay", "--quiet", "--cpu", sequence.string(), "--out", out.string()};
-  replay.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_normals.png"); };
+  replay.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_color.png"); };
   expect_interrupted_replay(run_relight(replay), out, 400);
 }
 

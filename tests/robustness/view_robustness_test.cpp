@@ -54,7 +54,7 @@ class ViewRobustness : public ::testing::Test {
 
 TEST_F(ViewRobustness, CtrlCDuringLiveWithTheView) {
   BoundedRun live = live_with_view();
-  live.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_normals.png"); };
+  live.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_color.png"); };
   expect_stopped_by_interrupt(run_relight(live));
 }
 
@@ -70,7 +70,7 @@ TEST_F(ViewRobustness, CtrlCWhileTheViewIsPaused) {
   Clock::time_point interrupted_at;
   live.interrupt_when = [&] {
     if (!paused_at) {
-      if (!std::filesystem::exists(out / "frames" / "000001_normals.png")) return false;
+      if (!std::filesystem::exists(out / "frames" / "000001_color.png")) return false;
       pressed = screen.press("relight live", "space");
       paused_at = Clock::now();
       return false;
