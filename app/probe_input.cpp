@@ -41,17 +41,25 @@ lights::ProbeCalibration probe_calibration(const ProbeInputOptions& options) {
 
 RealLightSource real_light_source(const fs::path& lights_file, const std::string& probe,
                                   const std::optional<fs::path>& scene, const std::string& no_probe) {
-  if (lights_file == kEstimateLights) return {{}, {}, true};
-  if (!lights_file.empty()) return {lights_file, {}};
-  if (!probe.empty()) return {{}, probe};
+  RealLightSource source;
+  if (lights_file == kEstimateLights) {
+    source.estimate = true;
+    return source;
+  }
+  source.lights_file = lights_file;
+  source.probe = probe;
+  if (!lights_file.empty() || !probe.empty()) return source;
   std::error_code ec;
   if (scene && scene->extension() != ".oni") {
-    if (fs::is_regular_file(*scene / "probe.txt", ec)) return {{}, (*scene / "probe.txt").string()};
-    if (fs::is_regular_file(*scene / "probe.hdr", ec)) return {{}, (*scene / "probe.hdr").string()};
+    for (const char* name : {"probe.txt", "probe.hdr"}) {
+      source.probe = (*scene / name).string();
+      if (fs::is_regular_file(source.probe, ec)) return source;
+    }
   }
-  throw Error(no_probe +
-              ": give one with --probe PATH|DEVICE, its lights with --lights FILE (from `relight lights`), "
-              "or estimate them from the frames with --lights estimate");
+  source.probe.clear();
+  source.estimate = true;
+  source.fallback = no_probe;
+  return source;
 }
 
 namespace {

@@ -57,14 +57,17 @@ struct RealLightSource {
   std::filesystem::path lights_file;  ///< constant lights (`relight lights` JSON); else the probe
   std::string probe;                  ///< probe spec (video_probe_stream.h: open_probe_input)
   bool estimate = false;              ///< `--lights estimate`: from the RGB-D frames (brdf/light_estimation.h)
+  /// Why the lights are estimated without being asked: "<no_probe>" (nothing else to light the
+  /// scene with); empty when the options chose the source.
+  std::string fallback;
 };
 
 /// The --lights value that estimates the lights from the frames instead of reading a file.
 inline constexpr const char* kEstimateLights = "estimate";
 
 /// --lights (a file, or `estimate`), else --probe, else `scene`'s probe.txt, else its probe.hdr;
-/// when there is none, throws relight::Error("<no_probe>: give one with --probe ... or its
-/// lights with --lights ...").
+/// when there is none, the estimate from the frames, with `fallback` = `no_probe` (every TUM
+/// recording and most users' own .oni have no probe: they are lit by what their frames show).
 [[nodiscard]] RealLightSource real_light_source(const std::filesystem::path& lights_file, const std::string& probe,
                                                 const std::optional<std::filesystem::path>& scene,
                                                 const std::string& no_probe);

@@ -215,6 +215,11 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   pipeline.probe = light_stages.probe;
   if (real_lights.lights_file.empty()) pipeline.extracted_lights = probe_input.lights;
   pipeline.light_estimation = light_stages.estimation;
+  pipeline.lights_estimated_because = real_lights.fallback;
+  if (!real_lights.fallback.empty() && !options.quiet)
+    std::cerr << "relight: " << real_lights.fallback
+              << ": the real lights are estimated from the frames (--lights estimate; --probe or --lights FILE to "
+                 "give them)\n";
   brdf::add_brdf_stages(graph, {}, per_pixel, pipeline.vulkan.get());
   // Culled unless the frame writer or report.html shows it; with the report alone only for its
   // contact-sheet frames (build_replay_pipeline).
@@ -377,7 +382,11 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
   }
   report["tracking"] = pipeline.trajectory->summary();
   if (pipeline.probe) report["probe"] = pipeline.probe->summary();
-  if (pipeline.light_estimation) report["light_estimate"] = pipeline.light_estimation->summary();
+  if (pipeline.light_estimation) {
+    report["light_estimate"] = pipeline.light_estimation->summary();
+    report["light_estimate"]["chosen"] =
+        pipeline.lights_estimated_because.empty() ? "--lights estimate" : pipeline.lights_estimated_because;
+  }
   if (pipeline.tracked_lamp) {
     report["tracked_lamp"] = pipeline.tracked_lamp->summary();
     if (pipeline.tracked_lamp->frames_seen() == 0) {

@@ -155,6 +155,7 @@ struct ReplayPipeline {
   app::LatencyStage* latency = nullptr;           ///< capture to final picture, every frame
   lights::ProbeStreamStage* probe = nullptr;      ///< set when the real lights come from a probe
   brdf::LightEstimationStage* light_estimation = nullptr;  ///< set with --lights estimate
+  std::string lights_estimated_because;  ///< RealLightSource::fallback: why, when nothing asked for it
   app::TrackedLampStage* tracked_lamp = nullptr;           ///< set with --real-spot-tag
   render::CompositeRule composite_rule = render::CompositeRule::Additive;  ///< as resolved for this run
   render::CameraLookStage* camera_look = nullptr;          ///< set with --camera-artefacts other than none

@@ -162,6 +162,24 @@ TEST(Cli, ReplayWritesTheInnerBuffersPicturesForTheFramesTheReportShows) {
   expect_one_line_error(relight("replay --previews sometimes --out " + dir.path().string()), 2);
 }
 
+// A recording without a light probe (every TUM sequence) is lit by the light estimated from its
+// own frames (issue: `--lights estimate` is the default without a probe), and the run says why.
+TEST(Cli, ReplayOfARecordingWithoutAProbeEstimatesItsLights) {
+  test::TempDir dir;
+  const std::string sample = std::string(RELIGHT_TEST_DATA) + "/tum_fr1_rpy";
+  const auto result = relight("replay " + sample + " --frames 0:2 --vpls 8 --no-video --object " + RELIGHT_TEST_DATA +
+                              "/models/glossy_pebble.gltf --place-on-plane --out " + dir.path().string());
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.err.find(sample + " has no light probe: the real lights are estimated from the frames"),
+            std::string::npos)
+      << result.err;
+  const auto report = nlohmann::json::parse(read_text_file(dir.path() / "report.json"));
+  ASSERT_TRUE(report.contains("light_estimate")) << report.dump();
+  EXPECT_EQ(report["light_estimate"]["chosen"], sample + " has no light probe");
+  EXPECT_EQ(report["light_estimate"]["evidence"], "shadows") << report["light_estimate"].dump();
+  EXPECT_TRUE(std::filesystem::exists(dir.path() / "frames" / "000001_composite_mapped.png"));
+}
+
 TEST(Cli, VulkanAndCpuBackendsWriteTheSameSmoothedDepth) {
   test::TempDir dir;
   const auto cpu = dir.path() / "cpu", vulkan = dir.path() / "vulkan";

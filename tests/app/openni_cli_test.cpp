@@ -92,7 +92,7 @@ TEST(OpenNiCli, LiveTracksTheCameraAndLightsAVirtualDeviceFromTheSceneItServes) 
   EXPECT_EQ(report["tracking"]["frames_tracked"], 3) << report["tracking"].dump();
   EXPECT_TRUE(std::filesystem::exists(dir.path() / "camera_trajectory.txt"));
   // The virtual device serves its scene (probe, tag layout): live lights and tracks it as replay
-  // would the same sequence; a device without a scene needs --lights, and the error names it.
+  // would the same sequence; a device without a scene has its lights estimated (below).
   const std::string model = std::string(RELIGHT_TEST_DATA) + "/models/glossy_pebble.gltf";
   const auto rendered = dir.path() / "render";
   const auto lit = relight("live --quiet --no-video --device \"relight://synthetic?size=320x240\" --frames 1 --vpls 8 --object " +
@@ -105,10 +105,17 @@ TEST(OpenNiCli, LiveTracksTheCameraAndLightsAVirtualDeviceFromTheSceneItServes) 
   EXPECT_GT(lit_report["latency_ms"]["median_ms"].get<double>(), 0.0);
   ASSERT_TRUE(lit_report.contains("device_memory")) << lit_report.dump();  // live reports it as replay does
   EXPECT_GT(lit_report["device_memory"]["allocations"].get<int>(), 0);
+  // A device without a probe: its lights are estimated from its frames, and the run says so.
   const std::string tum = "relight://tum/" + std::string(RELIGHT_TEST_DATA) + "/tum_fr1_rpy";
-  expect_one_line_error(relight("live --quiet --device " + tum + " --frames 1 --object " + model +
-                                " --place 0,0,0.8 --out " + (dir.path() / "tum").string()),
-                        "the device " + tum + " serves no light probe");
+  const auto estimated = relight("live --device " + tum + " --frames 1 --vpls 8 --no-video --object " + model +
+                                 " --place 0,0,0.8 --out " + (dir.path() / "tum").string());
+  ASSERT_EQ(estimated.exit_code, 0) << estimated.err;
+  EXPECT_NE(estimated.err.find("the device " + tum + " serves no light probe: the real lights are estimated"),
+            std::string::npos)
+      << estimated.err;
+  const auto estimated_report = read_report(dir.path() / "tum");
+  ASSERT_TRUE(estimated_report.contains("light_estimate")) << estimated_report.dump();
+  EXPECT_EQ(estimated_report["light_estimate"]["chosen"], "the device " + tum + " serves no light probe");
 }
 
 TEST(OpenNiCli, UnknownDeviceIsAClearError) {
