@@ -225,8 +225,8 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                     "How the rendered change reaches the camera image where it sees the real scene: additive "
                     "(camera + TM(L_rv) - TM(L_r)) or multiplicative (camera * TM(L_rv) / TM(L_r): a shadow "
                     "darkens the camera's own colour even where the measured light does not reproduce it). "
-                    "Default: additive; multiplicative for the main job, whose stand-in probe is not the desk's "
-                    "light");
+                    "Default: additive; multiplicative for the main job, whose estimated light colour rests on a "
+                    "white-patch guess");
   command
       .add_option("--exposure-time", options.exposure_time_s,
                   "Seconds the colour camera exposes each frame (its motion blur; at most the frame interval)")

@@ -418,11 +418,13 @@ ReplayOptions with_main_job_defaults(ReplayOptions options) {
   if (!embedded_sample || !nothing_to_render || options.no_object) return options;
   options.objects = {data_folder() / "models" / "glossy_pebble.gltf"};
   options.places_on_plane = {""};
-  // The sample was recorded without a light probe: the shipped Grace Cathedral probe stands in.
+  // The sample was recorded without a light probe: its light is estimated from its frames
+  // (real_light_source()'s fallback), and quietly so - the main job needs no options.
   if (options.lights.empty() && options.probe.empty()) {
-    options.probe = (data_folder() / "probes" / "grace_latlong.hdr").string();
-    // Its orange light does not reproduce the neutral desk the camera filmed: an additive shadow
-    // would subtract that orange and leave a cyan patch; the ratio darkens the desk's own colour.
+    options.lights = kEstimateLights;
+    // The estimate's light colour rests on the white-patch assumption (brdf/light_estimation.h:
+    // 0.13 off in chromaticity on the synthetic room): an additive shadow subtracts that tint
+    // and leaves its complement around the pebble; the ratio darkens the desk's own colour.
     if (!options.composite) options.composite = render::CompositeRule::Multiplicative;
   }
   return options;

@@ -92,7 +92,8 @@ struct ReplayOptions {
   std::filesystem::path lights;
   /// The light probe stream the real lights are extracted from every frame (app/probe_input.h):
   /// a folder with probe.txt, a list, an image, a video or a camera; empty: the sequence's own
-  /// probe.txt or probe.hdr. The main job's sample, recorded without one, gets a stand-in.
+  /// probe.txt or probe.hdr; without any, the lights are estimated from the frames (as for the
+  /// main job's sample, recorded without a probe).
   std::string probe;
   ProbeInputOptions probe_input;
   std::vector<std::string> virtual_lights;     ///< x,y,z,intensity[,r,g,b]

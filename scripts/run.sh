@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Installs what is missing, builds the Release binaries and runs the main job on the embedded
 # sample: `relight replay` with no arguments - the shipped glossy pebble stood on the desk of the
-# real TUM slice (its support plane, found in the first frame), lit by 8 lights extracted from
-# the shipped Grace Cathedral probe (a stand-in: the TUM recording has no probe of its own),
+# real TUM slice (its support plane, found in the first frame), lit by 8 lights of the light
+# estimated from the slice's own frames (the TUM recording has no light probe),
 # results in out/replay (or RELIGHT_OUT): frames/*_composite.png before and *_composite_mapped.png
 # after colour mapping, composite.mp4, report.html. Then the same on a short synthetic sequence
 # (`relight synth`, with its own light probe and exact geometry), results in
@@ -25,5 +25,5 @@ glass="$out-glass"
   --object "$root/data/models/metal_bottle.gltf" --place 0.1,-0.3,0.75 --out "$glass"
 glass_tum="$out-glass-tum"
 "$relight" replay --object "$root/data/models/glass_pebble.gltf" --place-on-plane \
-  --probe "$root/data/probes/grace_latlong.hdr" --composite multiplicative --out "$glass_tum"
+  --lights estimate --composite multiplicative --out "$glass_tum"
 echo "Results (open report.html in each): $out, $mixed, $glass, $glass_tum"
