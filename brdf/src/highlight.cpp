@@ -80,6 +80,43 @@ void dilate_disk(const Mask& input, int radius, Mask& output, int threads) {
   });
 }
 
+namespace {
+
+/// Chebyshev (chessboard) distance of every pixel to the nearest pixel outside `mask`, 0 outside
+/// it, `unreachable` where no such pixel is that near: two raster sweeps of the 3 x 3 chamfer
+/// with unit weights, which is exact for this metric.
+std::vector<int> chessboard_distance(const Mask& mask, int unreachable) {
+  const int w = mask.width(), h = mask.height();
+  std::vector<int> d(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  const auto at = [&](int r, int c) -> int& {
+    return d[static_cast<std::size_t>(r) * static_cast<std::size_t>(w) + static_cast<std::size_t>(c)];
+  };
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) {
+      int v = mask(r, c) ? unreachable : 0;
+      if (v != 0) {
+        if (c > 0) v = std::min(v, at(r, c - 1) + 1);
+        if (r > 0) {
+          for (int cc = std::max(0, c - 1); cc <= std::min(w - 1, c + 1); ++cc) v = std::min(v, at(r - 1, cc) + 1);
+        }
+      }
+      at(r, c) = v;
+    }
+  for (int r = h - 1; r >= 0; --r)
+    for (int c = w - 1; c >= 0; --c) {
+      int v = at(r, c);
+      if (v == 0) continue;
+      if (c + 1 < w) v = std::min(v, at(r, c + 1) + 1);
+      if (r + 1 < h) {
+        for (int cc = std::max(0, c - 1); cc <= std::min(w - 1, c + 1); ++cc) v = std::min(v, at(r + 1, cc) + 1);
+      }
+      at(r, c) = std::min(v, unreachable);
+    }
+  return d;
+}
+
+}  // namespace
+
 void remove_highlights(const ColorImage& color, const HighlightOptions& options, ColorImage& cleaned, Mask& mask) {
   const int w = color.width(), h = color.height();
   Mask seeds(w, h);
@@ -88,30 +125,32 @@ void remove_highlights(const ColorImage& color, const HighlightOptions& options,
   });
   dilate_disk(seeds, options.dilate_radius, mask, options.threads);
   cleaned = color;
+  // The ring of the nearest unmasked pixels is the one at their Chebyshev distance: searched
+  // alone, not after every smaller ring (a white desk under an overexposed camera is masked
+  // over whole regions, where searching ring after ring took 30-350 ms a frame at 640x480).
+  const int unreachable = options.fill_radius_max + 1;
+  const std::vector<int> ring_of = chessboard_distance(mask, unreachable);
   parallel_for_each_row(h, options.threads, [&](int r) {
     for (int c = 0; c < w; ++c) {
-      if (!mask(r, c)) continue;
-      for (int ring = 1; ring <= options.fill_radius_max; ++ring) {
-        int best = std::numeric_limits<int>::max();
-        Rgb8 best_color{};
-        const int r0 = std::max(0, r - ring), r1 = std::min(h - 1, r + ring);
-        for (int rr = r0; rr <= r1; ++rr) {
-          const bool edge_row = rr == r - ring || rr == r + ring;
-          const int step = edge_row ? 1 : 2 * ring;
-          for (int cc = c - ring; cc <= c + ring; cc += step) {
-            if (cc < 0 || cc >= w || mask(rr, cc)) continue;
-            const int d2 = (rr - r) * (rr - r) + (cc - c) * (cc - c);
-            if (d2 < best) {
-              best = d2;
-              best_color = color(rr, cc);
-            }
+      const int ring = ring_of[static_cast<std::size_t>(r) * static_cast<std::size_t>(w) + static_cast<std::size_t>(c)];
+      if (ring == 0 || ring >= unreachable) continue;
+      // The nearest unmasked pixel of the ring by Euclidean distance, the first in row-major order on ties.
+      int best = std::numeric_limits<int>::max();
+      Rgb8 best_color{};
+      const int r0 = std::max(0, r - ring), r1 = std::min(h - 1, r + ring);
+      for (int rr = r0; rr <= r1; ++rr) {
+        const bool edge_row = rr == r - ring || rr == r + ring;
+        const int step = edge_row ? 1 : 2 * ring;
+        for (int cc = c - ring; cc <= c + ring; cc += step) {
+          if (cc < 0 || cc >= w || mask(rr, cc)) continue;
+          const int d2 = (rr - r) * (rr - r) + (cc - c) * (cc - c);
+          if (d2 < best) {
+            best = d2;
+            best_color = color(rr, cc);
           }
         }
-        if (best != std::numeric_limits<int>::max()) {
-          cleaned(r, c) = best_color;
-          break;
-        }
       }
+      cleaned(r, c) = best_color;
     }
   });
 }

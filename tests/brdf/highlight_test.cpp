@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 #include "brdf_test_scene.h"
 
@@ -61,6 +63,64 @@ TEST(Highlight, FillTakesTheNearestUnmaskedColour) {
   EXPECT_EQ(cleaned(5, 15), (Rgb8{0, 0, 200}));  // nearest unmasked: (5, 16)
   EXPECT_EQ(cleaned(5, 5), (Rgb8{200, 0, 0}));   // (5, 4) is unmasked
   for (const Rgb8 c : cleaned.pixels()) EXPECT_NE(c, (Rgb8{255, 255, 255}));
+}
+
+// The fill's rule (highlight.h step 4) searched ring by ring, as written: the first Chebyshev
+// ring around (r, c) that holds an unmasked pixel, its nearest by Euclidean distance, the first
+// in row-major order on ties; beyond `radius` the pixel keeps its colour.
+Rgb8 fill_by_rule(const ColorImage& color, const Mask& mask, int r, int c, int radius) {
+  for (int ring = 1; ring <= radius; ++ring) {
+    int best = -1;
+    Rgb8 best_color{};
+    for (int rr = r - ring; rr <= r + ring; ++rr)
+      for (int cc = c - ring; cc <= c + ring; ++cc) {
+        if (std::max(std::abs(rr - r), std::abs(cc - c)) != ring || rr < 0 || cc < 0 || rr >= color.height() ||
+            cc >= color.width() || mask(rr, cc))
+          continue;
+        const int d2 = (rr - r) * (rr - r) + (cc - c) * (cc - c);
+        if (best < 0 || d2 < best) {
+          best = d2;
+          best_color = color(rr, cc);
+        }
+      }
+    if (best >= 0) return best_color;
+  }
+  return color(r, c);
+}
+
+// Large white regions (an overexposed white desk is masked over whole regions, far from any
+// unmasked pixel): every masked pixel takes the colour the rule gives, up to the search radius
+// and beyond it.
+TEST(Highlight, FillOfLargeRegionsFollowsTheRingRule) {
+  ColorImage image(96, 64);
+  for (int r = 0; r < 64; ++r)
+    for (int c = 0; c < 96; ++c)
+      image(r, c) = {static_cast<std::uint8_t>(40 + c), static_cast<std::uint8_t>(30 + 2 * r),
+                     static_cast<std::uint8_t>((7 * r + 13 * c) % 200)};
+  for (int r = 6; r < 58; ++r)  // a white 52 x 60 block, an L-shaped one at the right edge
+    for (int c = 10; c < 70; ++c) image(r, c) = {250, 250, 248};
+  for (int r = 0; r < 64; ++r)
+    for (int c = 80; c < 96; ++c)
+      if (r < 20 || c > 88) image(r, c) = {255, 255, 255};
+  HighlightOptions options;
+  options.fill_radius_max = 20;  // the block's centre is 26 px from its edge: kept
+  ColorImage cleaned;
+  Mask mask;
+  remove_highlights(image, options, cleaned, mask);
+  int masked = 0, kept = 0;
+  for (int r = 0; r < 64; ++r)
+    for (int c = 0; c < 96; ++c) {
+      if (!mask(r, c)) {
+        EXPECT_EQ(cleaned(r, c), image(r, c));
+        continue;
+      }
+      ++masked;
+      const Rgb8 expected = fill_by_rule(image, mask, r, c, options.fill_radius_max);
+      kept += expected == image(r, c);
+      ASSERT_EQ(cleaned(r, c), expected) << r << "," << c;
+    }
+  EXPECT_GT(masked, 3000);
+  EXPECT_GT(kept, 50) << "pixels beyond the search radius keep their colour";
 }
 
 TEST(Highlight, SyntheticSceneHighlightsAreMaskedAndMatteColoursAreNot) {
