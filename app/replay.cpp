@@ -419,9 +419,8 @@ ReplayOptions with_main_job_defaults(ReplayOptions options) {
   options.objects = {data_folder() / "models" / "glossy_pebble.gltf"};
   options.places_on_plane = {""};
   // The sample was recorded without a light probe: its light is estimated from its frames
-  // (real_light_source()'s fallback), and quietly so - the main job needs no options.
+  // (real_light_source()'s fallback, which says so on stderr and in report.json).
   if (options.lights.empty() && options.probe.empty()) {
-    options.lights = kEstimateLights;
     // The estimate's light colour rests on the white-patch assumption (brdf/light_estimation.h:
     // 0.13 off in chromaticity on the synthetic room): an additive shadow subtracts that tint
     // and leaves its complement around the pebble; the ratio darkens the desk's own colour.

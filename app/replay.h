@@ -45,8 +45,6 @@ inline constexpr std::array<NamedValue<GeometryMethod>, 2> kGeometryMethodNames{
 enum class Method2Normals { Filtered, Plain };
 inline constexpr std::array<NamedValue<Method2Normals>, 2> kMethod2NormalsNames{
     {{"filtered", Method2Normals::Filtered}, {"plain", Method2Normals::Plain}}};
-/// The k_d real surfaces are rendered with: each camera pixel's own estimate (render/dir/camera_albedo.h)
-/// or its material cluster's.
 /// Which frames get the per-frame pictures of the pipeline's inner buffers (depth, smoothed and
 /// filtered depth, normals, the BRDF estimation's mosaic): the frames report.html shows, or
 /// every frame. The camera image and the composites are written for every frame either way.
@@ -54,6 +52,8 @@ enum class PreviewFrames { Shown, Every };
 inline constexpr std::array<NamedValue<PreviewFrames>, 2> kPreviewFramesNames{
     {{"shown", PreviewFrames::Shown}, {"every", PreviewFrames::Every}}};
 
+/// The k_d real surfaces are rendered with: each camera pixel's own estimate (render/dir/camera_albedo.h)
+/// or its material cluster's.
 enum class RealAlbedo { Pixel, Cluster };
 inline constexpr std::array<NamedValue<RealAlbedo>, 2> kRealAlbedoNames{
     {{"pixel", RealAlbedo::Pixel}, {"cluster", RealAlbedo::Cluster}}};

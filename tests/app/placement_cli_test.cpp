@@ -76,7 +76,8 @@ int changed_pixels_near(const std::filesystem::path& frames, const std::string& 
 
 // The main job: `relight replay` with no arguments stands the shipped pebble on the desk of the
 // embedded sample (its dominant support plane, at the free spot nearest the image centre), lit
-// by the shipped probe, and writes the composites and the video.
+// by the light estimated from the sample's own frames (it has no probe), and writes the
+// composites and the video.
 TEST(ReplayPlacement, TheMainJobStandsThePebbleOnTheSamplesDesk) {
   test::TempDir dir;
   const auto out = dir.path() / "main";
@@ -84,6 +85,11 @@ TEST(ReplayPlacement, TheMainJobStandsThePebbleOnTheSamplesDesk) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_TRUE(result.err.empty()) << result.err;
   EXPECT_TRUE(std::filesystem::exists(out / "composite.mp4"));
+  const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
+  ASSERT_TRUE(report.contains("light_estimate")) << report.dump();
+  EXPECT_NE(report["light_estimate"].value("chosen", "").find("has no light probe"), std::string::npos)
+      << report["light_estimate"].dump();
+  EXPECT_EQ(report["composite"]["rule"], "multiplicative");
   const auto placement = placement_of(out);
   EXPECT_EQ(placement["placement"], "support_plane");
   EXPECT_EQ(placement["frame"], 0);
