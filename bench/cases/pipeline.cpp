@@ -28,6 +28,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 
 #include "bench.h"
 #include "relight/synth/sequence.h"
@@ -149,22 +150,38 @@ bench::Json compare_replays(app::ReplayPipeline& ours, app::ReplayPipeline& base
   return result;
 }
 
+/// The replay pipeline of `replay`, compiled.
+app::ReplayPipeline compiled_pipeline(const app::ReplayOptions& replay) {
+  auto pipeline = app::build_replay_pipeline(app::open_replay_source(replay), replay);
+  pipeline.graph->compile();
+  return pipeline;
+}
+
+/// The replay of `sequence` that `configure` sets up, with its coarse copy of the reconstruction
+/// (ours, into folder/ours) against the same without it (exact_replay, into folder/exact).
+bench::Json against_exact_replay(const std::filesystem::path& sequence, const std::filesystem::path& folder, int frames,
+                                 const std::string& case_name,
+                                 const std::function<void(app::ReplayOptions&)>& configure) {
+  const auto build = [&](const std::string& name, int coarse_mesh_stride) {
+    app::ReplayOptions replay = replay_options(sequence, folder / name);
+    configure(replay);
+    replay.coarse_mesh_stride = coarse_mesh_stride;
+    return compiled_pipeline(replay);
+  };
+  auto ours = build("ours", app::ReplayOptions{}.coarse_mesh_stride);
+  auto exact = build("exact", 1);
+  return compare_replays(ours, exact, frames, case_name, "exact_replay");
+}
+
 bench::Json replay_640x480(const bench::Options& options) {
   TempFolder folder;
   const int frames = std::max(options.repetitions, 3);
   write_sequence(folder.path / "sequence", frames + 2);
-  const auto build = [&](const std::string& name, int coarse_mesh_stride) {
-    app::ReplayOptions replay = replay_options(folder.path / "sequence", folder.path / name);
-    replay.objects = {app::data_folder() / "models" / "glossy_pebble.gltf"};
-    replay.vpls = 64;
-    replay.coarse_mesh_stride = coarse_mesh_stride;
-    auto pipeline = app::build_replay_pipeline(app::open_replay_source(replay), replay);
-    pipeline.graph->compile();
-    return pipeline;
-  };
-  auto ours = build("ours", app::ReplayOptions{}.coarse_mesh_stride);
-  auto exact = build("exact", 1);
-  bench::Json result = compare_replays(ours, exact, frames, "pipeline/replay_640x480", "exact_replay");
+  bench::Json result = against_exact_replay(folder.path / "sequence", folder.path, frames, "pipeline/replay_640x480",
+                                            [](app::ReplayOptions& replay) {
+                                              replay.objects = {app::data_folder() / "models" / "glossy_pebble.gltf"};
+                                              replay.vpls = 64;
+                                            });
   result["goal_fps"] = 5;
   return result;
 }
@@ -172,18 +189,11 @@ bench::Json replay_640x480(const bench::Options& options) {
 bench::Json replay_tum_640x480(const bench::Options& options) {
   TempFolder folder;
   const int frames = std::max(options.repetitions, 3);
-  const auto build = [&](const std::string& name, int coarse_mesh_stride) {
-    app::ReplayOptions replay = replay_options({}, folder.path / name);  // empty: the embedded sample
-    replay.quiet = true;
-    replay.loops = (frames + 1 + 3) / 4;  // the sample's 4 frames, looped
-    replay.coarse_mesh_stride = coarse_mesh_stride;
-    auto pipeline = app::build_replay_pipeline(app::open_replay_source(replay), replay);
-    pipeline.graph->compile();
-    return pipeline;
-  };
-  auto ours = build("ours", app::ReplayOptions{}.coarse_mesh_stride);
-  auto exact = build("exact", 1);
-  bench::Json result = compare_replays(ours, exact, frames, "pipeline/replay_tum_640x480", "exact_replay");
+  // An empty sequence is the embedded sample: the main job.
+  bench::Json result = against_exact_replay({}, folder.path, frames, "pipeline/replay_tum_640x480",
+                                            [frames](app::ReplayOptions& replay) {
+                                              replay.loops = (frames + 1 + 3) / 4;  // its 4 frames, looped
+                                            });
   result["sequence"] = "data/tum_fr1_rpy (real, looped)";
   result["goal_fps"] = 5;
   return result;
@@ -194,9 +204,8 @@ bench::Json replay_640x480_no_render(const bench::Options& options) {
   write_sequence(folder.path / "sequence", std::max(options.repetitions, 3) + 1);
   app::ReplayOptions replay = replay_options(folder.path / "sequence", folder.path / "out");
   replay.no_object = true;
-  auto pipeline = app::build_replay_pipeline(app::open_replay_source(replay), replay);
+  auto pipeline = compiled_pipeline(replay);
   FrameGraph& graph = *pipeline.graph;
-  graph.compile();
   if (!graph.run_frame()) throw Error("pipeline/replay_640x480_no_render: the sequence has no frames");
   const auto start = std::chrono::steady_clock::now();
   while (graph.run_frame()) {
@@ -228,9 +237,7 @@ bench::Json replay_gpu(const bench::Options& options, int width, int height, dou
     replay.backend = backend;
     replay.write_frames = false;
     replay.video = false;
-    auto pipeline = app::build_replay_pipeline(app::open_replay_source(replay), replay);
-    pipeline.graph->compile();
-    return pipeline;
+    return compiled_pipeline(replay);
   };
   auto gpu = build("gpu", vk::BackendPolicy::Auto);
   auto cpu = build("cpu", vk::BackendPolicy::ForceCpu);

@@ -110,7 +110,7 @@ std::vector<int> chessboard_distance(const Mask& mask, int unreachable) {
       if (r + 1 < h) {
         for (int cc = std::max(0, c - 1); cc <= std::min(w - 1, c + 1); ++cc) v = std::min(v, at(r + 1, cc) + 1);
       }
-      at(r, c) = std::min(v, unreachable);
+      at(r, c) = v;
     }
   return d;
 }
