@@ -261,7 +261,7 @@ void DirRenderStage::run(StageContext& context) {
     // The GPU time of the steps that ran on the device (timestamps; none on devices without them).
     const DirVkTimings& t = renderer_->last_timings();
     const double gpu_ms =
-        t.gbuffer_ms + t.shadow_maps_ms + t.ism_ms + (t.cpu_shading ? 0.0 : t.shading_ms + t.merge_ms);
+        t.gbuffer_ms + t.shadow_maps_ms + (t.cpu_shading ? 0.0 : t.ism_ms + t.shading_ms + t.merge_ms);
     if (gpu_ms > 0.0) context.report_device_ms(gpu_ms);
   }
   if (edge_samples_ > 0 && scene.triangle_count(false) > 0) {

@@ -15,6 +15,7 @@
 //
 // One pass vs two: `output` lets the same renderer produce only L_rv or only L_r, which is what
 // a renderer without the differential formulation has to do twice (bench dir/one_vs_two_pass).
+#include <future>
 #include <memory>
 #include <span>
 #include <vector>
@@ -62,8 +63,9 @@ class DirRendererVk {
 
  private:
   [[nodiscard]] DifferentialImages download_images() const;
+  struct TimedIsmAtlas;  ///< the CPU's ISM atlas and the milliseconds it took
   [[nodiscard]] DifferentialImages shade_on_cpu(const MrCamera& camera, std::span<const Vpl> vpls,
-                                                const DirRenderOptions& options);
+                                                std::future<TimedIsmAtlas>& ism, const DirRenderOptions& options);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
