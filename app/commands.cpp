@@ -248,9 +248,10 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
 void add_frame_options(CLI::App& command, ReplayOptions& options) {
   command.add_flag("!--no-frames", options.write_frames, "Do not write per-frame images");
   add_choice_option(command, "--previews", options.previews, kPreviewFramesNames,
-                    "Frames whose inner buffers (depth, smoothed depth, normals, the BRDF estimation's mosaic) are "
-                    "written as pictures: shown (the frames report.html shows) or every frame; the camera image and "
-                    "the composites are written for every frame");
+                    "Frames whose inner buffers (depth, smoothed depth, normals, the BRDF estimation's mosaic, and "
+                    "the composite before colour mapping when there is a mapped one) are made and written as "
+                    "pictures: shown (the frames report.html shows) or every frame; the camera image and the final "
+                    "composite are written for every frame");
 }
 
 void add_view_options(CLI::App& command, ReplayOptions& options) {

@@ -161,7 +161,9 @@ BufferName<ColorImage> add_color_mapping(ReplayPipeline& pipeline, const ReplayO
 
 /// The lights, the BRDF stages (real materials) and the DIR stage with its outputs, when the
 /// options ask for any virtual content.
-void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel) {
+/// `shown`: the frames report.html shows.
+void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& options, Backend per_pixel,
+                                const FrameFilter& shown) {
   check_real_places(options.real_objects, options.real_places);
   if (options.objects.empty() && options.virtual_lights.empty() && options.virtual_spots.empty()) {
     if (!options.real_objects.empty())
@@ -241,6 +243,12 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   look.artefacts = colormap::parse_camera_artefacts(options.camera_artefacts);
   look.exposure_time_s = options.exposure_time_s;
   dir.camera_look = look;
+  // Where a colour-mapped composite is the final picture, the plain one is an intermediate like
+  // the other previews (--previews): the report's frames only, unless the live view shows it.
+  const bool view_shows_plain = options.view && options.view_side == PreviewBuffer{kComposite};
+  if (options.colormap != colormap::ColorMapMethod::None && options.previews == PreviewFrames::Shown &&
+      !view_shows_plain)
+    dir.composite_frames = shown;
   dir.composite = options.composite.value_or(render::CompositeRule::Additive);
   pipeline.composite_rule = dir.composite;
   dir.environment = options.environment;
@@ -458,14 +466,14 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<capture::FrameSource> sourc
   graph.keep(kNormals);
   graph.keep(kPositions);
   add_camera_pose(pipeline, options);
-  add_differential_rendering(pipeline, options, per_pixel);
-  pipeline.latency =
-      &graph.emplace<LatencyStage>(pipeline.renders ? std::optional(pipeline.final_composite) : std::nullopt);
-  if (options.view) add_view(pipeline, options, method2);
   // The frames report.html shows: the inner buffers' pictures by default (--previews).
   const FrameFilter shown = [total_frames](std::int64_t frame) {
     return contact_sheet_row(frame, total_frames, kContactSheetRows).has_value();
   };
+  add_differential_rendering(pipeline, options, per_pixel, shown);
+  pipeline.latency =
+      &graph.emplace<LatencyStage>(pipeline.renders ? std::optional(pipeline.final_composite) : std::nullopt);
+  if (options.view) add_view(pipeline, options, method2);
   const bool every_preview = options.write_frames && options.previews == PreviewFrames::Every;
   const FrameFilter previewed = every_preview ? FrameFilter{} : shown;
   if (options.write_frames) {
@@ -476,8 +484,12 @@ ReplayPipeline build_replay_pipeline(std::unique_ptr<capture::FrameSource> sourc
     if (method2) writer->add(kDepthFiltered, previewed);
     writer->add(kNormals, previewed);
     if (pipeline.renders) {
-      writer->add(kComposite);
-      if (pipeline.final_composite != kComposite) writer->add(pipeline.final_composite);
+      if (pipeline.final_composite != kComposite) {
+        writer->add(kComposite, previewed);  // an intermediate then (add_differential_rendering)
+        writer->add(pipeline.final_composite);
+      } else {
+        writer->add(kComposite);
+      }
       writer->add(kBrdfPreview, previewed);
     }
     if (pipeline.renders && options.write_buffers) {

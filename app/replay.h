@@ -46,8 +46,9 @@ enum class Method2Normals { Filtered, Plain };
 inline constexpr std::array<NamedValue<Method2Normals>, 2> kMethod2NormalsNames{
     {{"filtered", Method2Normals::Filtered}, {"plain", Method2Normals::Plain}}};
 /// Which frames get the per-frame pictures of the pipeline's inner buffers (depth, smoothed and
-/// filtered depth, normals, the BRDF estimation's mosaic): the frames report.html shows, or
-/// every frame. The camera image and the composites are written for every frame either way.
+/// filtered depth, normals, the BRDF estimation's mosaic, and the composite before colour mapping
+/// when a colour-mapped one is the final picture): the frames report.html shows, or every frame.
+/// The camera image and the final composite are written for every frame either way.
 enum class PreviewFrames { Shown, Every };
 inline constexpr std::array<NamedValue<PreviewFrames>, 2> kPreviewFramesNames{
     {{"shown", PreviewFrames::Shown}, {"every", PreviewFrames::Every}}};

@@ -33,7 +33,7 @@ TEST(DeviceRobustness, NoVulkanDriverRendersOnTheCpuWithOneWarning) {
   expect_clean_success(outcome, out);
   EXPECT_EQ(count_lines(outcome.err), 1u) << outcome.err;
   EXPECT_EQ(outcome.err.rfind("relight: warning: no usable Vulkan device, using the CPU path", 0), 0u) << outcome.err;
-  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000001_composite.png"));
+  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000001_composite_mapped.png"));
   EXPECT_TRUE(std::filesystem::exists(out / "composite.mp4"));
 }
 
@@ -63,8 +63,8 @@ TEST(DeviceRobustness, GpuLostDuringReplay) {
   expect_clean_error(outcome, 1, "the Vulkan device was lost during frame 1 (", out);
   EXPECT_NE(outcome.err.find("VK_ERROR_DEVICE_LOST"), std::string::npos) << outcome.err;
   EXPECT_NE(outcome.err.find("the outputs hold frame 0; --cpu runs without the GPU"), std::string::npos) << outcome.err;
-  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000000_composite.png"));
-  EXPECT_FALSE(std::filesystem::exists(out / "frames" / "000001_composite.png"));
+  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000000_composite_mapped.png"));
+  EXPECT_FALSE(std::filesystem::exists(out / "frames" / "000001_composite_mapped.png"));
   EXPECT_TRUE(std::filesystem::exists(out / "composite.mp4"));
   const auto report = read_report(out);
   EXPECT_EQ(report["frames"].get<int>(), 1);
@@ -77,7 +77,7 @@ TEST(DeviceRobustness, GpuLostDuringLive) {
   const auto out = dir.path() / "out";
   const auto outcome = run_with_device_lost_at({"live", "--quiet", "--device", kDevice, "--frames", "5"}, 2, out);
   expect_clean_error(outcome, 1, "the Vulkan device was lost during frame 2 (", out);
-  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000001_composite.png"));
+  EXPECT_TRUE(std::filesystem::exists(out / "frames" / "000001_composite_mapped.png"));
   const auto report = read_report(out);
   EXPECT_EQ(report["frames"].get<int>(), 2);
 }

@@ -53,7 +53,7 @@ TEST(ReplayRunRobustness, CtrlCDuringReplayWithRendering) {
   BoundedRun replay;
   replay.arguments = {"replay", "--quiet", sequence.string(), "--object", (kData / "models" / "glossy_pebble.gltf").string(),
                       "--vpls", "8", "--out", out.string()};
-  replay.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_composite.png"); };
+  replay.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_composite_mapped.png"); };
   const auto run = run_relight(replay);
   expect_interrupted_replay(run, out, 200);
   EXPECT_TRUE(std::filesystem::exists(out / "composite.mp4"));
@@ -79,7 +79,7 @@ TEST(ReplayRunRobustness, CtrlCDuringReplayWithAProbeStreamAndOdometry) {
                       "8",
                       "--out",
                       out.string()};
-  replay.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_composite.png"); };
+  replay.interrupt_when = [&] { return std::filesystem::exists(out / "frames" / "000001_composite_mapped.png"); };
   const auto run = run_relight(replay);
   expect_interrupted_replay(run, out, 200);
   EXPECT_TRUE(std::filesystem::exists(out / "composite.mp4"));

@@ -59,7 +59,7 @@ DirStages add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* 
   const bool camera_look = options.camera_look && options.camera_look->artefacts.any();
   if (camera_look) stages.camera_look = &graph.emplace<CameraLookStage>(*options.camera_look);
   stages.tone_map = &graph.emplace<colormap::ToneMapStage>(options.tone_map);
-  graph.emplace<DifferentialCompositeStage>(camera_look, options.composite);
+  graph.emplace<DifferentialCompositeStage>(camera_look, options.composite, options.composite_frames);
   return stages;
 }
 
@@ -318,6 +318,10 @@ void DifferentialCompositeStage::declare(StageBuilder& builder) {
 }
 
 void DifferentialCompositeStage::run(StageContext& context) {
+  if (frames_ && !frames_(context.frame_index())) {
+    context.get(composite_) = ColorImage{};
+    return;
+  }
   const ColorImage& color = context.get(color_);
   const RadianceImage& real_virtual = context.get(real_virtual_);
   if (color.width() != real_virtual.width() || color.height() != real_virtual.height())

@@ -48,7 +48,8 @@
 //                                   "specular_back_projection", colormap::ToneMap
 //                                   "tone_map"; with `camera_look` also
 //                                   colormap::CameraLook "camera_look" (camera_look_stage.h)
-//                            writes ColorImage "composite" (composite.h, eq. 5.1)
+//                            writes ColorImage "composite" (composite.h, eq. 5.1; empty on the frames
+//                                   DirStageOptions::composite_frames leaves out)
 //
 // With a Vulkan context `dir` renders with DirRendererVk (made on the first frame, remade when
 // the frame size changes); without one, with render_dir_cpu() (same algorithm, much slower).
@@ -58,6 +59,8 @@
 // the differential adds TM(L_rv) - TM(L_r) to the camera image, so a virtual shadow computed
 // with a grey albedo on a brown table subtracts grey and tints the shadow orange.
 #include <array>
+#include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -148,6 +151,11 @@ struct DirStageOptions {
   /// The camera's look on the virtual layer (camera_look_stage.h): with any artefact on, a
   /// camera_look stage, and the composite reads it; none (or no artefact): the sharp render.
   std::optional<CameraLookOptions> camera_look;
+  /// The frames whose plain composite ("composite") is computed; empty: every frame. The others
+  /// get an empty image: where a colour-mapped composite is the final picture, the plain one is
+  /// an intermediate that the report shows on a few frames, and its camera look (the motion blur
+  /// over the whole differential layer) costs as much as the final one's on real input.
+  std::function<bool(std::int64_t)> composite_frames;
 };
 
 /// What the stages add to every frame's real geometry.
@@ -303,8 +311,11 @@ class IndirectSmoothingStage final : public Stage {
 class DifferentialCompositeStage final : public Stage {
  public:
   /// With `camera_look`, also reads colormap::CameraLook "camera_look" (camera_look_stage.h).
-  explicit DifferentialCompositeStage(bool camera_look = false, CompositeRule rule = CompositeRule::Additive)
-      : camera_look_(camera_look), rule_(rule) {}
+  /// `frames`: the frames it computes the composite for (empty: every frame); the others get an
+  /// empty image.
+  explicit DifferentialCompositeStage(bool camera_look = false, CompositeRule rule = CompositeRule::Additive,
+                                      std::function<bool(std::int64_t)> frames = {})
+      : camera_look_(camera_look), rule_(rule), frames_(std::move(frames)) {}
   [[nodiscard]] std::string name() const override { return "differential_composite"; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
@@ -312,6 +323,7 @@ class DifferentialCompositeStage final : public Stage {
  private:
   bool camera_look_;
   CompositeRule rule_;
+  std::function<bool(std::int64_t)> frames_;
   Read<colormap::ToneMap> tone_map_;
   Read<ColorImage> color_;
   Read<RadianceImage> real_virtual_;
