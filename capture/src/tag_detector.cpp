@@ -36,9 +36,13 @@ TagDetector::TagDetector(const TagDetectorOptions& options)
   apriltag_detector_add_family_bits(library_->detector.get(), library_->family.get(),
                                     std::clamp(options.max_hamming, 0, 2));
   library_->detector->quad_decimate = options.decimate;
-  library_->detector->nthreads =
-      options.threads > 0 ? options.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  library_->detector->nthreads = options.threads > 0 ? options.threads : default_tag_detector_threads();
   library_->detector->refine_edges = options.refine_edges;
+}
+
+int default_tag_detector_threads() {
+  const unsigned hardware = std::thread::hardware_concurrency();
+  return hardware <= 2 ? 1 : static_cast<int>(hardware);
 }
 
 TagDetector::~TagDetector() = default;

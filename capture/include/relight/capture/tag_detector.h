@@ -24,8 +24,8 @@ struct TagDetection {
 
 struct TagDetectorOptions {
   float decimate = 1.0f;      ///< quad_decimate: 2 is faster and less precise on small tags
-  /// apriltag's worker threads; 0: one per hardware thread (the detections do not depend on it:
-  /// they are sorted by id and position).
+  /// apriltag's worker threads; 0: default_tag_detector_threads() (the detections do not depend on
+  /// it: they are sorted by id and position).
   int threads = 0;
   bool refine_edges = true;
   int max_hamming = 1;        ///< detections with more corrected bits are dropped
@@ -49,6 +49,11 @@ class TagDetector {
   std::unique_ptr<Library> library_;
   TagDetectorOptions options_;
 };
+
+/// One per hardware thread, but one on a machine with two or fewer: there apriltag's worker pool
+/// costs more than it shares (bench apriltag/detect_640x480 on two cores: 4.2-4.3 ms on two
+/// threads, 3.3-3.4 on one; the replay's tag_detection stage 9.3-10.3 ms against 6.7-8.2).
+[[nodiscard]] int default_tag_detector_threads();
 
 /// Rec. 601 luma of an sRGB image, as 8-bit grey.
 [[nodiscard]] Image<std::uint8_t> to_grey(const ColorImage& image);
