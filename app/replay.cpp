@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <functional>
 #include <iostream>
+#include <optional>
 
 #include "as_rendered_composite_stage.h"
 #include "camera_trajectory_stage.h"
@@ -266,6 +267,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   pipeline.camera_look = stages.camera_look;
   pipeline.tone_map = stages.tone_map;
   pipeline.vpls = stages.vpls;
+  pipeline.dir = stages.dir;
   graph.keep(kComposite);
   pipeline.final_composite = add_color_mapping(pipeline, options, per_pixel, look.artefacts.any());
   if (options.video) graph.emplace<VideoWriterStage>(options.out / "composite.mp4", pipeline.final_composite);
@@ -381,6 +383,27 @@ nlohmann::ordered_json vpl_json(const render::VplStage& stage) {
 
 }  // namespace
 
+std::optional<nlohmann::ordered_json> dir_steps_json(const render::DirRenderStage& stage) {
+  const std::vector<render::DirVkTimings>& frames = stage.step_timings();
+  if (frames.empty()) return std::nullopt;
+  const auto median = [&](double render::DirVkTimings::*step) {
+    std::vector<double> values;
+    for (const render::DirVkTimings& t : frames) values.push_back(t.*step);
+    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+  };
+  nlohmann::ordered_json steps{{"gbuffer", median(&render::DirVkTimings::gbuffer_ms)},
+                               {"shadow_maps", median(&render::DirVkTimings::shadow_maps_ms)},
+                               {"ism", median(&render::DirVkTimings::ism_ms)},
+                               {"shading", median(&render::DirVkTimings::shading_ms)}};
+  if (!frames.back().cpu_shading) steps["merge"] = median(&render::DirVkTimings::merge_ms);
+  if (frames.back().specular_ms > 0.0) steps["specular"] = median(&render::DirVkTimings::specular_ms);
+  return nlohmann::ordered_json{{"frames", frames.size()},
+                                {"shading_on", frames.back().cpu_shading ? "cpu" : "device"},
+                                {"median_ms", std::move(steps)}};
+}
+
 void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline& pipeline,
                             const ReplayOptions& options) {
   if (pipeline.view) report["view"] = {{"drawn", pipeline.view->drawn()}, {"skipped", pipeline.view->skipped()}};
@@ -408,6 +431,9 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
     report["composite"] = {{"rule", name_of(render::kCompositeRuleNames, pipeline.composite_rule)}};
   }
   if (pipeline.vpls) report["vpls"] = vpl_json(*pipeline.vpls);
+  if (pipeline.dir) {
+    if (auto steps = dir_steps_json(*pipeline.dir)) report["dir_steps"] = std::move(*steps);
+  }
   if (pipeline.camera_look) report["camera_look"] = camera_look_json(pipeline.camera_look->summary());
   if (pipeline.tone_map) report["tone_map"] = tone_map_json(pipeline.tone_map->options(), pipeline.tone_map->last());
   report["latency_ms"] = pipeline.latency->summary();

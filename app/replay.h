@@ -163,6 +163,7 @@ struct ReplayPipeline {
   render::CameraLookStage* camera_look = nullptr;          ///< set with --camera-artefacts other than none
   colormap::ToneMapStage* tone_map = nullptr;              ///< set when the DIR stage is in the graph
   render::VplStage* vpls = nullptr;                        ///< set when the DIR stage is in the graph
+  const render::DirRenderStage* dir = nullptr;             ///< likewise (report.json's dir_steps)
   app::ViewStage* view_stage = nullptr;           ///< with --view
   bool renders = false;                           ///< the DIR stage is in the graph
   int extracted_lights = 0;                       ///< lights extracted per frame (probe or estimate); 0: none
@@ -193,6 +194,12 @@ struct ReplayPipeline {
 /// (with its no-tag warning on stderr), tracking, latency, and where each object was placed
 /// (also on stderr unless quiet).
 void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline& pipeline, const ReplayOptions& options);
+
+/// Where the dir stage's time went, per step (report.json's dir_steps): the medians over the
+/// frames of DirRenderStage::step_timings, the G-buffer's and shadow maps' from the device's
+/// timestamps; on a CPU device the ISMs are splatted while the device rasterises, so the steps
+/// can add up to more than the stage. None on the CPU backend.
+[[nodiscard]] std::optional<nlohmann::ordered_json> dir_steps_json(const render::DirRenderStage& stage);
 
 /// Runs the whole replay; returns the process exit code. Throws relight::Error on bad input.
 int run_replay(const ReplayOptions& options);

@@ -146,6 +146,8 @@ bench::Json compare_replays(app::ReplayPipeline& ours, app::ReplayPipeline& base
   result["compute"] = ours.compute;
   result["stages_ms"] = stage_medians(*ours.graph);
   result["stages_cpu_ms"] = stage_medians(*ours.graph, &StageTimings::cpu_ms);
+  if (const auto steps = ours.dir ? app::dir_steps_json(*ours.dir) : std::nullopt)
+    result["dir_steps_ms"] = (*steps)["median_ms"];
   result["baseline_stages_ms"] = stage_medians(*baseline.graph);
   return result;
 }

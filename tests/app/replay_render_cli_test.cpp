@@ -64,6 +64,15 @@ TEST(ReplayRenderCli, WritesCompositesVideoAndBuffers) {
   EXPECT_FALSE(std::filesystem::exists(out / "composite.partial.mp4"));
   const auto report = nlohmann::json::parse(read_text_file(out / "report.json"));
   EXPECT_NE(report.dump().find("\"dir\""), std::string::npos) << "the DIR stage is timed";
+  // And where its time goes: every frame's steps, the rasterising ones on the device.
+  const auto& steps = report["dir_steps"];
+  ASSERT_TRUE(steps.is_object()) << report.dump();
+  EXPECT_EQ(steps["frames"], report["frames"]);
+  // On a CPU device (lavapipe) the shading runs on the CPU (DirBackend::Auto).
+  const bool cpu_device = report["compute"].get<std::string>().find("llvmpipe") != std::string::npos;
+  EXPECT_EQ(steps["shading_on"], cpu_device ? "cpu" : "device");
+  for (const char* step : {"gbuffer", "shadow_maps", "ism", "shading"})
+    EXPECT_GT(steps["median_ms"][step].get<double>(), 0.0) << step;
 }
 
 // Also runs two VPL bounces by the point-cone method, which this scene exercises nowhere else.

@@ -54,7 +54,7 @@ DirStages add_dir_stages(FrameGraph& graph, Backend backend, vk::VulkanContext* 
   DirStages stages;
   graph.emplace<MrSceneStage>(std::move(content), options);
   stages.vpls = &graph.emplace<VplStage>(options.vpls, context);
-  graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffers, options.edge_samples);
+  stages.dir = &graph.emplace<DirRenderStage>(context, options.renderer, options.albedo_buffers, options.edge_samples);
   graph.emplace<IndirectSmoothingStage>(options.temporal_smoothing, options.temporal);
   const bool camera_look = options.camera_look && options.camera_look->artefacts.any();
   if (camera_look) stages.camera_look = &graph.emplace<CameraLookStage>(*options.camera_look);
@@ -260,6 +260,7 @@ void DirRenderStage::run(StageContext& context) {
     back_projection = renderer_->last_back_projection();
     // The GPU time of the steps that ran on the device (timestamps; none on devices without them).
     const DirVkTimings& t = renderer_->last_timings();
+    step_timings_.push_back(t);
     const double gpu_ms =
         t.gbuffer_ms + t.shadow_maps_ms + (t.cpu_shading ? 0.0 : t.ism_ms + t.shading_ms + t.merge_ms);
     if (gpu_ms > 0.0) context.report_device_ms(gpu_ms);

@@ -167,9 +167,12 @@ struct DirSceneContent {
   std::vector<std::pair<VirtualModel, Placement>> real_objects{};
 };
 
+class DirRenderStage;
+
 /// The stages of add_dir_stages whose summaries the report shows.
 struct DirStages {
   VplStage* vpls = nullptr;
+  DirRenderStage* dir = nullptr;
   CameraLookStage* camera_look = nullptr;  ///< none without DirStageOptions::camera_look
   colormap::ToneMapStage* tone_map = nullptr;
 };
@@ -265,11 +268,16 @@ class DirRenderStage final : public Stage {
   [[nodiscard]] Backend backend() const override { return context_ ? Backend::Vulkan : Backend::Cpu; }
   void declare(StageBuilder& builder) override;
   void run(StageContext& context) override;
+  /// The steps of every frame rendered through DirRendererVk, in order (empty on the CPU
+  /// backend): the device's G-buffer and shadow maps (timestamps), and the ISMs, shading and
+  /// merge wherever they ran (report.json's dir_steps).
+  [[nodiscard]] const std::vector<DirVkTimings>& step_timings() const { return step_timings_; }
 
  private:
   vk::VulkanContext* context_;
   DirRenderOptions options_;
   std::optional<RealAlbedoBuffers> albedo_buffers_;
+  std::vector<DirVkTimings> step_timings_;
   int edge_samples_;
   std::unique_ptr<DirRendererVk> renderer_;
   std::pair<int, int> renderer_size_{0, 0};
