@@ -148,6 +148,13 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
                     "How the real directional lights (a probe's, an estimate's) light the scene: directional (the "
                     "direct pass, two shadow maps each) or vpls (Knecht 2010: one emitter VPL each, shadowed by its "
                     "imperfect shadow map like the other VPLs; far cheaper per light, softer shadows)");
+  command
+      .add_option("--merge-lights", options.merge_lights_degrees,
+                  "Real directional lights (a probe's, an estimate's, a lights file's) within this many degrees of "
+                  "each other light the scene as one, with their summed power: the samples a probe's brightest "
+                  "source gets cast one shadow, at the cost of one light's two shadow maps (0: every light)")
+      ->check(CLI::Range(0.0, 90.0))
+      ->capture_default_str();
   add_choice_option(command, "--vpl-budget", options.vpl_budget, render::kVplBudgetNames,
                     "How the VPL samples are shared among the lights: equal, power (emitted power), weights "
                     "(--vpl-weights) or flux (the flux each light's VPLs carried last frame)");

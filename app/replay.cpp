@@ -253,6 +253,7 @@ void add_differential_rendering(ReplayPipeline& pipeline, const ReplayOptions& o
   dir.composite = options.composite.value_or(render::CompositeRule::Additive);
   pipeline.composite_rule = dir.composite;
   dir.environment = options.environment;
+  dir.merge_lights_degrees = options.merge_lights_degrees;
   dir.materials_buffer = brdf::kMaterials;
   dir.real_lights_buffer = lights::kLights;
   if (pipeline.placement) dir.placements_buffer = render::kObjectPlacements;
@@ -427,7 +428,8 @@ void add_pipeline_summaries(nlohmann::ordered_json& report, const ReplayPipeline
   }
   if (pipeline.renders) {
     report["environment"] = {{"mode", name_of(render::kEnvironmentLightNames, options.environment)},
-                             {"extracted_lights", pipeline.extracted_lights}};
+                             {"extracted_lights", pipeline.extracted_lights},
+                             {"merge_lights_degrees", options.merge_lights_degrees}};
     report["composite"] = {{"rule", name_of(render::kCompositeRuleNames, pipeline.composite_rule)}};
   }
   if (pipeline.vpls) report["vpls"] = vpl_json(*pipeline.vpls);

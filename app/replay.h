@@ -107,6 +107,9 @@ struct ReplayOptions {
   int vpls = 64;                               ///< first-bounce light samples per frame
   /// How the real directional lights (a probe's, an estimate's, a lights file's) reach the scene.
   render::EnvironmentLight environment = render::EnvironmentLight::Directional;
+  /// The real directional lights within this many degrees of each other light the scene as one
+  /// (render::DirStageOptions::merge_lights_degrees); 0: each as extracted.
+  float merge_lights_degrees = 0.f;
   render::VplBudget vpl_budget = render::VplBudget::ByPower;  ///< render/vpl/vpl.h
   std::vector<float> vpl_weights;              ///< per light (lights file order, then virtual lights)
   int vpl_bounces = 1;                         ///< indirect bounces carried by VPLs (render/vpl.h)

@@ -1,8 +1,10 @@
 #include "relight/lights/merge_lights.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 namespace relight::lights {
@@ -19,10 +21,10 @@ struct Cluster {
   }
 };
 
-/// Merges the closest pair of `clusters` until `max_count` are left (O(n^3); n is a probe's
-/// light count, at most a few hundred).
-void merge_down(std::vector<Cluster>& clusters, std::size_t max_count) {
-  while (clusters.size() > max_count && clusters.size() > 1) {
+/// Merges the closest pair of `clusters` until at most `max_count` are left and no two are closer
+/// than `min_cos` (O(n^3); n is a probe's light count, at most a few hundred).
+void merge_down(std::vector<Cluster>& clusters, std::size_t max_count, double min_cos = 2.0) {
+  while (clusters.size() > 1) {
     std::size_t best_a = 0, best_b = 1;
     double best_cos = -std::numeric_limits<double>::infinity();
     for (std::size_t a = 0; a < clusters.size(); ++a)
@@ -34,19 +36,17 @@ void merge_down(std::vector<Cluster>& clusters, std::size_t max_count) {
           best_b = b;
         }
       }
+    if (clusters.size() <= max_count && best_cos < min_cos) break;
     clusters[best_a].power += clusters[best_b].power;
     clusters[best_a].weighted_direction += clusters[best_b].weighted_direction;
     clusters.erase(clusters.begin() + static_cast<std::ptrdiff_t>(best_b));
   }
 }
 
-}  // namespace
-
-LightSet merge_directional_lights(const LightSet& set, std::size_t max_directional) {
-  std::size_t real_count = 0, virtual_count = 0;
-  for (const Light& light : set.lights)
-    if (light.kind == LightKind::Directional) ++(light.real ? real_count : virtual_count);
-  if (real_count <= max_directional && virtual_count <= max_directional) return set;
+/// The set with its real and its virtual directional lights each merged by `merge` (point and
+/// spot lights first, unchanged).
+template <class Merge>
+LightSet merged(const LightSet& set, const Merge& merge) {
   LightSet out;
   std::vector<Cluster> real, virtual_lights;
   for (const Light& light : set.lights) {
@@ -59,7 +59,7 @@ LightSet merge_directional_lights(const LightSet& set, std::size_t max_direction
     (light.real ? real : virtual_lights).push_back({light.power, weight * light.direction.normalized()});
   }
   for (auto* clusters : {&real, &virtual_lights}) {
-    merge_down(*clusters, max_directional);
+    merge(*clusters);
     for (const Cluster& cluster : *clusters) {
       Light light;
       light.kind = LightKind::Directional;
@@ -70,6 +70,24 @@ LightSet merge_directional_lights(const LightSet& set, std::size_t max_direction
     }
   }
   return out;
+}
+
+}  // namespace
+
+LightSet merge_directional_lights(const LightSet& set, std::size_t max_directional) {
+  std::size_t real_count = 0, virtual_count = 0;
+  for (const Light& light : set.lights)
+    if (light.kind == LightKind::Directional) ++(light.real ? real_count : virtual_count);
+  if (real_count <= max_directional && virtual_count <= max_directional) return set;
+  return merged(set, [max_directional](std::vector<Cluster>& clusters) { merge_down(clusters, max_directional); });
+}
+
+LightSet merge_close_directional_lights(const LightSet& set, double max_angle_degrees) {
+  if (!(max_angle_degrees > 0.0)) return set;
+  const double min_cos = std::cos(max_angle_degrees * std::numbers::pi / 180.0);
+  return merged(set, [min_cos](std::vector<Cluster>& clusters) {
+    merge_down(clusters, std::numeric_limits<std::size_t>::max(), min_cos);
+  });
 }
 
 }  // namespace relight::lights

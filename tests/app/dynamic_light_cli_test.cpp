@@ -356,6 +356,27 @@ TEST(DynamicLightCli, ProbeInputErrorsAreOneLine) {
   expect_one_line_error(relight(replay + " --probe-exposure 0"), 1);
 }
 
+// --merge-lights: the probe's eight lights, five of which sample its key light within 2 degrees,
+// light the scene as four (the five merged, their power summed): the real light and the pebble's
+// shadow stay within a few percent, and report.json says what was asked.
+TEST(DynamicLightCli, MergedLightsKeepTheLightAndTheShadow) {
+  test::TempDir dir;
+  const auto& sequence = cli_test::synthetic_sequence("--frames 2 --size 320x240 --trajectory static --no-gt");
+  const auto each = dir.path() / "each", merged = dir.path() / "merged";
+  ASSERT_EQ(replay_pebble(sequence, each).exit_code, 0);
+  const auto result = replay_pebble(sequence, merged, "--merge-lights 5");
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const FrameLight apart = frame_light(each / "frames", 1), together = frame_light(merged / "frames", 1);
+  std::cout << "mean L_r " << apart.real_light << " -> " << together.real_light << ", pebble shadow " << apart.shadow
+            << " -> " << together.shadow << "\n";
+  EXPECT_NEAR(together.real_light, apart.real_light, 0.02 * apart.real_light);
+  EXPECT_NEAR(together.shadow, apart.shadow, 0.15 * apart.shadow);
+  const auto report = nlohmann::json::parse(read_text_file(merged / "report.json"));
+  EXPECT_EQ(report["environment"]["merge_lights_degrees"], 5.0);
+  expect_one_line_error(
+      relight("replay --quiet " + sequence.string() + " --merge-lights -1 --out " + (dir.path() / "bad").string()), 2);
+}
+
 // A hand-held lamp tracked through a tag of its own (dissertation §5.2.12): relight re-poses the
 // real spot every frame from the tag and the camera's pose. The lamp turns by 40 degrees from
 // beside the pebble (frame 0) onto it (the last frame): the pebble's shadow grows with it, and

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 namespace relight::lights {
@@ -74,6 +75,24 @@ TEST(MergeLights, PointLightsAndTheRealVirtualSplitStay) {
   EXPECT_FALSE(merged.lights[2].real);
   EXPECT_NEAR(merged.lights[2].power.x(), 1.0, 1e-12);
   EXPECT_NEAR(merged.lights[2].direction.y(), std::sin(std::atan(0.1) / 2), 1e-3) << "halfway between its two";
+}
+
+// merge_close_directional_lights: the samples of each window (within 5 degrees of it) merge; the
+// windows, 40 degrees and more apart, stay four lights; with no angle the set is as it was.
+TEST(MergeLights, CloseLightsMergeByAngleAndDistantOnesStay) {
+  const LightSet set = four_windows();
+  const LightSet merged = merge_close_directional_lights(set, 15.0);
+  ASSERT_EQ(merged.lights.size(), 4u);
+  EXPECT_TRUE(total_power(merged).isApprox(total_power(set), 1e-12)) << "the energy stays";
+  for (const Light& light : merged.lights) EXPECT_NEAR(light.power.x(), 1.6, 1e-9);
+  EXPECT_EQ(merge_close_directional_lights(set, 0.0).lights.size(), set.lights.size());
+  // Two lights 3 degrees apart merge at 5 degrees and stay two at 2.
+  LightSet pair;
+  pair.lights.push_back(directional({0, 0, 1}, 1.0));
+  pair.lights.push_back(
+      directional({std::sin(3.0 * std::numbers::pi / 180.0), 0, std::cos(3.0 * std::numbers::pi / 180.0)}, 1.0));
+  EXPECT_EQ(merge_close_directional_lights(pair, 5.0).lights.size(), 1u);
+  EXPECT_EQ(merge_close_directional_lights(pair, 2.0).lights.size(), 2u);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "relight/colormap/buffers.h"
 #include "relight/colormap/tone_map_stage.h"
 #include "relight/core/error.h"
+#include "relight/lights/merge_lights.h"
 #include "relight/render/dir/camera_albedo.h"
 #include "relight/render/dir/composite.h"
 #include "relight/render/dir/edge_coverage.h"
@@ -73,7 +74,8 @@ MrSceneStage::MrSceneStage(DirSceneContent content, const DirStageOptions& optio
       environment_(options.environment),
       materials_buffer_(options.materials_buffer),
       placements_buffer_(options.placements_buffer),
-      real_lights_buffer_(options.real_lights_buffer) {}
+      real_lights_buffer_(options.real_lights_buffer),
+      merge_lights_degrees_(options.merge_lights_degrees) {}
 
 void MrSceneStage::declare(StageBuilder& builder) {
   frame_ = builder.read(kFrame);
@@ -112,7 +114,8 @@ void MrSceneStage::run(StageContext& context) {
   TriangleMesh mesh = mesh_from_positions(positions, &context.get(normals_), camera_to_world, materials, fine);
   mesh.name = "reconstruction";
   scene.meshes.push_back(std::move(mesh));
-  if (real_lights_buffer_) add_lights(scene, context.get(real_lights_));
+  if (real_lights_buffer_)
+    add_lights(scene, lights::merge_close_directional_lights(context.get(real_lights_), merge_lights_degrees_));
   scene.lights.insert(scene.lights.end(), content_.lights.begin(), content_.lights.end());
   if (environment_ == EnvironmentLight::Vpls)
     for (MrLight& light : scene.lights) light.through_vpl = light.kind == LightKind::Directional;

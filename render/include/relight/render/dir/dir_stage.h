@@ -6,7 +6,8 @@
 //                                   PositionMap "positions" and NormalMap "normals" (camera frame,
 //                                   reconstruct/), brdf::Materials when `materials_buffer` is set,
 //                                   ObjectPlacements when `placements_buffer` is set,
-//                                   lights::LightSet when `real_lights_buffer` is set
+//                                   lights::LightSet when `real_lights_buffer` is set (its
+//                                   directional lights within `merge_lights_degrees` merged)
 //                            writes MrScene "mr_scene": the reconstruction's position map as the
 //                                   real mesh (and on a wider grid as MrScene::coarse_real_meshes),
 //                                   that frame's real lights (when set) and the
@@ -139,6 +140,10 @@ struct DirStageOptions {
   /// The frame's real lights (e.g. lights::kLights, extracted from the probe every frame), put
   /// before DirSceneContent::lights; none: DirSceneContent's lights alone.
   std::optional<BufferName<lights::LightSet>> real_lights_buffer;
+  /// Those real lights' directional ones within this many degrees of each other are merged into
+  /// one (lights::merge_close_directional_lights: the power stays) before they light the scene;
+  /// 0: every light as it comes.
+  float merge_lights_degrees = 0.f;
   /// Per-pixel k_d of the camera's real surfaces, modulating the cluster k_d of diffuse real
   /// surfaces (camera_albedo.h); none: the clusters' k_d alone.
   std::optional<RealAlbedoBuffers> albedo_buffers;
@@ -199,6 +204,7 @@ class MrSceneStage final : public Stage {
   std::optional<BufferName<brdf::Materials>> materials_buffer_;
   std::optional<BufferName<ObjectPlacements>> placements_buffer_;
   std::optional<BufferName<lights::LightSet>> real_lights_buffer_;
+  float merge_lights_degrees_;
   Read<FrameInfo> frame_;
   Read<PositionMap> positions_;
   Read<NormalMap> normals_;
