@@ -152,7 +152,8 @@ void add_render_options(CLI::App& command, ReplayOptions& options) {
       .add_option("--merge-lights", options.merge_lights_degrees,
                   "Real directional lights (a probe's, an estimate's, a lights file's) within this many degrees of "
                   "each other light the scene as one, with their summed power: the samples a probe's brightest "
-                  "source gets cast one shadow, at the cost of one light's two shadow maps (0: every light)")
+                  "source gets cast one shadow, at the cost of one light's two shadow maps; it changes the picture "
+                  "slightly (0, the default: every light as extracted)")
       ->check(CLI::Range(0.0, 90.0))
       ->capture_default_str();
   add_choice_option(command, "--vpl-budget", options.vpl_budget, render::kVplBudgetNames,
