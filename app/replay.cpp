@@ -389,6 +389,7 @@ std::optional<nlohmann::ordered_json> dir_steps_json(const render::DirRenderStag
   if (frames.empty()) return std::nullopt;
   const auto median = [&](double render::DirVkTimings::*step) {
     std::vector<double> values;
+    values.reserve(frames.size());
     for (const render::DirVkTimings& t : frames) values.push_back(t.*step);
     const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
     std::nth_element(values.begin(), middle, values.end());
