@@ -71,14 +71,26 @@ void summary_section(std::ostringstream& html, const Json& timing) {
     html << "<tr><td>" << key << "<td class=l>" << html_escape(text);
   }
   // Summaries of one level: "key = value; ..." (lists as their length: the report.json has them).
-  for (const char* section : {"latency_ms", "tracking", "marker_pose", "camera_look", "composite"}) {
+  // An object of numbers (dir_steps' medians) shows inline; deeper ones point to report.json.
+  const auto number = [](const Json& value) {
+    return value.is_number_float() ? format("%.3g", value.get<double>())
+           : value.is_string()     ? value.get<std::string>()
+                                   : value.dump();
+  };
+  const auto numbers_only = [](const Json& value) {
+    return std::all_of(value.begin(), value.end(), [](const Json& v) { return v.is_number(); });
+  };
+  for (const char* section : {"latency_ms", "dir_steps", "tracking", "marker_pose", "camera_look", "composite"}) {
     if (!timing.contains(section) || !timing[section].is_object()) continue;
     html << "<tr><td>" << section << "<td class=l>";
     for (const auto& [key, value] : timing[section].items()) {
-      const std::string text = value.is_number_float() ? format("%.3g", value.get<double>())
-                               : value.is_array()      ? std::to_string(value.size()) + " entries"
-                               : value.is_object()     ? "(see report.json)"
-                                                       : value.dump();
+      std::string text = value.is_array() ? std::to_string(value.size()) + " entries" : number(value);
+      if (value.is_object() && numbers_only(value)) {
+        text.clear();
+        for (const auto& [inner, v] : value.items()) text += (text.empty() ? "" : ", ") + inner + " " + number(v);
+      } else if (value.is_object()) {
+        text = "(see report.json)";
+      }
       html << html_escape(key) << " = " << html_escape(text) << "; ";
     }
   }

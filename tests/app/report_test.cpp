@@ -125,7 +125,10 @@ TEST(HtmlReport, PageIsSelfContainedAndShowsEverySection) {
   content.contact_sheet.push_back({0, {{"composite", std::string("\xff\xd8\xff\xe0", 4), 8, 6}}});
   content.materials = std::vector<brdf::MaterialParams>{{{{0.5f, 0.25f, 0.125f}, 0.3f, 40.f}, 1234, 0.01f}};
   content.lights = lights::LightSet{{directional_light({0, 0.6, 0.8}, {2, 2, 2})}};
-  const std::string html = html_report("title", two_stage_timing(), content, "digraph {}", std::nullopt);
+  nlohmann::ordered_json timing = two_stage_timing();
+  timing["dir_steps"] = {
+      {"frames", 3}, {"shading_on", "cpu"}, {"median_ms", {{"gbuffer", 31.5}, {"shadow_maps", 64.25}}}};
+  const std::string html = html_report("title", timing, content, "digraph {}", std::nullopt);
 
   // No resource leaves the page: the only URL is the SVG namespace name.
   const std::regex external(R"((src|href)\s*=\s*["']?(https?:|//))");
@@ -136,6 +139,8 @@ TEST(HtmlReport, PageIsSelfContainedAndShowsEverySection) {
   EXPECT_NE(html.find("src=\"data:image/jpeg;base64,/9j/4A==\""), std::string::npos);
   // Timing table: the median shares, and the plot with one area per stage.
   EXPECT_NE(html.find("97 %"), std::string::npos);  // dir: 300 / 310
+  // Where the dir stage's time went, inline in the summary.
+  EXPECT_NE(html.find("median_ms = gbuffer 31.5, shadow_maps 64.2"), std::string::npos);
   std::size_t polygons = 0;
   for (auto at = html.find("<polygon"); at != std::string::npos; at = html.find("<polygon", at + 1)) ++polygons;
   EXPECT_EQ(polygons, 2u);
