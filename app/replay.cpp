@@ -387,13 +387,12 @@ nlohmann::ordered_json vpl_json(const render::VplStage& stage) {
 std::optional<nlohmann::ordered_json> dir_steps_json(const render::DirRenderStage& stage) {
   const std::vector<render::DirVkTimings>& frames = stage.step_timings();
   if (frames.empty()) return std::nullopt;
+  // The same median as the stages' beside them in report.json (summarize).
   const auto median = [&](double render::DirVkTimings::*step) {
     std::vector<double> values;
     values.reserve(frames.size());
     for (const render::DirVkTimings& t : frames) values.push_back(t.*step);
-    const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
+    return summarize(std::move(values)).median;
   };
   nlohmann::ordered_json steps{{"gbuffer", median(&render::DirVkTimings::gbuffer_ms)},
                                {"shadow_maps", median(&render::DirVkTimings::shadow_maps_ms)},
