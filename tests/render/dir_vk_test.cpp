@@ -436,6 +436,39 @@ TEST_F(DirVkTest, CpuAndGpuBackendsAgreeAndAutoPicksTheCpuOnASoftwareDevice) {
   EXPECT_GT(close, static_cast<int>(gpu.real.pixels().size()) * 98 / 100);
 }
 
+// The CPU shading reads the device's G-buffer and shadow atlas in place where the host can map
+// them (lavapipe) and through staging copies where it cannot (a discrete GPU; force_staging
+// here): both give the same pictures, and the G-buffer images a renderer reuses from frame to
+// frame hold nothing of the frame before.
+TEST_F(DirVkTest, CpuShadingReadsTheMapsInPlaceOrThroughStagingAlike) {
+  RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
+  const MrScene scene = cube_scene();
+  DirRenderOptions options = test_options();
+  options.backend = DirBackend::Cpu;
+  const std::vector<Vpl> vpls = make_vpls(scene, 16);
+  const MrCamera camera = camera_at({0.2, -1.5, 1.4}, {0, 0, 0.1}, 64, 48);
+  const MrCamera other = camera_at({-0.8, -1.0, 0.6}, {0, 0, 0.2}, 64, 48);
+  DirRendererVk mapped(context, 64, 48);
+  mapped.set_scene(scene, options);
+  const DifferentialImages first = mapped.render(camera, vpls, options);
+  const GBuffer first_gbuffer = mapped.last_gbuffer();
+  (void)mapped.render(other, vpls, options);
+  const DifferentialImages again = mapped.render(camera, vpls, options);
+  EXPECT_TRUE(std::ranges::equal(again.real_virtual.pixels(), first.real_virtual.pixels()));
+  EXPECT_TRUE(std::ranges::equal(mapped.last_gbuffer().position.pixels(), first_gbuffer.position.pixels()));
+  EXPECT_TRUE(std::ranges::equal(mapped.last_gbuffer().material.pixels(), first_gbuffer.material.pixels()));
+
+  auto staging_context = vk::try_create_vulkan({.validation = vk::Validation::On, .force_staging = true});
+  ASSERT_NE(staging_context, nullptr);
+  DirRendererVk staged(*staging_context, 64, 48);
+  staged.set_scene(scene, options);
+  const DifferentialImages copied = staged.render(camera, vpls, options);
+  EXPECT_TRUE(std::ranges::equal(copied.real_virtual.pixels(), first.real_virtual.pixels()));
+  EXPECT_TRUE(std::ranges::equal(copied.real.pixels(), first.real.pixels()));
+  EXPECT_EQ(staged.last_shadow_atlas(), mapped.last_shadow_atlas());
+  EXPECT_EQ(staging_context->validation_errors(), 0) << staging_context->validation_log()->summary();
+}
+
 TEST_F(DirVkTest, RejectsMisuse) {
   RELIGHT_REQUIRE_VULKAN_CONTEXT(context);
   EXPECT_THROW(DirRendererVk(context, 0, 10), Error);

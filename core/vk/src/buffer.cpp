@@ -103,6 +103,12 @@ void VulkanBuffer::write(std::span<const std::byte> source) {
 void VulkanBuffer::read(std::span<std::byte> destination) const {
   if (!mapped_ || destination.size() > size_) throw LogicError("VulkanBuffer::read: buffer not mapped or too small");
   if (destination.empty()) return;
+  const std::span<const std::byte> mapped = mapped_bytes();
+  std::memcpy(destination.data(), mapped.data(), destination.size());
+}
+
+std::span<const std::byte> VulkanBuffer::mapped_bytes() const {
+  if (!mapped_) return {};
   if (!coherent_) {
     VkMappedMemoryRange range{};
     range.sType = VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE;
@@ -110,7 +116,7 @@ void VulkanBuffer::read(std::span<std::byte> destination) const {
     range.size = VK_WHOLE_SIZE;
     RELIGHT_VK_CHECK(vkInvalidateMappedMemoryRanges(memory_.device(), 1, &range));
   }
-  std::memcpy(destination.data(), mapped_, destination.size());
+  return {mapped_, size_};
 }
 
 VulkanBuffer& buffer_of_size(std::optional<VulkanBuffer>& slot, const VulkanContext& context, std::size_t bytes) {

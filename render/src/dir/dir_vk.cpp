@@ -251,7 +251,21 @@ struct DirRendererVk::Impl {
   DirVkTimings timings;
   std::uint32_t vpl_count = 0;
   std::vector<float> cpu_ism_atlas;  // of the last render when it shaded on the CPU
-  std::optional<GBuffer> last_gbuffer;  // read back on demand, dropped by the next render
+  // The G-buffer read back on demand (once per render; the images are reused frame to frame).
+  GBuffer last_gbuffer;
+  bool last_gbuffer_current = false;
+  // Where the G-buffer and the shadow atlas are copied when the host cannot map them.
+  std::vector<float> gbuffer_copy, shadow_atlas_copy;
+
+  /// The device buffer's first `floats` floats for the host to read: the mapped memory itself
+  /// where the device's memory is host-visible (lavapipe, integrated GPUs), else a copy in `copy`.
+  std::span<const float> host_view(const vk::VulkanBuffer& buffer, std::size_t floats, std::vector<float>& copy) {
+    if (const std::span<const std::byte> mapped = buffer.mapped_bytes(); mapped.size() >= floats * sizeof(float))
+      return {reinterpret_cast<const float*>(mapped.data()), floats};
+    copy.resize(floats);
+    context.transfer().download(buffer, std::as_writable_bytes(std::span(copy)));
+    return copy;
+  }
 
   // Steps 3-5 (ISMs, shading, merge) into `cmd`.
   void record_shading(VkCommandBuffer cmd, const ShadeParams& params, const DirRenderOptions& options) {
@@ -321,7 +335,7 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
   if (options.interleave < 1 || options.interleave > 8) throw Error("the interleave factor must be 1 to 8");
   d.upload(d.vpls, pack_vpls(vpls));
   d.vpl_count = static_cast<std::uint32_t>(vpls.size());
-  d.last_gbuffer.reset();
+  d.last_gbuffer_current = false;
   d.back_projection = {};
 
   const Eigen::Vector3f centre = camera.camera_to_world.translation().cast<float>();
@@ -377,7 +391,7 @@ DifferentialImages DirRendererVk::render(const MrCamera& camera, std::span<const
     // from this frame's maps (specular_shading.h).
     const auto start = std::chrono::steady_clock::now();
     d.back_projection = add_specular_light(out, *d.specular_tracer, camera, last_gbuffer(), d.layout,
-                                           last_shadow_atlas(), vpls, last_ism_atlas(), d.points, options);
+                                           shadow_atlas_view(), vpls, last_ism_atlas(), d.points, options);
     d.timings.specular_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     d.timings.total_ms += d.timings.specular_ms;
   }
@@ -411,7 +425,7 @@ DifferentialImages DirRendererVk::shade_on_cpu(const MrCamera& camera, std::span
   const auto ism_done = Clock::now();
   DifferentialImages out =
       shade_dir_from_maps(last_gbuffer(), *d.scene, camera.camera_to_world.translation().cast<float>(), d.layout,
-                          last_shadow_atlas(), vpls, d.cpu_ism_atlas, d.points, options);
+                          shadow_atlas_view(), vpls, d.cpu_ism_atlas, d.points, options);
   const auto done = Clock::now();
   // ism_ms: the splatting's own time, though most of it overlapped the device's passes; total_ms
   // counts only what it added after them.
@@ -428,22 +442,28 @@ const IsmPointPools& DirRendererVk::ism_points() const { return impl_->points; }
 
 const GBuffer& DirRendererVk::last_gbuffer() const {
   // Read back once per render: the CPU backend shades from it and the DIR stage smooths with it.
-  if (!impl_->last_gbuffer) {
+  Impl& d = *impl_;
+  if (!d.last_gbuffer_current) {
     // The texture coordinates (the last third) only when a material has a texture to sample.
-    std::size_t floats = impl_->gbuffer_buffer.size_bytes() / sizeof(float);
-    if (!impl_->scene || !has_textures(*impl_->scene)) floats = floats / 12 * 8;
-    std::vector<float> data(floats);
-    impl_->context.transfer().download(impl_->gbuffer_buffer, std::as_writable_bytes(std::span(data)));
-    impl_->last_gbuffer = GBufferVk::unpack(data, impl_->width, impl_->height);
+    std::size_t floats = d.gbuffer_buffer.size_bytes() / sizeof(float);
+    if (!d.scene || !has_textures(*d.scene)) floats = floats / 12 * 8;
+    GBufferVk::unpack_into(d.host_view(d.gbuffer_buffer, floats, d.gbuffer_copy), d.width, d.height, d.last_gbuffer);
+    d.last_gbuffer_current = true;
   }
-  return *impl_->last_gbuffer;
+  return d.last_gbuffer;
+}
+
+std::span<const float> DirRendererVk::shadow_atlas_view() const {
+  Impl& d = *impl_;
+  return d.host_view(
+      d.shadow_maps.atlas(),
+      static_cast<std::size_t>(d.layout.atlas_width()) * static_cast<std::size_t>(d.layout.atlas_height()),
+      d.shadow_atlas_copy);
 }
 
 std::vector<float> DirRendererVk::last_shadow_atlas() const {
-  std::vector<float> data(static_cast<std::size_t>(impl_->layout.atlas_width()) *
-                          static_cast<std::size_t>(impl_->layout.atlas_height()));
-  impl_->context.transfer().download(impl_->shadow_maps.atlas(), std::as_writable_bytes(std::span(data)));
-  return data;
+  const std::span<const float> view = shadow_atlas_view();
+  return {view.begin(), view.end()};
 }
 
 std::vector<float> DirRendererVk::last_ism_atlas() const {

@@ -151,38 +151,52 @@ GBuffer GBufferVk::render(const MrCamera& camera) {
   Impl& g = *impl_;
   g.context.submit([&](VkCommandBuffer cmd) { record(cmd, camera, g.readback); });
   g.gpu_ms = g.timer.elapsed_ms().value_or(0.0);
-
-  std::vector<float> data(packed_bytes(static_cast<int>(g.width), static_cast<int>(g.height)) / sizeof(float));
-  g.readback.read(std::as_writable_bytes(std::span(data)));
-  return unpack(data, static_cast<int>(g.width), static_cast<int>(g.height));
+  const std::size_t floats = packed_bytes(static_cast<int>(g.width), static_cast<int>(g.height)) / sizeof(float);
+  const std::span<const std::byte> mapped = g.readback.mapped_bytes();
+  return unpack({reinterpret_cast<const float*>(mapped.data()), floats}, static_cast<int>(g.width),
+                static_cast<int>(g.height));
 }
 
 GBuffer GBufferVk::unpack(std::span<const float> data, int width, int height) {
+  GBuffer out;
+  unpack_into(data, width, height, out);
+  return out;
+}
+
+void GBufferVk::unpack_into(std::span<const float> data, int width, int height, GBuffer& out) {
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   if (data.size() < 8 * pixels) throw LogicError("GBufferVk::unpack: too few values");
   const bool texcoords = data.size() >= 12 * pixels;
-  GBuffer out{PositionMap(width, height), NormalMap(width, height), LabelImage(width, height), Mask(width, height),
-              DepthMap(width, height)};
+  const auto sized = [width, height]<typename T>(Image<T>& image) {
+    if (image.width() != width || image.height() != height) image = Image<T>(width, height);
+  };
+  sized(out.position);
+  sized(out.normal);
+  sized(out.material);
+  sized(out.virtual_surface);
+  sized(out.distance);
   if (texcoords) {
-    out.texcoord = Image<Float3>(width, height);
-    out.tangent = Image<float>(width, height);
+    sized(out.texcoord);
+    sized(out.tangent);
+  } else {
+    out.texcoord = {};
+    out.tangent = {};
   }
   for (std::size_t i = 0; i < pixels; ++i) {
     const float* p = &data[4 * i];
     const float* n = &data[4 * (pixels + i)];
-    if (p[3] == 0.f) continue;  // cleared: nothing drawn
-    out.position.pixels()[i] = {p[0], p[1], p[2]};
+    const bool drawn = p[3] != 0.f;  // cleared: nothing drawn
+    out.position.pixels()[i] = drawn ? Float3{p[0], p[1], p[2]} : Float3{};
     out.distance.pixels()[i] = std::abs(p[3]);
     out.virtual_surface.pixels()[i] = p[3] < 0.f ? 1 : 0;
-    out.normal.pixels()[i] = {n[0], n[1], n[2]};
-    out.material.pixels()[i] = static_cast<std::uint16_t>(n[3] + 1.f);
+    out.normal.pixels()[i] = drawn ? Float3{n[0], n[1], n[2]} : Float3{};
+    out.material.pixels()[i] = drawn ? static_cast<std::uint16_t>(n[3] + 1.f) : std::uint16_t{0};
     if (texcoords) {
       const float* t = &data[4 * (2 * pixels + i)];
-      out.texcoord.pixels()[i] = {t[0], t[1], t[2]};
-      out.tangent.pixels()[i] = t[3];
+      out.texcoord.pixels()[i] = drawn ? Float3{t[0], t[1], t[2]} : Float3{};
+      out.tangent.pixels()[i] = drawn ? t[3] : 0.f;
     }
   }
-  return out;
 }
 
 }  // namespace relight::render

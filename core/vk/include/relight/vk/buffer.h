@@ -47,6 +47,10 @@ class VulkanBuffer final : public DeviceBuffer {
   /// Copies the start of the mapped buffer into `destination` (invalidating non-coherent memory
   /// first). Requires host_mapped() and destination.size() <= size_bytes().
   void read(std::span<std::byte> destination) const;
+  /// The mapped buffer itself, for the host to read in place where a copy would cost more than
+  /// the reads (non-coherent memory is invalidated first); empty when not host_mapped(). Valid
+  /// until the buffer is destroyed; the device must not be writing it meanwhile.
+  [[nodiscard]] std::span<const std::byte> mapped_bytes() const;
 
  private:
   UniqueMemory memory_;  // declared first, so the buffer is destroyed before its memory is freed

@@ -63,6 +63,9 @@ class DirRendererVk {
 
  private:
   [[nodiscard]] DifferentialImages download_images() const;
+  /// The last render's shadow atlas for the host to read, without a copy where the device's
+  /// memory is host-visible; valid until the next read-back.
+  [[nodiscard]] std::span<const float> shadow_atlas_view() const;
   struct TimedIsmAtlas;  ///< the CPU's ISM atlas and the milliseconds it took
   [[nodiscard]] DifferentialImages shade_on_cpu(const MrCamera& camera, std::span<const Vpl> vpls,
                                                 std::future<TimedIsmAtlas>& ism, const DirRenderOptions& options);

@@ -47,6 +47,9 @@ class GBufferVk {
   /// The GBuffer of a packed copy (distance 0 = nothing drawn); a copy of the first two blocks
   /// only (8 floats per pixel) gives a GBuffer without texcoord.
   [[nodiscard]] static GBuffer unpack(std::span<const float> packed, int width, int height);
+  /// unpack() into `out`, whose images are reused where they have the size already (a renderer's
+  /// per-frame read-back: fresh 640x480 images cost more in page faults than the unpacking).
+  static void unpack_into(std::span<const float> packed, int width, int height, GBuffer& out);
   /// GPU time of the last render's draw, milliseconds (0 without timestamp support).
   [[nodiscard]] double last_gpu_ms() const;
 
