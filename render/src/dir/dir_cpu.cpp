@@ -1,5 +1,6 @@
 // shade_dir_from_maps(): the CPU mirror of dir_shade.comp (see dir_vk.h). Keep the two in step.
 #include <algorithm>
+#include <memory>
 
 #include "relight/core/error.h"
 #include "relight/core/parallel.h"
@@ -13,12 +14,39 @@ namespace {
 
 using Vec3 = Eigen::Vector3f;
 
+/// No initialisers: the shading pass sets every field of every pixel, so its 640x480 of them
+/// (18 MB) are allocated without a serial fill and first touched by the workers.
 struct Radiance {
-  Vec3 real_virtual = Vec3::Zero();  ///< direct + emission
-  Vec3 real = Vec3::Zero();
-  Vec3 indirect_real_virtual = Vec3::Zero();  ///< this pixel's VPL subset, scaled by n^2
-  Vec3 indirect_real = Vec3::Zero();
-  Vec3 kd_texture = Vec3::Ones();  ///< the texture factor of k_d, applied to the indirect light after the merge
+  Vec3 real_virtual;  ///< direct + emission
+  Vec3 real;
+  Vec3 indirect_real_virtual;  ///< this pixel's VPL subset, scaled by n^2
+  Vec3 indirect_real;
+};
+
+/// A texture factor of pixel (x, y); texture_factors() leaves the image empty where no material
+/// has that texture: the factor is 1.
+Vec3 factor_at(const RadianceImage& factors, int x, int y) {
+  if (factors.empty()) return Vec3::Ones();
+  const Float3& f = factors(y, x);
+  return {f.x, f.y, f.z};
+}
+
+/// The first pass's pixels, row-major.
+class ShadedPixels {
+ public:
+  ShadedPixels(int width, int height)
+      : width_(width),
+        pixels_(std::make_unique_for_overwrite<Radiance[]>(static_cast<std::size_t>(width) *
+                                                           static_cast<std::size_t>(height))) {}
+  Radiance& operator()(int y, int x) { return pixels_[index(y, x)]; }
+  const Radiance& operator()(int y, int x) const { return pixels_[index(y, x)]; }
+
+ private:
+  [[nodiscard]] std::size_t index(int y, int x) const {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(width_) + static_cast<std::size_t>(x);
+  }
+  int width_;
+  std::unique_ptr<Radiance[]> pixels_;
 };
 
 class MapShader {
@@ -42,10 +70,7 @@ class MapShader {
   [[nodiscard]] Radiance shade(const Vec3& point, const Vec3& normal, const Vec3& wo, const Phong& m,
                                const Vec3& kd_texture, const Vec3& emission, float real_pixel, std::uint32_t subset,
                                float camera_distance) const {
-    Radiance out;
-    out.real_virtual = emission;
-    out.real = real_pixel * emission;
-    out.kd_texture = kd_texture;
+    Radiance out{emission, real_pixel * emission, Vec3::Zero(), Vec3::Zero()};
     const float tolerance =
         real_pixel > 0.f ? real_surface_tolerance(options_.shading.real_depth_noise_sigmas, camera_distance) : 0.f;
     if (options_.shading.direct)
@@ -161,7 +186,8 @@ class SimilarTo {
 /// the found pixels of a subset are averaged first, so that every subset found counts once.
 /// Without that search, a pixel next to an edge loses the same subsets as its neighbours, and
 /// their indirect light shows as light or dark blocks.
-Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, int y, int n) {
+Radiance merged_pixel(const GBuffer& g, const ShadedPixels& shaded, const RadianceImage& kd_texture, int x, int y,
+                      int n) {
   const Radiance& own = shaded(y, x);
   Vec3 sum_rv = own.indirect_real_virtual, sum_r = own.indirect_real;
   float weight = 1.f;
@@ -193,9 +219,11 @@ Radiance merged_pixel(const GBuffer& g, const Image<Radiance>& shaded, int x, in
         weight += 1.f;
       }
   }
+  // The texture factor of k_d, applied to the indirect light after the merge (MapShader::shade).
+  const Vec3 texture = factor_at(kd_texture, x, y);
   Radiance out;
-  out.indirect_real_virtual = (sum_rv / weight).cwiseProduct(own.kd_texture);
-  out.indirect_real = (sum_r / weight).cwiseProduct(own.kd_texture);
+  out.indirect_real_virtual = (sum_rv / weight).cwiseProduct(texture);
+  out.indirect_real = (sum_r / weight).cwiseProduct(texture);
   out.real_virtual = own.real_virtual + out.indirect_real_virtual;
   out.real = own.real + out.indirect_real;
   return out;
@@ -225,12 +253,12 @@ DifferentialImages shade_from_maps(const GBuffer& gbuffer, const MrScene& scene,
   const NormalMap& normals = bent.empty() ? gbuffer.normal : bent;
   const Vec3 environment = scene.environment.radiance;
   const int n = options.interleave;
-  Image<Radiance> shaded(width, height);
+  ShadedPixels shaded(width, height);
   parallel_rows(height, options.shading.threads, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
       for (int x = 0; x < width; ++x) {
         if (gbuffer.distance(y, x) == 0.f) {
-          shaded(y, x).real_virtual = shaded(y, x).real = environment;
+          shaded(y, x) = {environment, environment, Vec3::Zero(), Vec3::Zero()};
           continue;
         }
         const auto& p = gbuffer.position(y, x);
@@ -238,12 +266,7 @@ DifferentialImages shade_from_maps(const GBuffer& gbuffer, const MrScene& scene,
         const Vec3 point(p.x, p.y, p.z), normal(nn.x, nn.y, nn.z);
         const float real_pixel = gbuffer.virtual_surface(y, x) ? 0.f : 1.f;
         const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));
-        // texture_factors() is empty where no material has that texture: the factor is 1.
-        const auto factor = [x, y](const RadianceImage& factors) {
-          if (factors.empty()) return Vec3::Ones().eval();
-          const Float3& f = factors(y, x);
-          return Vec3(f.x, f.y, f.z);
-        };
+        const auto factor = [x, y](const RadianceImage& factors) { return factor_at(factors, x, y); };
         const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
         const Vec3 eye = eyes ? Vec3((*eyes)(y, x).x, (*eyes)(y, x).y, (*eyes)(y, x).z) : camera_centre;
         shaded(y, x) =
@@ -257,7 +280,7 @@ DifferentialImages shade_from_maps(const GBuffer& gbuffer, const MrScene& scene,
   parallel_rows(height, options.shading.threads, [&](int begin, int end) {
     for (int y = begin; y < end; ++y)
       for (int x = 0; x < width; ++x) {
-        const Radiance r = merged_pixel(gbuffer, shaded, x, y, n);
+        const Radiance r = merged_pixel(gbuffer, shaded, kd_texture, x, y, n);
         out.real_virtual(y, x) = {r.real_virtual.x(), r.real_virtual.y(), r.real_virtual.z()};
         out.real(y, x) = {r.real.x(), r.real.y(), r.real.z()};
         out.indirect_real_virtual(y, x) = {r.indirect_real_virtual.x(), r.indirect_real_virtual.y(), r.indirect_real_virtual.z()};
