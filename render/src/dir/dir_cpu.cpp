@@ -1,5 +1,6 @@
 // shade_dir_from_maps(): the CPU mirror of dir_shade.comp (see dir_vk.h). Keep the two in step.
 #include <algorithm>
+#include <limits>
 #include <memory>
 
 #include "relight/core/error.h"
@@ -180,18 +181,103 @@ class SimilarTo {
   Float3 normal_;
 };
 
+/// Per column of one output row, the extremes over the merge window's n rows of what SimilarTo
+/// compares (distance, virtual flag, normal), so that a pixel can tell from its window's
+/// extremes, without comparing each neighbour, that all of them are similar (all_similar).
+class WindowExtremes {
+ public:
+  WindowExtremes(const GBuffer& g, int n) : g_(g), n_(n), columns_(static_cast<std::size_t>(g.distance.width())) {}
+
+  /// The columns' extremes for output row y; false when the window leaves the image there.
+  bool set_row(int y) {
+    const int top = y - n_ / 2, bottom = y + (n_ - n_ / 2) - 1;
+    if (top < 0 || bottom >= g_.distance.height()) return false;
+    for (std::size_t x = 0; x < columns_.size(); ++x) {
+      Column c;
+      for (int r = top; r <= bottom; ++r) {
+        const int col = static_cast<int>(x);
+        const float d = g_.distance(r, col);
+        const float v = g_.virtual_surface(r, col) != 0 ? 1.f : 0.f;
+        const Float3& normal = g_.normal(r, col);
+        c.min_distance = std::min(c.min_distance, d);
+        c.max_distance = std::max(c.max_distance, d);
+        c.min_virtual = std::min(c.min_virtual, v);
+        c.max_virtual = std::max(c.max_virtual, v);
+        c.min_normal = {std::min(c.min_normal.x, normal.x), std::min(c.min_normal.y, normal.y),
+                        std::min(c.min_normal.z, normal.z)};
+        c.max_normal = {std::max(c.max_normal.x, normal.x), std::max(c.max_normal.y, normal.y),
+                        std::max(c.max_normal.z, normal.z)};
+      }
+      columns_[x] = c;
+    }
+    return true;
+  }
+
+  /// Whether SimilarTo(g, x, y) holds for every pixel of the window around (x, y) (a drawn
+  /// pixel): the distance test at the window's nearest and farthest distance, the normal test
+  /// at a lower bound of every neighbour's dot product (float products and sums are monotone,
+  /// so the bound holds for the rounded dot products too; the margin covers a compiler fusing
+  /// one of them into a multiply-add). False sends the pixel to the neighbour-by-neighbour merge.
+  [[nodiscard]] bool all_similar(int x, int y) const {
+    const int left = x - n_ / 2, right = x + (n_ - n_ / 2) - 1;
+    if (left < 0 || right >= static_cast<int>(columns_.size())) return false;
+    Column w = columns_[static_cast<std::size_t>(left)];
+    for (int q = left + 1; q <= right; ++q) {
+      const Column& c = columns_[static_cast<std::size_t>(q)];
+      w.min_distance = std::min(w.min_distance, c.min_distance);
+      w.max_distance = std::max(w.max_distance, c.max_distance);
+      w.min_virtual = std::min(w.min_virtual, c.min_virtual);
+      w.max_virtual = std::max(w.max_virtual, c.max_virtual);
+      w.min_normal = {std::min(w.min_normal.x, c.min_normal.x), std::min(w.min_normal.y, c.min_normal.y),
+                      std::min(w.min_normal.z, c.min_normal.z)};
+      w.max_normal = {std::max(w.max_normal.x, c.max_normal.x), std::max(w.max_normal.y, c.max_normal.y),
+                      std::max(w.max_normal.z, c.max_normal.z)};
+    }
+    const float distance = g_.distance(y, x);
+    if (w.min_distance == 0.f || w.min_virtual != w.max_virtual) return false;
+    if (std::abs(w.min_distance - distance) > 0.05f * distance ||
+        std::abs(w.max_distance - distance) > 0.05f * distance)
+      return false;
+    const Float3& normal = g_.normal(y, x);
+    const Float3 extreme{normal.x >= 0.f ? w.min_normal.x : w.max_normal.x,
+                         normal.y >= 0.f ? w.min_normal.y : w.max_normal.y,
+                         normal.z >= 0.f ? w.min_normal.z : w.max_normal.z};
+    return dot(extreme, normal) >= 0.9f + 1e-5f;
+  }
+
+ private:
+  struct Column {
+    float min_distance = std::numeric_limits<float>::max(), max_distance = 0.f;
+    float min_virtual = 1.f, max_virtual = 0.f;
+    Float3 min_normal{1.f, 1.f, 1.f}, max_normal{-1.f, -1.f, -1.f};
+  };
+  const GBuffer& g_;
+  int n_;
+  std::vector<Column> columns_;
+};
+
 /// merge_interleaved: dir_merge.comp's geometry-aware average of the indirect light, direct
 /// light added unblurred. The n x n window holds one pixel of every VPL subset; a subset whose
 /// pixel there is not similar is looked for one period further out (its 8 pixels at ±n), and
 /// the found pixels of a subset are averaged first, so that every subset found counts once.
 /// Without that search, a pixel next to an edge loses the same subsets as its neighbours, and
 /// their indirect light shows as light or dark blocks.
+/// `window_similar`: WindowExtremes::all_similar() said every neighbour is similar; the sum is
+/// then the one below without its tests (the same additions in the same order).
 Radiance merged_pixel(const GBuffer& g, const ShadedPixels& shaded, const RadianceImage& kd_texture, int x, int y,
-                      int n) {
+                      int n, bool window_similar) {
   const Radiance& own = shaded(y, x);
   Vec3 sum_rv = own.indirect_real_virtual, sum_r = own.indirect_real;
   float weight = 1.f;
-  if (n > 1 && g.distance(y, x) != 0.f) {
+  if (n > 1 && window_similar) {
+    for (int dy = -n / 2; dy < n - n / 2; ++dy)
+      for (int dx = -n / 2; dx < n - n / 2; ++dx) {
+        if (dx == 0 && dy == 0) continue;
+        sum_rv += shaded(y + dy, x + dx).indirect_real_virtual;
+        sum_r += shaded(y + dy, x + dx).indirect_real;
+        weight += 1.f;
+      }
+  } else if (n > 1 && g.distance(y, x) != 0.f) {
     const SimilarTo similar(g, x, y);
     for (int dy = -n / 2; dy < n - n / 2; ++dy)
       for (int dx = -n / 2; dx < n - n / 2; ++dx) {
@@ -277,17 +363,25 @@ DifferentialImages shade_from_maps(const GBuffer& gbuffer, const MrScene& scene,
   }, 4);
   DifferentialImages out{RadianceImage(width, height), RadianceImage(width, height), CoverageImage(width, height), 1,
                          RadianceImage(width, height), RadianceImage(width, height)};
-  parallel_rows(height, options.shading.threads, [&](int begin, int end) {
-    for (int y = begin; y < end; ++y)
-      for (int x = 0; x < width; ++x) {
-        const Radiance r = merged_pixel(gbuffer, shaded, kd_texture, x, y, n);
-        out.real_virtual(y, x) = {r.real_virtual.x(), r.real_virtual.y(), r.real_virtual.z()};
-        out.real(y, x) = {r.real.x(), r.real.y(), r.real.z()};
-        out.indirect_real_virtual(y, x) = {r.indirect_real_virtual.x(), r.indirect_real_virtual.y(), r.indirect_real_virtual.z()};
-        out.indirect_real(y, x) = {r.indirect_real.x(), r.indirect_real.y(), r.indirect_real.z()};
-        out.virtual_coverage(y, x) = gbuffer.distance(y, x) != 0.f && gbuffer.virtual_surface(y, x) ? 1.f : 0.f;
-      }
-  }, 8);
+  parallel_rows(
+      height, options.shading.threads,
+      [&](int begin, int end) {
+        WindowExtremes window(gbuffer, n);
+        for (int y = begin; y < end; ++y) {
+          const bool window_in_image = n > 1 && window.set_row(y);
+          for (int x = 0; x < width; ++x) {
+            const bool similar = window_in_image && gbuffer.distance(y, x) != 0.f && window.all_similar(x, y);
+            const Radiance r = merged_pixel(gbuffer, shaded, kd_texture, x, y, n, similar);
+            out.real_virtual(y, x) = {r.real_virtual.x(), r.real_virtual.y(), r.real_virtual.z()};
+            out.real(y, x) = {r.real.x(), r.real.y(), r.real.z()};
+            out.indirect_real_virtual(y, x) = {r.indirect_real_virtual.x(), r.indirect_real_virtual.y(),
+                                               r.indirect_real_virtual.z()};
+            out.indirect_real(y, x) = {r.indirect_real.x(), r.indirect_real.y(), r.indirect_real.z()};
+            out.virtual_coverage(y, x) = gbuffer.distance(y, x) != 0.f && gbuffer.virtual_surface(y, x) ? 1.f : 0.f;
+          }
+        }
+      },
+      8);
   return out;
 }
 
