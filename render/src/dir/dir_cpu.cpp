@@ -129,10 +129,11 @@ class MapShader {
       const Vec3 to_vpl = vpl.position - point;
       const float distance2 = to_vpl.squaredNorm();
       if (!(distance2 > 0.f)) continue;
-      const Vec3 wi = to_vpl / std::sqrt(distance2);
+      const float distance = std::sqrt(distance2);
+      const Vec3 wi = to_vpl / distance;
       const float cos_x = wi.dot(n), cos_y = -wi.dot(vpl.normal);
       if (cos_x <= 0.f || cos_y <= 0.f) continue;
-      const IsmLookup::Visibility seen = ism_(j, point);
+      const IsmLookup::Visibility seen = ism_(j, -to_vpl, distance);
       if (seen.real == 0.f) continue;
       const Vec3 contribution = vpl.flux.cwiseProduct(phong_brdf(vpl_phong(scene_, vpl), vpl.normal, vpl.incident, -wi))
                                     .cwiseProduct(phong_brdf(m, n, wi, wo)) *

@@ -322,10 +322,11 @@ IsmLookup::IsmLookup(std::span<const float> atlas, const IsmOptions& options, st
   }
 }
 
-float IsmLookup::visible(const TileProjection& projection, std::size_t tile_offset, const Vec3& point,
-                         float constant_bias) const {
-  float distance = 0.f;
-  const Vec3 dir = projection.local(point, distance);
+float IsmLookup::visible(const TileProjection& projection, std::size_t tile_offset, const Vec3& from_origin,
+                         float distance, float constant_bias) const {
+  // TileProjection::local() with the offset and its length given.
+  const Vec3 dir =
+      Vec3(from_origin.dot(projection.t), from_origin.dot(projection.b), from_origin.dot(projection.n)) / distance;
   Vec2 texel;
   if (!(distance > 0.f) || !projection.texel(dir, tile_, texel)) return 1.f;
   const int x = std::clamp(static_cast<int>(std::floor(texel.x())), 0, tile_ - 1);
@@ -337,11 +338,17 @@ float IsmLookup::visible(const TileProjection& projection, std::size_t tile_offs
 }
 
 IsmLookup::Visibility IsmLookup::operator()(std::uint32_t index, const Vec3& point) const {
+  // Both tiles of a VPL share its position as their origin (TileProjection::hemisphere, towards).
+  const Vec3 from_vpl = point - real_[index].origin;
+  return (*this)(index, from_vpl, from_vpl.norm());
+}
+
+IsmLookup::Visibility IsmLookup::operator()(std::uint32_t index, const Vec3& from_vpl, float distance) const {
   const std::size_t offset = static_cast<std::size_t>(index) * static_cast<std::size_t>(tile_) * static_cast<std::size_t>(tile_);
-  const float real = visible(real_[index], offset, point, kIsmBias);
+  const float real = visible(real_[index], offset, from_vpl, distance, kIsmBias);
   if (real == 0.f) return {0.f, 0.f};
-  return {real,
-          visible(virtual_[index], layer_stride_ + offset, point, emitter_[index] ? kEmitterVirtualIsmBias : kIsmBias)};
+  return {real, visible(virtual_[index], layer_stride_ + offset, from_vpl, distance,
+                        emitter_[index] ? kEmitterVirtualIsmBias : kIsmBias)};
 }
 
 }  // namespace relight::render

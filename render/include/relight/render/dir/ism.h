@@ -130,10 +130,13 @@ class IsmLookup {
   };
   /// Whether `point` is visible from VPL `index` through each layer.
   [[nodiscard]] Visibility operator()(std::uint32_t index, const Eigen::Vector3f& point) const;
+  /// The same, for a caller that has the offset from the VPL to the point and its length already
+  /// (the shading loop's light direction): both layers' lookups reuse them.
+  [[nodiscard]] Visibility operator()(std::uint32_t index, const Eigen::Vector3f& from_vpl, float distance) const;
 
  private:
-  [[nodiscard]] float visible(const TileProjection& projection, std::size_t tile_offset, const Eigen::Vector3f& point,
-                              float constant_bias) const;
+  [[nodiscard]] float visible(const TileProjection& projection, std::size_t tile_offset,
+                              const Eigen::Vector3f& from_origin, float distance, float constant_bias) const;
 
   std::span<const float> atlas_;
   int tile_;
