@@ -1,5 +1,6 @@
 // shade_dir_from_maps(): the CPU mirror of dir_shade.comp (see dir_vk.h). Keep the two in step.
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <memory>
 
@@ -208,6 +209,8 @@ class WindowExtremes {
                         std::min(c.min_normal.z, normal.z)};
         c.max_normal = {std::max(c.max_normal.x, normal.x), std::max(c.max_normal.y, normal.y),
                         std::max(c.max_normal.z, normal.z)};
+        // min/max pass a NaN by, where SimilarTo compares it: such a window takes the slow path.
+        if (std::isnan(d) || std::isnan(normal.x) || std::isnan(normal.y) || std::isnan(normal.z)) c.min_distance = 0.f;
       }
       columns_[x] = c;
     }
