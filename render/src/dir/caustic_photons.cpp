@@ -245,9 +245,8 @@ void add_caustic_light(DifferentialImages& images, const GBuffer& gbuffer, const
             const Float3 w = weights ? (*weights)(y, x) : Float3{1.f, 1.f, 1.f};
             if (w == Float3{}) continue;
             const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
-            const Phong phong = with_kd_factor(
-                surface_phong(material, metallic_roughness.empty() ? Vec3::Ones() : vec(metallic_roughness(y, x))),
-                kd_texture.empty() ? Vec3::Ones() : vec(kd_texture(y, x)));
+            const Phong phong = with_kd_factor(surface_phong(material, texture_factor_at(metallic_roughness, x, y)),
+                                               texture_factor_at(kd_texture, x, y));
             const Vec3 p = vec(gbuffer.position(y, x)), n = vec(gbuffer.normal(y, x));
             const Vec3 wo = ((eyes ? vec((*eyes)(y, x)) : camera_centre) - p).normalized();
             const bool real_surface = !gbuffer.virtual_surface(y, x);

@@ -25,14 +25,6 @@ struct Radiance {
   Vec3 indirect_real;
 };
 
-/// A texture factor of pixel (x, y); texture_factors() leaves the image empty where no material
-/// has that texture: the factor is 1.
-Vec3 factor_at(const RadianceImage& factors, int x, int y) {
-  if (factors.empty()) return Vec3::Ones();
-  const Float3& f = factors(y, x);
-  return {f.x, f.y, f.z};
-}
-
 /// The first pass's pixels, row-major.
 class ShadedPixels {
  public:
@@ -310,7 +302,7 @@ Radiance merged_pixel(const GBuffer& g, const ShadedPixels& shaded, const Radian
       }
   }
   // The texture factor of k_d, applied to the indirect light after the merge (MapShader::shade).
-  const Vec3 texture = factor_at(kd_texture, x, y);
+  const Vec3 texture = texture_factor_at(kd_texture, x, y);
   Radiance out;
   out.indirect_real_virtual = (sum_rv / weight).cwiseProduct(texture);
   out.indirect_real = (sum_r / weight).cwiseProduct(texture);
@@ -356,7 +348,7 @@ DifferentialImages shade_from_maps(const GBuffer& gbuffer, const MrScene& scene,
         const Vec3 point(p.x, p.y, p.z), normal(nn.x, nn.y, nn.z);
         const float real_pixel = gbuffer.virtual_surface(y, x) ? 0.f : 1.f;
         const auto subset = static_cast<std::uint32_t>(x % n + n * (y % n));
-        const auto factor = [x, y](const RadianceImage& factors) { return factor_at(factors, x, y); };
+        const auto factor = [x, y](const RadianceImage& factors) { return texture_factor_at(factors, x, y); };
         const PhongMaterial& material = scene.materials[gbuffer.material(y, x) - 1u];
         const Vec3 eye = eyes ? Vec3((*eyes)(y, x).x, (*eyes)(y, x).y, (*eyes)(y, x).z) : camera_centre;
         shaded(y, x) =

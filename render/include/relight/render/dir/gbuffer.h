@@ -39,6 +39,12 @@ enum class MaterialTexture { BaseColor, Emission, MetallicRoughness, Normal };
 /// textured material without coordinates there); 1 elsewhere. Empty when `gbuffer` carries no
 /// texture coordinates or no material has such a texture.
 [[nodiscard]] RadianceImage texture_factors(const GBuffer& gbuffer, const MrScene& scene, MaterialTexture which);
+/// texture_factors()' factor at pixel (x, y): 1 where it is empty.
+[[nodiscard]] inline Eigen::Vector3f texture_factor_at(const RadianceImage& factors, int x, int y) {
+  if (factors.empty()) return Eigen::Vector3f::Ones();
+  const Float3& f = factors(y, x);
+  return {f.x, f.y, f.z};
+}
 
 /// The shading normal at each pixel of `gbuffer`: its normal bent by its material's normal
 /// texture (normal_map.h; at the pixel's footprint, in its tangent frame), the normal itself
