@@ -80,17 +80,19 @@ void summary_section(std::ostringstream& html, const Json& timing) {
   const auto numbers_only = [](const Json& value) {
     return std::all_of(value.begin(), value.end(), [](const Json& v) { return v.is_number(); });
   };
+  const auto inline_numbers = [&](const Json& value) {
+    std::string text;
+    for (const auto& [inner, v] : value.items()) text += (text.empty() ? "" : ", ") + inner + " " + number(v);
+    return text;
+  };
   for (const char* section : {"latency_ms", "dir_steps", "tracking", "marker_pose", "camera_look", "composite"}) {
     if (!timing.contains(section) || !timing[section].is_object()) continue;
     html << "<tr><td>" << section << "<td class=l>";
     for (const auto& [key, value] : timing[section].items()) {
-      std::string text = value.is_array() ? std::to_string(value.size()) + " entries" : number(value);
-      if (value.is_object() && numbers_only(value)) {
-        text.clear();
-        for (const auto& [inner, v] : value.items()) text += (text.empty() ? "" : ", ") + inner + " " + number(v);
-      } else if (value.is_object()) {
-        text = "(see report.json)";
-      }
+      const std::string text = value.is_array()      ? std::to_string(value.size()) + " entries"
+                               : !value.is_object()  ? number(value)
+                               : numbers_only(value) ? inline_numbers(value)
+                                                     : "(see report.json)";
       html << html_escape(key) << " = " << html_escape(text) << "; ";
     }
   }
